@@ -1,0 +1,80 @@
+package org.arflex.contract;
+
+import java.util.List;
+import java.util.Map;
+import java.util.Optional;
+
+/**
+ * A validated, immutable component contract (spec: contracts/SPEC.md). Instances are only
+ * produced by {@link ContractParser}; every list and map is unmodifiable.
+ *
+ * @param name         component name, unique in a runtime ({@code [a-z][a-z0-9-]{0,47}})
+ * @param version      semantic version of the component
+ * @param description  free text, may be empty
+ * @param executable   name of the RT executable inside the bundle ({@code native/linux-x86_64/<executable>})
+ * @param taskType     how the RT half is scheduled
+ * @param movesHardware true when the component commands motion: after a restart it waits for an
+ *                     operator reset before it drives outputs again
+ * @param attributes   provider attributes that input binding filters match against
+ * @param ports        inputs and outputs in declaration order
+ * @param properties   typed parameters in declaration order
+ * @param timing       period, deadline, WCET, priority, CPU set
+ * @param resources    memory and network budget
+ * @param criticality  larger is more critical; the lowest goes first when resources shrink
+ * @param fault        restart and safe-output policy
+ * @param update       where updates come from, if anywhere
+ * @param source       where this contract was read from, for error messages
+ */
+public record Contract(
+        String name,
+        String version,
+        String description,
+        String executable,
+        TaskType taskType,
+        boolean movesHardware,
+        Map<String, String> attributes,
+        List<PortSpec> ports,
+        List<PropertySpec> properties,
+        Timing timing,
+        Resources resources,
+        int criticality,
+        FaultPolicy fault,
+        Optional<UpdateSpec> update,
+        String source) {
+
+    public Contract {
+        attributes = Map.copyOf(attributes);
+        ports = List.copyOf(ports);
+        properties = List.copyOf(properties);
+    }
+
+    /** The inputs, in declaration order. */
+    public List<PortSpec> inputs() {
+        return ports.stream().filter(p -> p.direction() == PortSpec.Direction.IN).toList();
+    }
+
+    /** The outputs, in declaration order. */
+    public List<PortSpec> outputs() {
+        return ports.stream().filter(p -> p.direction() == PortSpec.Direction.OUT).toList();
+    }
+
+    /** The port of that name, if declared. */
+    public Optional<PortSpec> port(String portName) {
+        return ports.stream().filter(p -> p.name().equals(portName)).findFirst();
+    }
+
+    /** The property of that name, if declared. */
+    public Optional<PropertySpec> property(String propertyName) {
+        return properties.stream().filter(p -> p.name().equals(propertyName)).findFirst();
+    }
+
+    /** How the RT half is scheduled. */
+    public enum TaskType {
+        /** A periodic loop at {@link Timing#periodNs()}. */
+        PERIODIC,
+        /** Released by input events, at most once per {@link Timing#periodNs()} (minimum inter-arrival). */
+        SPORADIC,
+        /** Not real-time: no admission test on CPU, runs at SCHED_OTHER. */
+        SERVICE
+    }
+}

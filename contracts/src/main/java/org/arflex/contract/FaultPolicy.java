@@ -1,0 +1,36 @@
+package org.arflex.contract;
+
+/**
+ * What the supervisor does when the RT half crashes or hangs, in the style of Erlang/OTP
+ * supervisors: at most {@code intensity} restarts in {@code windowMs}, with exponential backoff
+ * from {@code backoffMs}; past that the component is Failed.
+ *
+ * @param restart            restart strategy
+ * @param intensity          restarts allowed within the window
+ * @param windowMs           the intensity window, milliseconds
+ * @param backoffMs          first restart delay, doubled each restart inside the window
+ * @param safeOutput         what the RT half's outputs do in safe mode
+ * @param heartbeatTimeoutMs how long the RT half tolerates a silent runtime (then it calls its
+ *                           safe hook), and the runtime a silent RT half (then it is hung)
+ */
+public record FaultPolicy(
+        Restart restart, int intensity, long windowMs, long backoffMs, SafeOutput safeOutput, long heartbeatTimeoutMs) {
+
+    /** Restart strategy, as OTP child specs. */
+    public enum Restart {
+        /** Always restart. */
+        PERMANENT,
+        /** Restart only after an abnormal exit (crash, hang, non-zero exit). */
+        TRANSIENT,
+        /** Never restart. */
+        TEMPORARY
+    }
+
+    /** Safe output behaviour. */
+    public enum SafeOutput {
+        /** Keep the last output value. */
+        HOLD,
+        /** Write zeros to every output. */
+        ZERO
+    }
+}
