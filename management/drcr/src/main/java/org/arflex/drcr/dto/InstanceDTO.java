@@ -1,0 +1,31 @@
+package org.arflex.drcr.dto;
+
+/** A component instance and its state. */
+public class InstanceDTO {
+    /** Instance name (the component name). */
+    public String name;
+    /** INSTALLED, UNSATISFIED, ACTIVE, DESTROYED or FAILED. */
+    public String state;
+    /** The state the DRCR is driving the instance to. */
+    public String targetState;
+    /** Why the instance is not Active (unsatisfied input, admission refusal, crash...), or null. */
+    public String failureReason;
+    /** Restarts left in the current intensity window. */
+    public int restartsLeft;
+    /** Total restarts since install. */
+    public int restarts;
+    /** Process id of the RT half, or 0 when none runs. */
+    public long pid;
+    /** CPU admission placed the task on, or -1. */
+    public int cpu;
+    /** True when the RT half waits for an operator reset before driving outputs. */
+    public boolean awaitingReset;
+    /** Id of the bundle that carries the contract. */
+    public long bundleId;
+    /** The wires of this instance's inputs. */
+    public BindingDTO[] bindings;
+    /** Parameters with their applied values. */
+    public ParamDTO[] params;
+    /** RT statistics, or null when no RT half runs. */
+    public StatsDTO stats;
+}
