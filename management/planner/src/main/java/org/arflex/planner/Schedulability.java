@@ -1,0 +1,157 @@
+package org.arflex.planner;
+
+import java.util.Collection;
+
+/**
+ * Uniprocessor fixed-priority schedulability tests used by {@link Admission}, public so they can
+ * be checked against textbook examples.
+ *
+ * <p>Tasks are periodic or sporadic (period = minimum inter-arrival time) with constrained
+ * deadlines ({@code D <= T}), independent, fully preemptive (SCHED_FIFO). Tasks of equal
+ * priority are counted as interfering with each other (FIFO order among equals is not known in
+ * advance), which is safe.
+ */
+public final class Schedulability {
+
+    private Schedulability() {
+    }
+
+    /**
+     * One task on one CPU.
+     *
+     * @param name       component name
+     * @param periodNs   period or minimum inter-arrival time, {@code > 0}
+     * @param deadlineNs relative deadline, {@code 0 < D <= T}
+     * @param wcetNs     worst-case execution time used for the analysis, {@code > 0}
+     * @param priority   larger is more urgent
+     */
+    public record Task(String name, long periodNs, long deadlineNs, long wcetNs, int priority) {
+        public Task {
+            if (periodNs <= 0) {
+                throw new IllegalArgumentException("task '" + name + "': period " + periodNs + " ns is not positive");
+            }
+            if (deadlineNs <= 0 || deadlineNs > periodNs) {
+                throw new IllegalArgumentException("task '" + name + "': deadline " + deadlineNs
+                        + " ns is not in (0, period " + periodNs + " ns]");
+            }
+            if (wcetNs <= 0) {
+                throw new IllegalArgumentException("task '" + name + "': WCET " + wcetNs + " ns is not positive");
+            }
+        }
+
+        /** {@code C / T}. */
+        public double utilisation() {
+            return (double) wcetNs / periodNs;
+        }
+
+        /** True when {@code D == T}. */
+        public boolean implicitDeadline() {
+            return deadlineNs == periodNs;
+        }
+    }
+
+    /** Total utilisation {@code sum C/T}. */
+    public static double utilisation(Collection<Task> tasks) {
+        double u = 0;
+        for (Task t : tasks) {
+            u += t.utilisation();
+        }
+        return u;
+    }
+
+    /** The Liu and Layland bound {@code n (2^(1/n) - 1)} for n tasks (1 for n = 0). */
+    public static double liuLaylandBound(int n) {
+        return n == 0 ? 1.0 : n * (Math.pow(2.0, 1.0 / n) - 1.0);
+    }
+
+    /**
+     * True when the bounds apply to this set: every deadline is implicit and priorities are rate
+     * monotonic (a shorter period never has a lower or equal priority than a longer one).
+     */
+    public static boolean boundsApply(Collection<Task> tasks) {
+        for (Task a : tasks) {
+            if (!a.implicitDeadline()) {
+                return false;
+            }
+            for (Task b : tasks) {
+                if (a.periodNs() < b.periodNs() && a.priority() <= b.priority()) {
+                    return false;
+                }
+            }
+        }
+        return true;
+    }
+
+    /**
+     * Liu and Layland's sufficient test: {@code U <= n (2^(1/n) - 1)}. Only meaningful when
+     * {@link #boundsApply} holds; returns false otherwise.
+     */
+    public static boolean liuLaylandTest(Collection<Task> tasks) {
+        return boundsApply(tasks) && utilisation(tasks) <= liuLaylandBound(tasks.size()) + 1e-12;
+    }
+
+    /**
+     * Bini and Buttazzo's hyperbolic sufficient test: {@code prod (U_i + 1) <= 2}, never worse
+     * than Liu and Layland's. Only meaningful when {@link #boundsApply} holds; returns false
+     * otherwise.
+     */
+    public static boolean hyperbolicTest(Collection<Task> tasks) {
+        if (!boundsApply(tasks)) {
+            return false;
+        }
+        double p = 1;
+        for (Task t : tasks) {
+            p *= t.utilisation() + 1;
+        }
+        return p <= 2 + 1e-12;
+    }
+
+    /**
+     * Exact worst-case response time of {@code task} among {@code others} (Joseph and Pandya;
+     * Audsley et al.): the least fixpoint of {@code R = C + sum ceil(R / Tj) Cj} over the other
+     * tasks of higher or equal priority, starting from {@code C}. Tasks in {@code others} equal
+     * to {@code task} are ignored.
+     *
+     * @return the response time in ns, or {@code -1} when it exceeds the task's deadline (the
+     *         iteration stops there)
+     */
+    public static long responseTime(Task task, Collection<Task> others) {
+        return responseTime(task, others, task.wcetNs());
+    }
+
+    /**
+     * As {@link #responseTime(Task, Collection)}, starting the iteration from {@code start}
+     * (any value not above the true response time, for example a previous result before a task
+     * was added; values below C are raised to C).
+     */
+    public static long responseTime(Task task, Collection<Task> others, long start) {
+        long r = Math.max(start, task.wcetNs());
+        while (true) {
+            long next = task.wcetNs();
+            for (Task o : others) {
+                if (o == task || o.priority() < task.priority() || o.equals(task)) {
+                    continue;
+                }
+                long releases = (r + o.periodNs() - 1) / o.periodNs();
+                next += releases * o.wcetNs();
+                if (next > task.deadlineNs()) {
+                    return -1;
+                }
+            }
+            if (next == r) {
+                return r;
+            }
+            r = next;
+        }
+    }
+
+    /** True when every task meets its deadline by {@link #responseTime}. */
+    public static boolean rtaTest(Collection<Task> tasks) {
+        for (Task t : tasks) {
+            if (responseTime(t, tasks) < 0) {
+                return false;
+            }
+        }
+        return true;
+    }
+}
