@@ -1,0 +1,151 @@
+/*
+ * arflex/component.h - the template of an RT half: an ops struct and arflex_component_main().
+ *
+ *   static const struct arflex_component_ops ops = {
+ *           .name = "gain", .configure = my_configure, .update = my_update,
+ *   };
+ *   int main(int argc, char **argv) { return arflex_component_main(argc, argv, &ops); }
+ *
+ * arflex_component_main() does everything else:
+ *   1. parses `--runtime <rid> --instance <inst>` (also --help, --version);
+ *   2. opens (never creates) /arflex.<rid>.<inst>.ctl, checks magic/ABI/size, writes its pid,
+ *      state CONFIGURING, applies parameter defaults; opens the cmd/rsp queues;
+ *   3. calls configure (main thread), where the component declares its ports with
+ *      arflex_component_output() / arflex_component_input() and looks up its parameters;
+ *   4. state READY; the mailbox thread serves commands (START, STOP, SET_PARAM, GET_PARAM,
+ *      BIND, UNBIND, GET_STATE, GET_STATS, RESET, SHUTDOWN, PING);
+ *   5. on START: the RT thread (arflex_task: SCHED_FIFO at config.priority when permitted,
+ *      affinity config.cpu_mask, mlockall, cpu_dma_latency) calls start, then every period:
+ *      picks up new input bindings and parameter requests (cycle boundary), checks the
+ *      runtime heartbeat, writes its own heartbeat, calls update (or safe), records stats;
+ *      on STOP it calls stop and returns to READY;
+ *   6. on SHUTDOWN or SIGTERM/SIGINT: stops the loop if running, calls cleanup, unmaps
+ *      everything, state EXITED, returns 0. If configure fails: state FAILED, ctl.exit_status
+ *      = the error, nothing is left mapped, returns ARFLEX_EXIT_CONFIGURE.
+ *
+ * Safe mode: when config.hb_timeout_ns > 0 and the runtime heartbeat (ctl.runtime_hb_ns) is
+ * older than that, the RT thread sets ARFLEX_FLAG_SAFE_ACTIVE and calls safe instead of
+ * update every cycle. When the heartbeat is fresh again: without ARFLEX_CFG_MOVES_HARDWARE
+ * safe mode ends by itself; with it, ARFLEX_FLAG_RESET_REQUIRED is set and safe mode lasts
+ * until the operator's RESET command (which fails with -EAGAIN while the heartbeat is stale).
+ *
+ * Threads: configure and cleanup run on the main thread; start, update, safe and stop on the
+ * RT thread; commands on the mailbox thread. Hooks never run concurrently with each other.
+ */
+#ifndef ARFLEX_COMPONENT_H
+#define ARFLEX_COMPONENT_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "arflex/control.h"
+#include "arflex/port.h"
+#include "arflex/sys.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Maximum ports of each direction per component. */
+#define ARFLEX_MAX_INPUTS 16
+#define ARFLEX_MAX_OUTPUTS 16
+
+/** Process exit codes of arflex_component_main. */
+enum arflex_exit {
+	ARFLEX_EXIT_OK = 0,        /**< SHUTDOWN or SIGTERM, clean */
+	ARFLEX_EXIT_USAGE = 2,     /**< bad command line */
+	ARFLEX_EXIT_ATTACH = 3,    /**< control block or queues missing or incompatible */
+	ARFLEX_EXIT_CONFIGURE = 4, /**< configure hook or port declaration failed */
+	ARFLEX_EXIT_RUNTIME = 5,   /**< fatal error after configure */
+};
+
+struct arflex_component; /* opaque, one per process */
+struct arflex_input;     /* opaque, one per declared input */
+
+/**
+ * The hooks of a component. @user is ops->user. Return conventions: 0 or a negative errno.
+ */
+struct arflex_component_ops {
+	/** Component name for messages (optional; default "component"). */
+	const char *name;
+	/** Passed to every hook (optional). */
+	void *user;
+	/** OPTIONAL, main thread, once: declare ports, look up parameters, allocate. < 0 aborts
+	 *  the process start (state FAILED; cleanup is NOT called: undo your own partial work). */
+	int (*configure)(struct arflex_component *c, void *user);
+	/** OPTIONAL, RT thread, at each START before the first cycle: prefault, reset state.
+	 *  < 0 refuses the START (its reply carries the error; state stays READY). */
+	int (*start)(struct arflex_component *c, void *user);
+	/** REQUIRED, RT thread, once per period: read inputs, compute, write outputs. Must not
+	 *  block, allocate or print. < 0 is counted (stats.update_errors) and the loop goes on. */
+	int (*update)(struct arflex_component *c, void *user, uint64_t release_ns);
+	/** OPTIONAL, RT thread, after the last cycle of a run (STOP, SHUTDOWN, SIGTERM). */
+	void (*stop)(struct arflex_component *c, void *user);
+	/** OPTIONAL, main thread, once before exit if configure succeeded: free resources. */
+	void (*cleanup)(struct arflex_component *c, void *user);
+	/** OPTIONAL (REQUIRED in practice when the component moves hardware), RT thread, every
+	 *  cycle while safe mode is active, instead of update; @first is true on the first call
+	 *  of a safe episode. Drive outputs as @mode says (hold or zero). No safe hook: outputs
+	 *  simply stop changing (hold). Return as update. */
+	int (*safe)(struct arflex_component *c, void *user, enum arflex_safe_mode mode,
+		    bool first);
+};
+
+/** Runs an RT half. Returns an enum arflex_exit code for main() to return. */
+ARFLEX_API int arflex_component_main(int argc, char **argv,
+				     const struct arflex_component_ops *ops);
+
+/* ---- for configure ------------------------------------------------------------------- */
+
+/**
+ * Opens the output port @port (segment /arflex.<rid>.<inst>.out.<port>, created by the
+ * manager) as its producer, checking @method and @type exactly. On success *@out points to
+ * the port (owned by the library, valid until exit). Configure only. Returns 0 or -errno
+ * (-ENOENT: the manager did not create it; -EPROTOTYPE: type/method mismatch; -ENOSPC: too
+ * many outputs; -EEXIST: declared twice).
+ */
+ARFLEX_API int arflex_component_output(struct arflex_component *c, const char *port,
+				       enum arflex_port_method method,
+				       const struct arflex_port_type *type,
+				       struct arflex_port **out);
+
+/** Declares the input @port; it stays unbound until a BIND names a provider segment, whose
+ *  header must be compatible with @method and @type. *@out is owned by the library.
+ *  Configure only. Returns 0 or -errno (-EINVAL, -ENOSPC, -EEXIST). */
+ARFLEX_API int arflex_component_input(struct arflex_component *c, const char *port,
+				      enum arflex_port_method method,
+				      const struct arflex_port_type *type,
+				      struct arflex_input **out);
+
+/** Index of parameter @name in the control block, or -ENOENT. */
+ARFLEX_API int arflex_component_param(const struct arflex_component *c, const char *name);
+
+/* ---- for update / safe (RT safe) ----------------------------------------------------- */
+
+/** Parameter value in force (changes only between cycles while running). */
+ARFLEX_API int64_t arflex_param_i64(const struct arflex_component *c, int idx);
+ARFLEX_API double arflex_param_f64(const struct arflex_component *c, int idx);
+ARFLEX_API bool arflex_param_bool(const struct arflex_component *c, int idx);
+
+/** True while an input has a provider. */
+ARFLEX_API bool arflex_input_bound(const struct arflex_input *in);
+/** arflex_state_read on the bound provider; -ENOTCONN when unbound. */
+ARFLEX_API int arflex_input_state_read(struct arflex_input *in, void *out, size_t len,
+				       uint64_t *seq);
+/** arflex_stream_pop on the bound provider; -ENOTCONN when unbound. */
+ARFLEX_API int arflex_input_stream_pop(struct arflex_input *in, void *out, size_t len);
+/** arflex_frame_acquire on the bound provider; -ENOTCONN when unbound. */
+ARFLEX_API int arflex_input_frame_acquire(struct arflex_input *in, struct arflex_frame_view *v);
+
+/** The control block (read-only use; e.g. config.period_ns). */
+ARFLEX_API const struct arflex_ctl *arflex_component_ctl(const struct arflex_component *c);
+/** Runtime id and instance name. */
+ARFLEX_API const char *arflex_component_runtime(const struct arflex_component *c);
+ARFLEX_API const char *arflex_component_instance(const struct arflex_component *c);
+/** True while safe mode is active. */
+ARFLEX_API bool arflex_component_safe_active(const struct arflex_component *c);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* ARFLEX_COMPONENT_H */
