@@ -1,0 +1,193 @@
+package org.arflex.drcr.impl.abi;
+
+import java.io.IOException;
+import java.nio.ByteBuffer;
+import java.nio.ByteOrder;
+import java.nio.charset.StandardCharsets;
+import java.util.Optional;
+
+/**
+ * The manager side of rt-core/include/arflex/mailbox.h: the queue pair
+ * {@code /arflex.<rid>.<inst>.cmd} (requests, manager to RT) and {@code .rsp} (replies), each
+ * message one 512-byte struct arflex_msg. One request is outstanding at a time (calls are
+ * serialised); a reply whose seq is not the awaited one is a late reply to a request that timed
+ * out and is discarded.
+ */
+public final class Mailbox implements AutoCloseable {
+
+    public static final int MSG_MAGIC = 0x534D4641; // "AFMS"
+    public static final int MSG_SIZE = 512;
+    public static final int MQ_MAXMSG = 8;
+    public static final int OFF_MAGIC = 0;
+    public static final int OFF_ABI_MAJOR = 4;
+    public static final int OFF_ABI_MINOR = 6;
+    public static final int OFF_SEQ = 8;
+    public static final int OFF_CMD = 12;
+    public static final int OFF_FLAGS = 14;
+    public static final int OFF_STATUS = 16;
+    public static final int OFF_PAYLOAD_LEN = 20;
+    public static final int OFF_PAYLOAD = 32;
+    public static final int FLAG_REPLY = 1;
+    // struct arflex_msg_param, relative to the payload
+    public static final int PARAM_INDEX = 0;
+    public static final int PARAM_TYPE = 4;
+    public static final int PARAM_VALUE = 8;
+    public static final int PARAM_APPLIED_SEQ = 16;
+    public static final int PARAM_NAME = 24;
+    public static final int PARAM_SIZE = 56;
+    // struct arflex_msg_bind
+    public static final int BIND_PORT = 0;
+    public static final int BIND_SHM_NAME = 32;
+    public static final int BIND_SIZE = 160;
+    public static final int OBJ_NAME_SIZE = 128;
+    // struct arflex_msg_state
+    public static final int STATE_STATE = 0;
+    public static final int STATE_FLAGS = 4;
+    public static final int STATE_PID = 8;
+    public static final int STATE_BOUND = 12;
+    public static final int STATE_CYCLES = 16;
+
+    /** enum arflex_cmd. */
+    public enum Cmd {
+        START(1), STOP(2), SET_PARAM(3), GET_PARAM(4), BIND(5), UNBIND(6), GET_STATE(7), GET_STATS(8),
+        RESET(9), SHUTDOWN(10), PING(11);
+
+        public final int code;
+
+        Cmd(int code) {
+            this.code = code;
+        }
+    }
+
+    /** A reply: status 0 or -errno from the RT side, and the whole message for payload reads. */
+    public record Reply(int status, ByteBuffer msg) {
+        public long payloadLong(int off) {
+            return msg.getLong(OFF_PAYLOAD + off);
+        }
+
+        public int payloadInt(int off) {
+            return msg.getInt(OFF_PAYLOAD + off);
+        }
+    }
+
+    private final MessageQueue cmd;
+    private final MessageQueue rsp;
+    private int seq;
+
+    private Mailbox(MessageQueue cmd, MessageQueue rsp) {
+        this.cmd = cmd;
+        this.rsp = rsp;
+    }
+
+    /** Creates both queues exclusively (0600); nothing is left behind on failure. */
+    public static Mailbox create(String cmdName, String rspName) throws IOException {
+        MessageQueue c = MessageQueue.create(cmdName, MQ_MAXMSG, MSG_SIZE);
+        try {
+            return new Mailbox(c, MessageQueue.create(rspName, MQ_MAXMSG, MSG_SIZE));
+        } catch (IOException e) {
+            c.close();
+            throw e;
+        }
+    }
+
+    /** A request message with header filled and zeroed payload. */
+    public static ByteBuffer message(Cmd c, int seq) {
+        ByteBuffer b = ByteBuffer.allocate(MSG_SIZE).order(ByteOrder.LITTLE_ENDIAN);
+        b.putInt(OFF_MAGIC, MSG_MAGIC);
+        b.putShort(OFF_ABI_MAJOR, (short) ControlBlock.ABI_MAJOR);
+        b.putShort(OFF_ABI_MINOR, (short) ControlBlock.ABI_MINOR);
+        b.putInt(OFF_SEQ, seq);
+        b.putShort(OFF_CMD, (short) c.code);
+        return b;
+    }
+
+    /** Writes a NUL-terminated name into the payload. */
+    public static void putName(ByteBuffer b, int payloadOff, int size, String s) {
+        byte[] bytes = s.getBytes(StandardCharsets.US_ASCII);
+        if (bytes.length >= size) {
+            throw new IllegalArgumentException("'" + s + "' longer than " + (size - 1) + " bytes");
+        }
+        for (int i = 0; i < size; i++) {
+            b.put(OFF_PAYLOAD + payloadOff + i, i < bytes.length ? bytes[i] : 0);
+        }
+    }
+
+    /** BIND of input {@code port} to the provider segment {@code shmName}. */
+    public Reply bind(String port, String shmName, long timeoutMs) throws IOException {
+        return call(Cmd.BIND, b -> {
+            putName(b, BIND_PORT, ControlBlock.NAME_SIZE, port);
+            putName(b, BIND_SHM_NAME, OBJ_NAME_SIZE, shmName);
+            b.putInt(OFF_PAYLOAD_LEN, BIND_SIZE);
+        }, timeoutMs);
+    }
+
+    /** UNBIND of input {@code port}. */
+    public Reply unbind(String port, long timeoutMs) throws IOException {
+        return call(Cmd.UNBIND, b -> {
+            putName(b, BIND_PORT, ControlBlock.NAME_SIZE, port);
+            b.putInt(OFF_PAYLOAD_LEN, BIND_SIZE);
+        }, timeoutMs);
+    }
+
+    /** SET_PARAM of slot {@code index}; the reply carries the applied value. */
+    public Reply setParam(int index, long bits, long timeoutMs) throws IOException {
+        return call(Cmd.SET_PARAM, b -> {
+            b.putInt(OFF_PAYLOAD + PARAM_INDEX, index);
+            b.putLong(OFF_PAYLOAD + PARAM_VALUE, bits);
+            b.putInt(OFF_PAYLOAD_LEN, PARAM_SIZE);
+        }, timeoutMs);
+    }
+
+    /** A command without payload. */
+    public Reply call(Cmd c, long timeoutMs) throws IOException {
+        return call(c, b -> { }, timeoutMs);
+    }
+
+    /**
+     * Sends a request and waits for its reply until the deadline.
+     *
+     * @throws IOException on transport failure or when no reply came in time
+     */
+    public synchronized Reply call(Cmd c, java.util.function.Consumer<ByteBuffer> fill, long timeoutMs)
+            throws IOException {
+        int s = ++seq;
+        ByteBuffer req = message(c, s);
+        fill.accept(req);
+        long deadline = System.nanoTime() + timeoutMs * 1_000_000L;
+        cmd.send(req.array(), timeoutMs);
+        while (true) {
+            long left = (deadline - System.nanoTime()) / 1_000_000L;
+            if (left <= 0) {
+                throw new IOException(c + " (seq " + s + "): no reply within " + timeoutMs + " ms on " + rsp.name());
+            }
+            Optional<byte[]> got = rsp.receive(left);
+            if (got.isEmpty()) {
+                continue;
+            }
+            ByteBuffer r = ByteBuffer.wrap(got.get()).order(ByteOrder.LITTLE_ENDIAN);
+            if (got.get().length < OFF_PAYLOAD || r.getInt(OFF_MAGIC) != MSG_MAGIC
+                    || r.getShort(OFF_ABI_MAJOR) != ControlBlock.ABI_MAJOR) {
+                continue; // not a message of ours: discarded
+            }
+            if (r.getInt(OFF_SEQ) != s || (r.getShort(OFF_FLAGS) & FLAG_REPLY) == 0) {
+                continue; // a late reply to an earlier request
+            }
+            return new Reply(r.getInt(OFF_STATUS), r);
+        }
+    }
+
+    public String cmdName() {
+        return cmd.name();
+    }
+
+    public String rspName() {
+        return rsp.name();
+    }
+
+    /** Closes and removes both queues. */
+    @Override
+    public void close() {
+        cmd.close();
+        rsp.close();
+    }
+}

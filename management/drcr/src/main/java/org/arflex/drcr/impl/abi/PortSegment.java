@@ -1,0 +1,130 @@
+package org.arflex.drcr.impl.abi;
+
+import java.io.IOException;
+import java.nio.charset.StandardCharsets;
+
+/**
+ * An output port segment {@code /arflex.<rid>.<inst>.out.<port>}: Java side of struct
+ * arflex_port_hdr in rt-core/include/arflex/port.h. The manager creates and formats it (as
+ * arflex_port_create does) before the producer starts, and removes it when the producer is
+ * destroyed; it survives restarts of its producer, so consumers keep their mapping.
+ */
+public final class PortSegment implements AutoCloseable {
+
+    public static final long MAGIC = 0x545250584C465241L; // "ARFLXPRT"
+    public static final int HDR_SIZE = 256;
+    public static final int SLOT_HDR_SIZE = 64;
+    public static final int TYPE_NAME_SIZE = 64;
+    public static final int OFF_MAGIC = 0;
+    public static final int OFF_ABI_MAJOR = 8;
+    public static final int OFF_ABI_MINOR = 10;
+    public static final int OFF_HEADER_SIZE = 12;
+    public static final int OFF_SIZE = 16;
+    public static final int OFF_METHOD = 24;
+    public static final int OFF_ELEM_SIZE = 28;
+    public static final int OFF_DEPTH = 32;
+    public static final int OFF_OVERFLOW = 36;
+    public static final int OFF_SLOT_STRIDE = 40;
+    public static final int OFF_TYPE_MAJOR = 44;
+    public static final int OFF_TYPE_MINOR = 46;
+    public static final int OFF_TYPE_HASH = 48;
+    public static final int OFF_TYPE_NAME = 56;
+    public static final int OFF_HEAD = 128;
+    public static final int OFF_WRITTEN = 136;
+    public static final int OFF_WRITER_PID = 152;
+    public static final int OFF_TAIL = 192;
+    public static final int METHOD_STATE = 1;
+    public static final int METHOD_STREAM = 2;
+    public static final int METHOD_FRAME = 3;
+    public static final int OVERFLOW_NONE = 0;
+    public static final int OVERFLOW_DROP_OLDEST = 1;
+    public static final int OVERFLOW_DROP_NEWEST = 2;
+    public static final int MAX_DEPTH = 65536;
+    public static final long MAX_ELEM = 64L << 20;
+
+    private final ShmSegment shm;
+
+    private PortSegment(ShmSegment shm) {
+        this.shm = shm;
+    }
+
+    /** FNV-1a 64 over the bytes of the type name, as arflex_port_type_hash. */
+    public static long typeHash(String name) {
+        long h = 0xcbf29ce484222325L;
+        for (byte b : name.getBytes(StandardCharsets.UTF_8)) {
+            h ^= b & 0xff;
+            h *= 0x100000001b3L;
+        }
+        return h;
+    }
+
+    /** Stride of one slot: slot header plus payload, rounded up to 64. */
+    public static int stride(int elemSize) {
+        return (SLOT_HDR_SIZE + elemSize + 63) & ~63;
+    }
+
+    /** Segment size: header plus depth slots, rounded up to 4096, as arflex_port_segment_size. */
+    public static long segmentSize(int method, int elemSize, int depth) {
+        int d = method == METHOD_STATE ? 1 : depth;
+        long s = HDR_SIZE + (long) d * stride(elemSize);
+        return (s + 4095) & ~4095L;
+    }
+
+    /** Creates and formats an output segment. */
+    public static PortSegment create(String name, int method, String typeName, int typeMajor, int typeMinor,
+                                     int elemSize, int depth, int overflow) throws IOException {
+        if (elemSize <= 0 || elemSize > MAX_ELEM) {
+            throw new IOException("port " + name + ": element size " + elemSize + " not in 1.." + MAX_ELEM);
+        }
+        int d = method == METHOD_STATE ? 1 : depth;
+        if (d < 1 || d > MAX_DEPTH) {
+            throw new IOException("port " + name + ": depth " + depth + " not in 1.." + MAX_DEPTH);
+        }
+        if (typeName.getBytes(StandardCharsets.UTF_8).length >= TYPE_NAME_SIZE) {
+            throw new IOException("port " + name + ": type name '" + typeName + "' longer than 63 bytes");
+        }
+        long size = segmentSize(method, elemSize, d);
+        ShmSegment s = ShmSegment.create(name, size);
+        s.putLong(OFF_MAGIC, MAGIC);
+        s.buffer().putShort(OFF_ABI_MAJOR, (short) ControlBlock.ABI_MAJOR);
+        s.buffer().putShort(OFF_ABI_MINOR, (short) ControlBlock.ABI_MINOR);
+        s.putInt(OFF_HEADER_SIZE, HDR_SIZE);
+        s.putLong(OFF_SIZE, size);
+        s.putInt(OFF_METHOD, method);
+        s.putInt(OFF_ELEM_SIZE, elemSize);
+        s.putInt(OFF_DEPTH, d);
+        s.putInt(OFF_OVERFLOW, method == METHOD_STREAM ? overflow : OVERFLOW_NONE);
+        s.putInt(OFF_SLOT_STRIDE, stride(elemSize));
+        s.buffer().putShort(OFF_TYPE_MAJOR, (short) typeMajor);
+        s.buffer().putShort(OFF_TYPE_MINOR, (short) typeMinor);
+        s.putLong(OFF_TYPE_HASH, typeHash(typeName));
+        s.putString(OFF_TYPE_NAME, TYPE_NAME_SIZE, typeName);
+        return new PortSegment(s);
+    }
+
+    public String name() {
+        return shm.name();
+    }
+
+    /** Elements published by the producer. */
+    public long head() {
+        return shm.getLongAcquire(OFF_HEAD);
+    }
+
+    /** Write attempts by the producer. */
+    public long written() {
+        return shm.getLongAcquire(OFF_WRITTEN);
+    }
+
+    /** The mapped segment, for monitoring reads. */
+    public ShmSegment segment() {
+        return shm;
+    }
+
+    /** Unmaps and removes the segment. */
+    @Override
+    public void close() {
+        shm.unlink();
+        shm.close();
+    }
+}
