@@ -1,0 +1,111 @@
+package org.arflex.contract;
+
+import java.nio.charset.StandardCharsets;
+import java.util.List;
+import java.util.Optional;
+import java.util.Set;
+
+/**
+ * A port type: a fixed-width little-endian layout with a name and a {@code major.minor} version
+ * (spec §13). Defined in contracts/types/*.xml; the C header and the Java accessor are
+ * generated from it. Instances come from {@link PortTypes}.
+ *
+ * @param name        qualified name, for example {@code arflex.JointState}
+ * @param version     layout version; a provider of P feeds a consumer of C when same major, P.minor >= C.minor
+ * @param methods     transport methods a port of this type may use
+ * @param fields      fields and explicit pads in layout order, with their offsets
+ * @param constants   named values of fields (enumerations, flags)
+ * @param size        size of one value, bytes (a multiple of 8)
+ * @param maxPayload  for frame types: largest payload after the header in one slot, bytes; 0 otherwise
+ * @param description free text
+ * @param source      where the definition was read from
+ */
+public record PortType(String name, TypeVersion version, Set<PortSpec.Method> methods, List<Field> fields,
+        List<Constant> constants, int size, long maxPayload, String description, String source) {
+
+    public PortType {
+        methods = Set.copyOf(methods);
+        fields = List.copyOf(fields);
+        constants = List.copyOf(constants);
+    }
+
+    /** The 64-bit type id shared by C and Java: FNV-1a 64 of {@code name@major} (spec §13.3). */
+    public long id() {
+        return fnv1a64(name + "@" + version.major());
+    }
+
+    /** The field of that name (pads excluded). */
+    public Optional<Field> field(String fieldName) {
+        return fields.stream().filter(f -> !f.padding() && f.name().equals(fieldName)).findFirst();
+    }
+
+    /** FNV-1a 64-bit hash of the UTF-8 bytes of {@code text}. */
+    public static long fnv1a64(String text) {
+        long h = 0xcbf29ce484222325L;
+        for (byte b : text.getBytes(StandardCharsets.UTF_8)) {
+            h ^= b & 0xff;
+            h *= 0x100000001b3L;
+        }
+        return h;
+    }
+
+    /** Scalar element types; each is aligned to its own size (spec §13.2). */
+    public enum Scalar {
+        U8(1, "uint8_t"), U16(2, "uint16_t"), U32(4, "uint32_t"), U64(8, "uint64_t"),
+        I32(4, "int32_t"), I64(8, "int64_t"), F32(4, "float"), F64(8, "double");
+
+        private final int size;
+        private final String cType;
+
+        Scalar(int size, String cType) {
+            this.size = size;
+            this.cType = cType;
+        }
+
+        /** Size and alignment in bytes. */
+        public int size() {
+            return size;
+        }
+
+        /** The C type. */
+        public String cType() {
+            return cType;
+        }
+
+        /** The spelling in definitions ({@code u8} ... {@code f64}). */
+        public String xmlName() {
+            return name().toLowerCase(java.util.Locale.ROOT);
+        }
+    }
+
+    /**
+     * A field (or explicit pad) of a layout.
+     *
+     * @param name        field name; pads are named {@code _padN}
+     * @param scalar      element type (U8 for pads)
+     * @param count       number of elements, 1 for a scalar
+     * @param array       declared with {@code count} (an array, even of 1)
+     * @param offset      byte offset from the start of the value
+     * @param padding     true for an explicit pad
+     * @param unit        unit text, may be empty
+     * @param description free text
+     */
+    public record Field(String name, Scalar scalar, int count, boolean array, int offset, boolean padding,
+            String unit, String description) {
+        /** Size in bytes. */
+        public int size() {
+            return scalar.size() * count;
+        }
+    }
+
+    /**
+     * A named value.
+     *
+     * @param name        constant name, upper case
+     * @param scalar      its type
+     * @param value       its value (two's complement bits for signed, raw bits for unsigned)
+     * @param description free text
+     */
+    public record Constant(String name, Scalar scalar, long value, String description) {
+    }
+}
