@@ -1,0 +1,149 @@
+// The simulated robot cell: the TRUE arm in MuJoCo driven by the conventional controller (a
+// joint position servo with gravity compensation from the NOMINAL model), sensors, scripted
+// disturbances and a lock-step stepping API.
+//
+// Threading: a Cell is used by one thread (the physics/RT thread). Rendering happens
+// elsewhere from a copy of qpos (see render.h); Step() never waits for it.
+// Allocation: everything is allocated in Create(); Step() and the accessors do not allocate.
+#ifndef ARFLEX_SIM_CELL_H_
+#define ARFLEX_SIM_CELL_H_
+
+#include <mujoco/mujoco.h>
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "arflex_sim/kinematics.h"
+#include "arflex_sim/params.h"
+
+namespace arflex {
+namespace sim {
+
+// Motor-side joint state as the robot's own controller reports it.
+struct JointState {
+  JointVector q{};    // motor (encoder) angles (rad)
+  JointVector dq{};   // motor velocities (rad/s)
+  JointVector tau{};  // drive torque delivered to the joint (N m), incl. the servo's damping
+};
+
+// Wrist force/torque sensor reading in the sensor frame (the flange frame), MuJoCo's
+// convention: the force and torque that the arm exerts on the tool (tool + payload +
+// anything pushing on them), measured at the flange.
+struct Wrench {
+  Vec3 force{};
+  Vec3 torque{};
+};
+
+class Cell {
+ public:
+  // Builds the TRUE and NOMINAL models from `config`, the tag textures, and puts the arm at
+  // rest at q = `initial_q` (reference = initial_q). Returns nullptr and sets `*error` to a
+  // message naming the problem on failure.
+  static std::unique_ptr<Cell> Create(const CellConfig& config, const JointVector& initial_q,
+                                      std::string* error);
+  ~Cell();
+  Cell(const Cell&) = delete;
+  Cell& operator=(const Cell&) = delete;
+
+  // The joint reference the servo follows, and the correction added to it (the only way a
+  // correction component acts on the arm). Both in rad, motor side.
+  void SetJointReference(const JointVector& q_ref) { q_ref_ = q_ref; }
+  void SetCorrection(const JointVector& dq) { correction_ = dq; }
+
+  // Advances exactly `n` physics steps of config.timestep; each runs the servo once. No
+  // sleeping: real-time pacing is the caller's business.
+  void Step(int n);
+
+  // Puts the arm at motor angles `q` with zero velocity, the compliance joints at their
+  // static deflection, reference = q, time and counters unchanged.
+  void ResetTo(const JointVector& q);
+
+  uint64_t step_count() const { return steps_; }
+  double time() const { return data_->time; }
+  double timestep() const { return model_->opt.timestep; }
+
+  JointState ReadJointState() const;
+  Wrench ReadWrench() const;
+  // Ground truth: the TCP pose of the TRUE arm (for evaluation only).
+  Eigen::Isometry3d TrueTcp() const;
+  // Current deflection of the series compliance joints (0 where a joint is rigid).
+  JointVector ComplianceDeflection() const;
+  // Gravity (+payload) torque at the joints computed on the NOMINAL model at `q`, the
+  // payload being `payload_mass`. What the compliance model says the springs carry.
+  JointVector NominalGravityTorque(const JointVector& q, double payload_mass);
+
+  // The actual payload, and whether the controller's gravity compensation is told of it.
+  void SetPayload(double mass, bool tell_controller);
+  double payload() const { return payload_mass_; }
+
+  // Moves the obstacle (a mocap box) to `pos`, or far away when `enabled` is false.
+  void SetObstacle(bool enabled, const Vec3& pos);
+  // Replaces the scripted pushes (at most the number given in the config at Create(); extra
+  // entries are ignored and counted as warnings) and the hand guiding script.
+  void SetPushes(const std::vector<PushSpec>& pushes);
+  void SetHandGuide(const HandGuideSpec& hand) { hand_ = hand; }
+  // External force applied at the TCP in the last step (world frame), for inspection.
+  Vec3 last_external_force() const { return last_force_; }
+  // Number of contacts between the arm and the obstacle in the last step.
+  int obstacle_contacts() const;
+
+  // Independent nominal kinematics (the arm the controller knows).
+  const NominalKinematics& nominal() const { return kinematics_; }
+  const CellConfig& config() const { return config_; }
+  const ErrorSet& errors() const { return errors_; }
+
+  // Read-only access for renderers and tests. qpos() is the full TRUE-model state vector
+  // (copy model()->nq values to render elsewhere).
+  const mjModel* model() const { return model_; }
+  const mjData* data() const { return data_; }
+  const double* qpos() const { return data_->qpos; }
+
+  // Warnings counted instead of printed (MuJoCo's d->warning plus ours).
+  int warning_count() const;
+
+  // qpos address of motor joint i and of its compliance joint (-1 if rigid) in model().
+  int motor_qpos(int i) const { return motor_qadr_[i]; }
+  int compliance_qpos(int i) const { return compliance_qadr_[i]; }
+
+ private:
+  Cell(const CellConfig& config);
+  void Controller();
+  void ApplyDisturbances();
+  void SolveStaticCompliance();
+
+  CellConfig config_;
+  ErrorSet errors_;
+  NominalKinematics kinematics_;
+  mjModel* model_ = nullptr;
+  mjData* data_ = nullptr;
+  mjModel* nominal_model_ = nullptr;
+  mjData* nominal_data_ = nullptr;
+  int motor_qadr_[kNumJoints]{};
+  int motor_dadr_[kNumJoints]{};
+  int compliance_qadr_[kNumJoints]{};
+  int compliance_dadr_[kNumJoints]{};
+  int tcp_site_ = -1;
+  int tool_body_ = -1;
+  int payload_body_ = -1;
+  int nominal_payload_body_ = -1;
+  int obstacle_mocap_ = -1;
+  int obstacle_geom_ = -1;
+  int ft_force_adr_ = -1;
+  int ft_torque_adr_ = -1;
+  JointVector q_ref_{};
+  JointVector correction_{};
+  double payload_mass_ = 0.0;
+  std::vector<PushSpec> pushes_;  // capacity fixed at Create()
+  size_t push_capacity_ = 0;
+  HandGuideSpec hand_;
+  Vec3 last_force_{};
+  uint64_t steps_ = 0;
+  int own_warnings_ = 0;
+};
+
+}  // namespace sim
+}  // namespace arflex
+
+#endif  // ARFLEX_SIM_CELL_H_
