@@ -120,8 +120,12 @@ public final class PortTypes {
         Set<String> names = new HashSet<>();
         for (Path f : files) {
             try (InputStream in = Files.newInputStream(f)) {
-                PortType t = read(in, f.getFileName().toString(), problems);
-                if (t != null && !names.add(t.name())) {
+                String file = f.getFileName().toString();
+                PortType t = read(in, file, problems);
+                if (t != null && !file.equals(t.name() + ".xml")) {
+                    problems.add(new Problem(file, 1, 1, "13.1", "portType/@name",
+                            "file of port type " + t.name() + " must be named " + t.name() + ".xml"));
+                } else if (t != null && !names.add(t.name())) {
                     problems.add(new Problem(t.source(), 1, 1, "13.1", "portType/@name",
                             "port type " + t.name() + " is defined by more than one file"));
                 } else if (t != null) {
@@ -301,6 +305,9 @@ public final class PortTypes {
             String base = "const[" + c.name + "]";
             if (c.name == null || !CONST_NAME.matcher(c.name).matches()) {
                 p.at(c, "13.2", base + "/@name", "'" + c.name + "' is not a constant name ([A-Z][A-Z0-9_]{0,47})");
+            } else if (Set.of("NAME", "ID", "SIZE", "METHODS", "MAX_PAYLOAD", "VERSION_MAJOR", "VERSION_MINOR")
+                    .contains(c.name) || c.name.startsWith("OFFSET_") || c.name.endsWith("_LENGTH")) {
+                p.at(c, "13.2", base + "/@name", "'" + c.name + "' clashes with a generated name");
             } else if (!cnames.add(c.name)) {
                 p.at(c, "13.2", base + "/@name", "duplicate constant '" + c.name + "'");
             }
