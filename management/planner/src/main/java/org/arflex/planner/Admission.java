@@ -1,8 +1,20 @@
 package org.arflex.planner;
 
+import java.util.ArrayList;
 import java.util.Collection;
+import java.util.Comparator;
+import java.util.HashMap;
+import java.util.HashSet;
+import java.util.List;
 import java.util.Map;
+import java.util.OptionalInt;
+import java.util.PriorityQueue;
+import java.util.Set;
+import java.util.TreeMap;
+import java.util.TreeSet;
 import org.arflex.contract.Contract;
+import org.arflex.contract.PortSpec;
+import org.arflex.contract.Timing;
 
 /**
  * Admission control: decides which of the satisfied components the cell can run.
@@ -33,7 +45,7 @@ public final class Admission {
     }
 
     /**
-     * Runs admission.
+     * Runs admission; the components in {@code previousCpu} count as running.
      *
      * @param candidates     the satisfied components to consider
      * @param wires          the resolver's wires (those of required inputs between candidates
@@ -45,12 +57,515 @@ public final class Admission {
      */
     public static AdmissionResult admit(Collection<Contract> candidates, Collection<Wire> wires,
             Capacities capacities, Map<String, Long> measuredWcetNs, Map<String, Integer> previousCpu) {
-        throw new UnsupportedOperationException("API draft");
+        return admit(candidates, wires, capacities, measuredWcetNs, previousCpu, previousCpu.keySet());
+    }
+
+    /**
+     * Runs admission.
+     *
+     * @param candidates     the satisfied components to consider
+     * @param wires          the resolver's wires (those of required inputs between candidates
+     *                       order the admission)
+     * @param capacities     what the cell offers
+     * @param measuredWcetNs measured WCET by component name, ns (missing or 0: none)
+     * @param previousCpu    CPU of each component currently running (kept when it still fits)
+     * @param running        components currently running (preferred at equal criticality)
+     * @return a decision for every candidate
+     */
+    public static AdmissionResult admit(Collection<Contract> candidates, Collection<Wire> wires,
+            Capacities capacities, Map<String, Long> measuredWcetNs, Map<String, Integer> previousCpu,
+            Set<String> running) {
+        return new Run(candidates, wires, capacities, measuredWcetNs, previousCpu, running).run();
     }
 
     /** Runs admission over the satisfied components of {@code resolver}, with nothing running. */
     public static AdmissionResult admit(Resolver resolver, Capacities capacities, Map<String, Long> measuredWcetNs) {
-        throw new UnsupportedOperationException("API draft");
+        List<Contract> cands = new ArrayList<>();
+        for (String n : resolver.satisfied()) {
+            cands.add(resolver.contract(n).orElseThrow());
+        }
+        return admit(cands, resolver.wires(), capacities, measuredWcetNs, Map.of(), Set.of());
     }
 
+    /** One task placed on a CPU. */
+    private static final class Entry {
+        final Schedulability.Task task;
+        long r; // a lower bound of the response time (exact after final analysis); -1 unknown
+
+        Entry(Schedulability.Task task) {
+            this.task = task;
+            this.r = -1;
+        }
+    }
+
+    /** The outcome of testing one task on one CPU. */
+    private record Fit(boolean ok, String reason, Map<Entry, Long> newR) {
+    }
+
+    private static final class Cpu {
+        final int id;
+        final double cap;
+        final List<Entry> tasks = new ArrayList<>();
+        double util;
+
+        Cpu(Capacities.Cpu c) {
+            this.id = c.id();
+            this.cap = c.utilisationCap();
+        }
+
+        /** All deadlines implicit and priorities rate monotonic (so the bounds apply). */
+        boolean rmOk = true;
+        /** prod (U_i + 1). */
+        double hyper = 1;
+        /** period -> {min priority, max priority} of the tasks of that period. */
+        final TreeMap<Long, int[]> prioByPeriod = new TreeMap<>();
+
+        /** Whether the bounds still apply with {@code t} added: O(log n) thanks to monotony. */
+        boolean rmOkWith(Schedulability.Task t) {
+            if (!rmOk || !t.implicitDeadline()) {
+                return false;
+            }
+            Map.Entry<Long, int[]> shorter = prioByPeriod.lowerEntry(t.periodNs());
+            if (shorter != null && shorter.getValue()[0] <= t.priority()) {
+                return false;
+            }
+            Map.Entry<Long, int[]> longer = prioByPeriod.higherEntry(t.periodNs());
+            return longer == null || longer.getValue()[1] < t.priority();
+        }
+
+        /** Adds a task that passed {@link #test}; returns the undo step. */
+        Runnable add(Entry e) {
+            Schedulability.Task t = e.task;
+            boolean oldRm = rmOk;
+            double oldHyper = hyper;
+            double oldUtil = util;
+            int[] oldPrio = prioByPeriod.get(t.periodNs());
+            rmOk = rmOkWith(t);
+            hyper *= t.utilisation() + 1;
+            util += t.utilisation();
+            prioByPeriod.put(t.periodNs(), oldPrio == null ? new int[] {t.priority(), t.priority()}
+                    : new int[] {Math.min(oldPrio[0], t.priority()), Math.max(oldPrio[1], t.priority())});
+            tasks.add(e);
+            return () -> {
+                tasks.remove(e);
+                rmOk = oldRm;
+                hyper = oldHyper;
+                util = oldUtil;
+                if (oldPrio == null) {
+                    prioByPeriod.remove(t.periodNs());
+                } else {
+                    prioByPeriod.put(t.periodNs(), oldPrio);
+                }
+            };
+        }
+
+        List<Schedulability.Task> taskList(Schedulability.Task extra) {
+            List<Schedulability.Task> all = new ArrayList<>(tasks.size() + 1);
+            for (Entry e : tasks) {
+                all.add(e.task);
+            }
+            if (extra != null) {
+                all.add(extra);
+            }
+            return all;
+        }
+
+        Fit test(Schedulability.Task t) {
+            double u = util + t.utilisation();
+            if (u > cap + 1e-9) {
+                return new Fit(false, "cpu " + id + ": utilisation " + Text.util(u) + " with '" + t.name()
+                        + "' exceeds cap " + Text.util(cap), Map.of());
+            }
+            if (rmOkWith(t) && hyper * (t.utilisation() + 1) <= 2 + 1e-12) {
+                return new Fit(true, null, Map.of());
+            }
+            List<Schedulability.Task> all = taskList(t);
+            Map<Entry, Long> newR = new HashMap<>();
+            // The new task first, then the tasks it can delay (lower or equal priority), most
+            // urgent first, so the first miss reported is the most telling one.
+            Entry fresh = new Entry(t);
+            List<Entry> affected = new ArrayList<>();
+            affected.add(fresh);
+            for (Entry e : tasks) {
+                if (e.task.priority() <= t.priority()) {
+                    affected.add(e);
+                }
+            }
+            affected.subList(1, affected.size()).sort(Comparator.comparingInt((Entry e) -> -e.task.priority())
+                    .thenComparing(e -> e.task.name()));
+            for (Entry e : affected) {
+                long start = Math.max(e.r, e.task.wcetNs());
+                long r = Schedulability.responseTime(e.task, all, start);
+                if (r < 0) {
+                    long shown = responseTimeForMessage(e.task, all, start);
+                    String rt = shown > 0 ? "response time " + Text.duration(shown) : "response time (unbounded)";
+                    String who = e == fresh ? rt + " of '" + t.name() + "'"
+                            : "adding '" + t.name() + "' gives " + rt + " of '" + e.task.name() + "', which";
+                    return new Fit(false, "cpu " + id + ": " + who + " exceeds deadline "
+                            + Text.duration(e.task.deadlineNs()) + " (U=" + Text.util(u) + ")", Map.of());
+                }
+                newR.put(e, r);
+            }
+            return new Fit(true, null, newR);
+        }
+
+        String testName() {
+            if (tasks.isEmpty()) {
+                return "none";
+            }
+            return rmOk && hyper <= 2 + 1e-12 ? "hyperbolic bound" : "response-time analysis";
+        }
+    }
+
+    /** The exact response time when it is finite and below 100 periods, else the last iterate, else -1. */
+    private static long responseTimeForMessage(Schedulability.Task t, List<Schedulability.Task> all, long start) {
+        double u = 0;
+        for (Schedulability.Task o : all) {
+            if (o != t && o.priority() >= t.priority()) {
+                u += o.utilisation();
+            }
+        }
+        if (u >= 1) {
+            return -1;
+        }
+        long limit = 100 * t.periodNs();
+        long r = Math.max(start, t.wcetNs());
+        for (int iter = 0; iter < 10_000; iter++) {
+            long next = t.wcetNs();
+            for (Schedulability.Task o : all) {
+                if (o != t && o.priority() >= t.priority()) {
+                    next += ((r + o.periodNs() - 1) / o.periodNs()) * o.wcetNs();
+                }
+            }
+            if (next == r || next > limit) {
+                return next;
+            }
+            r = next;
+        }
+        return r;
+    }
+
+    /** One admission run. */
+    private static final class Run {
+        final TreeMap<String, Contract> cands = new TreeMap<>();
+        final Map<String, List<Wire>> requiredIn = new HashMap<>();
+        final Capacities caps;
+        final Map<String, Long> measured;
+        final Map<String, Integer> previousCpu;
+        final Set<String> running;
+        final TreeMap<Integer, Cpu> cpus = new TreeMap<>();
+        final TreeMap<String, Decision> decisions = new TreeMap<>();
+        final Map<String, Cpu> placedOn = new HashMap<>();
+        final Map<String, Entry> entryOf = new HashMap<>();
+        final Map<String, String> notes = new HashMap<>();
+        final Set<String> admitted = new HashSet<>();
+        long memUsed;
+        long netUsed;
+
+        Run(Collection<Contract> candidates, Collection<Wire> wires, Capacities caps, Map<String, Long> measured,
+                Map<String, Integer> previousCpu, Set<String> running) {
+            for (Contract c : candidates) {
+                if (cands.put(c.name(), c) != null) {
+                    throw new IllegalArgumentException("candidate '" + c.name() + "' given twice");
+                }
+            }
+            for (Wire w : wires) {
+                Contract c = cands.get(w.consumer());
+                if (c == null) {
+                    continue;
+                }
+                PortSpec in = c.port(w.inPort()).orElse(null);
+                if (in != null && !in.optional()) {
+                    requiredIn.computeIfAbsent(w.consumer(), k -> new ArrayList<>()).add(w);
+                }
+            }
+            for (List<Wire> l : requiredIn.values()) {
+                l.sort(null);
+            }
+            this.caps = caps;
+            this.measured = measured;
+            this.previousCpu = previousCpu;
+            this.running = running;
+            for (Capacities.Cpu c : caps.cpus()) {
+                cpus.put(c.id(), new Cpu(c));
+            }
+        }
+
+        Set<String> providersOf(String n) {
+            List<Wire> ws = requiredIn.get(n);
+            if (ws == null) {
+                return Set.of();
+            }
+            Set<String> s = new TreeSet<>();
+            for (Wire w : ws) {
+                s.add(w.provider());
+            }
+            return s;
+        }
+
+        AdmissionResult run() {
+            List<List<String>> groups = Graphs.dependencyOrder(cands.keySet(), this::providersOf);
+            int g = groups.size();
+            Map<String, Integer> groupOf = new HashMap<>();
+            for (int i = 0; i < g; i++) {
+                for (String n : groups.get(i)) {
+                    groupOf.put(n, i);
+                }
+            }
+            List<Set<Integer>> consumersOf = new ArrayList<>();
+            List<Set<Integer>> providersOfGroup = new ArrayList<>();
+            for (int i = 0; i < g; i++) {
+                consumersOf.add(new HashSet<>());
+                providersOfGroup.add(new HashSet<>());
+            }
+            for (int i = 0; i < g; i++) {
+                for (String n : groups.get(i)) {
+                    for (String p : providersOf(n)) {
+                        Integer j = groupOf.get(p);
+                        if (j != null && j != i) {
+                            consumersOf.get(j).add(i);
+                            providersOfGroup.get(i).add(j);
+                        }
+                    }
+                }
+            }
+            // Effective criticality: consumers before providers (reverse dependency order).
+            int[] eff = new int[g];
+            boolean[] isRunning = new boolean[g];
+            for (int i = g - 1; i >= 0; i--) {
+                int e = Integer.MIN_VALUE;
+                for (String n : groups.get(i)) {
+                    e = Math.max(e, cands.get(n).criticality());
+                    isRunning[i] |= running.contains(n);
+                }
+                for (int c : consumersOf.get(i)) {
+                    e = Math.max(e, eff[c]);
+                }
+                eff[i] = e;
+            }
+            int[] pending = new int[g];
+            PriorityQueue<Integer> ready = new PriorityQueue<>(Comparator.comparingInt((Integer i) -> -eff[i])
+                    .thenComparing(i -> isRunning[i] ? 0 : 1).thenComparing(i -> groups.get(i).get(0)));
+            for (int i = 0; i < g; i++) {
+                pending[i] = providersOfGroup.get(i).size();
+                if (pending[i] == 0) {
+                    ready.add(i);
+                }
+            }
+            while (!ready.isEmpty()) {
+                int i = ready.poll();
+                admitGroup(groups.get(i));
+                for (int c : consumersOf.get(i)) {
+                    if (--pending[c] == 0) {
+                        ready.add(c);
+                    }
+                }
+            }
+            return result();
+        }
+
+        void admitGroup(List<String> members) {
+            // A required provider outside the group that is not admitted refuses the group.
+            for (String n : members) {
+                List<Wire> ws = requiredIn.getOrDefault(n, List.of());
+                for (Wire w : ws) {
+                    if (members.contains(w.provider())) {
+                        continue;
+                    }
+                    if (!cands.containsKey(w.provider())) {
+                        refuseAll(members, n, "input '" + w.inPort() + "' of '" + n + "': provider '" + w.provider()
+                                + "' is not a candidate");
+                        return;
+                    }
+                    if (!admitted.contains(w.provider())) {
+                        refuseAll(members, n, "input '" + w.inPort() + "' of '" + n + "': provider '" + w.provider()
+                                + "' was refused admission");
+                        return;
+                    }
+                }
+            }
+            List<Runnable> undo = new ArrayList<>();
+            for (String n : members) {
+                String refusal = place(cands.get(n), undo);
+                if (refusal != null) {
+                    for (int k = undo.size() - 1; k >= 0; k--) {
+                        undo.get(k).run();
+                    }
+                    refuseAll(members, n, refusal);
+                    return;
+                }
+            }
+        }
+
+        void refuseAll(List<String> members, String culprit, String reason) {
+            for (String n : members) {
+                String r = n.equals(culprit) ? reason
+                        : "refused with its cycle " + members + ": '" + culprit + "': " + reason;
+                decisions.put(n, new Decision(n, false, OptionalInt.empty(), wcetOf(cands.get(n)), -1, r));
+            }
+        }
+
+        long wcetOf(Contract c) {
+            if (c.taskType() == Contract.TaskType.SERVICE) {
+                return 0;
+            }
+            long m = measured.getOrDefault(c.name(), 0L);
+            return Math.max(c.timing().wcetNs(), m);
+        }
+
+        /** Places one component; returns null on success (with undo steps added) or the refusal. */
+        String place(Contract c, List<Runnable> undo) {
+            String n = c.name();
+            long mem = c.resources().memoryBytes();
+            long net = c.resources().networkBps();
+            if (memUsed + mem > caps.memoryBytes()) {
+                return "memory: " + Text.bytes(mem) + " requested, " + Text.bytes(Math.max(0, caps.memoryBytes() - memUsed))
+                        + " free";
+            }
+            if (netUsed + net > caps.networkBps()) {
+                return "network: " + Text.rate(net) + " requested, " + Text.rate(Math.max(0, caps.networkBps() - netUsed))
+                        + " free";
+            }
+            Cpu chosen = null;
+            Fit fit = null;
+            if (c.taskType() != Contract.TaskType.SERVICE) {
+                Timing t = c.timing();
+                long wcet = wcetOf(c);
+                long declared = t.wcetNs();
+                if (wcet > declared) {
+                    notes.put(n, "measured WCET " + Text.duration(wcet) + " > declared " + Text.duration(declared));
+                }
+                Schedulability.Task task;
+                try {
+                    task = new Schedulability.Task(n, t.periodNs(), t.deadlineNs(), wcet, t.priority());
+                } catch (IllegalArgumentException e) {
+                    return "timing: " + e.getMessage() + (wcet > declared ? " (" + notes.get(n) + ")" : "");
+                }
+                if (wcet > t.deadlineNs()) {
+                    return "timing: WCET " + Text.duration(wcet) + " exceeds deadline " + Text.duration(t.deadlineNs())
+                            + (wcet > declared ? " (" + notes.get(n) + ")" : "");
+                }
+                List<Cpu> allowed = new ArrayList<>();
+                if (t.cpus().isEmpty()) {
+                    allowed.addAll(cpus.values());
+                } else {
+                    for (int id : new TreeSet<>(t.cpus())) {
+                        Cpu cpu = cpus.get(id);
+                        if (cpu != null) {
+                            allowed.add(cpu);
+                        }
+                    }
+                }
+                if (allowed.isEmpty()) {
+                    return "cpu: " + (t.cpus().isEmpty() ? "no cpu in capacities"
+                            : "allowed cpus " + join(new TreeSet<>(t.cpus())) + " not in capacities (have "
+                                    + (cpus.isEmpty() ? "none" : join(cpus.keySet())) + ")");
+                }
+                // Keep the previous CPU when it still fits; otherwise worst fit, then lowest id.
+                List<Cpu> order = new ArrayList<>(allowed);
+                order.sort(Comparator.comparingDouble((Cpu x) -> x.util).thenComparingInt(x -> x.id));
+                Integer prev = previousCpu.get(n);
+                if (prev != null) {
+                    for (int k = 0; k < order.size(); k++) {
+                        if (order.get(k).id == prev) {
+                            order.add(0, order.remove(k));
+                            break;
+                        }
+                    }
+                }
+                List<String> why = new ArrayList<>();
+                for (Cpu cpu : order) {
+                    Fit f = cpu.test(task);
+                    if (f.ok()) {
+                        chosen = cpu;
+                        fit = f;
+                        break;
+                    }
+                    why.add(f.reason());
+                }
+                if (chosen == null) {
+                    String r = why.size() <= 3 ? String.join("; ", why)
+                            : String.join("; ", why.subList(0, 3)) + "; and " + (why.size() - 3) + " more cpus";
+                    return wcet > declared ? r + " (" + notes.get(n) + ")" : r;
+                }
+                Cpu cpu = chosen;
+                Entry e = new Entry(task);
+                Map<Entry, Long> old = new HashMap<>();
+                for (Map.Entry<Entry, Long> nr : fit.newR().entrySet()) {
+                    Entry x = nr.getKey();
+                    if (x.task == task) {
+                        e.r = nr.getValue();
+                    } else {
+                        old.put(x, x.r);
+                        x.r = nr.getValue();
+                    }
+                }
+                Runnable cpuUndo = cpu.add(e);
+                placedOn.put(n, cpu);
+                entryOf.put(n, e);
+                undo.add(() -> {
+                    cpuUndo.run();
+                    old.forEach((x, r) -> x.r = r);
+                    placedOn.remove(n);
+                    entryOf.remove(n);
+                });
+            }
+            memUsed += mem;
+            netUsed += net;
+            admitted.add(n);
+            undo.add(() -> {
+                memUsed -= mem;
+                netUsed -= net;
+                admitted.remove(n);
+            });
+            return null;
+        }
+
+        AdmissionResult result() {
+            List<CpuLoad> loads = new ArrayList<>();
+            for (Cpu cpu : cpus.values()) {
+                String test = cpu.testName();
+                List<Schedulability.Task> all = cpu.taskList(null);
+                boolean rta = test.equals("response-time analysis");
+                List<Entry> sorted = new ArrayList<>(cpu.tasks);
+                sorted.sort(Comparator.comparingInt((Entry e) -> -e.task.priority()).thenComparing(e -> e.task.name()));
+                List<String> names = new ArrayList<>();
+                for (Entry e : sorted) {
+                    names.add(e.task.name());
+                    e.r = rta ? Schedulability.responseTime(e.task, all, Math.max(e.r, e.task.wcetNs())) : -1;
+                }
+                loads.add(new CpuLoad(cpu.id, cpu.cap, cpu.util, names, test));
+            }
+            for (String n : admitted) {
+                Contract c = cands.get(n);
+                Cpu cpu = placedOn.get(n);
+                String reason;
+                long r = -1;
+                if (cpu == null) {
+                    reason = "service task: no CPU budget";
+                } else {
+                    Entry e = entryOf.get(n);
+                    r = e.r;
+                    reason = r >= 0
+                            ? "cpu " + cpu.id + ": R=" + Text.duration(r) + " <= D=" + Text.duration(e.task.deadlineNs())
+                                    + " (U=" + Text.util(cpu.util) + ")"
+                            : "cpu " + cpu.id + ": hyperbolic bound holds (U=" + Text.util(cpu.util) + ")";
+                    if (notes.containsKey(n)) {
+                        reason += "; " + notes.get(n);
+                    }
+                }
+                decisions.put(n, new Decision(n, true, cpu == null ? OptionalInt.empty() : OptionalInt.of(cpu.id),
+                        wcetOf(c), r, reason));
+            }
+            return new AdmissionResult(decisions, loads, memUsed, netUsed, caps);
+        }
+    }
+
+    private static String join(Collection<Integer> ids) {
+        List<String> s = new ArrayList<>();
+        for (int i : ids) {
+            s.add(Integer.toString(i));
+        }
+        return String.join(", ", s);
+    }
 }

@@ -193,7 +193,7 @@ public final class Plan {
         return admission;
     }
 
-    /** Cycles of required inputs among the components Active after, each from its least name. */
+    /** Cycles of required inputs among the components Active after: members sorted, by first member. */
     public List<List<String>> cycles() {
         return cycles;
     }
@@ -261,7 +261,7 @@ public final class Plan {
         if (!cycles.isEmpty()) {
             sb.append("cycles:\n");
             for (List<String> c : cycles) {
-                sb.append("  ").append(String.join(" -> ", c)).append(" -> ").append(c.get(0)).append('\n');
+                sb.append("  {").append(String.join(", ", c)).append("}\n");
             }
         }
         sb.append("cpus:");

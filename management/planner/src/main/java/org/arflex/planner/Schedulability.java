@@ -1,6 +1,9 @@
 package org.arflex.planner;
 
+import java.util.ArrayList;
 import java.util.Collection;
+import java.util.Comparator;
+import java.util.List;
 
 /**
  * Uniprocessor fixed-priority schedulability tests used by {@link Admission}, public so they can
@@ -69,15 +72,30 @@ public final class Schedulability {
      * monotonic (a shorter period never has a lower or equal priority than a longer one).
      */
     public static boolean boundsApply(Collection<Task> tasks) {
-        for (Task a : tasks) {
-            if (!a.implicitDeadline()) {
+        for (Schedulability.Task t : tasks) {
+            if (!t.implicitDeadline()) {
                 return false;
             }
-            for (Task b : tasks) {
-                if (a.periodNs() < b.periodNs() && a.priority() <= b.priority()) {
-                    return false;
-                }
+        }
+        List<Schedulability.Task> sorted = new ArrayList<>(tasks);
+        sorted.sort(Comparator.comparingLong(Schedulability.Task::periodNs));
+        // Every task must have a strictly higher priority than all tasks of longer period.
+        int i = 0;
+        int minPrioShorter = Integer.MAX_VALUE;
+        while (i < sorted.size()) {
+            int j = i;
+            int minHere = Integer.MAX_VALUE;
+            int maxHere = Integer.MIN_VALUE;
+            while (j < sorted.size() && sorted.get(j).periodNs() == sorted.get(i).periodNs()) {
+                minHere = Math.min(minHere, sorted.get(j).priority());
+                maxHere = Math.max(maxHere, sorted.get(j).priority());
+                j++;
             }
+            if (maxHere >= minPrioShorter) {
+                return false;
+            }
+            minPrioShorter = Math.min(minPrioShorter, minHere);
+            i = j;
         }
         return true;
     }
