@@ -11,11 +11,10 @@
 namespace arflex {
 namespace sim {
 
-// Loads MJCF text through a private virtual file system. Returns nullptr with `error` set.
-mjModel* LoadModelFromString(const std::string& xml, const char* name, std::string* error) {
+mjModel* LoadMjcf(const std::string& xml, const std::string& name, std::string* error) {
   auto vfs = std::make_unique<mjVFS>();
   mj_defaultVFS(vfs.get());
-  const std::string file = std::string(name) + ".xml";
+  const std::string file = name + ".xml";
   if (mj_makeEmptyFileVFS(vfs.get(), file.c_str(), static_cast<int>(xml.size())) != 0) {
     *error = "cannot create virtual file for model " + file;
     return nullptr;
@@ -78,9 +77,9 @@ std::unique_ptr<Cell> Cell::Create(const CellConfig& config, const JointVector& 
     *error = std::string("invalid CellConfig: ") + e.what();
     return nullptr;
   }
-  cell->model_ = LoadModelFromString(true_xml, "arflex_cell_true", error);
+  cell->model_ = LoadMjcf(true_xml, "arflex_cell_true", error);
   if (!cell->model_) return nullptr;
-  cell->nominal_model_ = LoadModelFromString(nominal_xml, "arflex_cell_nominal", error);
+  cell->nominal_model_ = LoadMjcf(nominal_xml, "arflex_cell_nominal", error);
   if (!cell->nominal_model_) return nullptr;
   cell->data_ = mj_makeData(cell->model_);
   cell->nominal_data_ = mj_makeData(cell->nominal_model_);

@@ -2,6 +2,8 @@
 #ifndef ARFLEX_SIM_MJCF_H_
 #define ARFLEX_SIM_MJCF_H_
 
+#include <mujoco/mujoco.h>
+
 #include <string>
 
 #include "arflex_sim/params.h"
@@ -22,6 +24,11 @@ enum class ModelKind {
 // Returns the MJCF text of the cell for `kind`. Deterministic: the same config gives the
 // same text.
 std::string GenerateMjcf(const CellConfig& config, ModelKind kind);
+
+// Compiles MJCF text (through a private virtual file system, nothing touches the disk).
+// Returns the model, owned by the caller (free with mj_deleteModel), or nullptr with
+// `*error` naming `name` and MuJoCo's message.
+mjModel* LoadMjcf(const std::string& xml, const std::string& name, std::string* error);
 
 // Camera frame axes (MuJoCo convention: the camera looks along its -z, +y is up in the
 // image) for a camera at `pos` looking at `look_at` with `up` as the up hint.
