@@ -90,4 +90,76 @@ class ContractParserTest {
         assertTrue(r.get(2).ok());
         assertEquals("sample-scaler-2", r.get(2).contract().orElseThrow().name());
     }
+
+    @Test
+    void inputLargerThanOneMebibyteIsRefusedBeforeParsing() throws Exception {
+        String good = resource("/good/sample-scaler.xml");
+        String big = good.replace("<description>", "<description>" + "x".repeat(ContractParser.MAX_BYTES));
+        List<Problem> p = PARSER.validate(big, "big.xml");
+        assertEquals(1, p.size());
+        assertEquals("2.1", p.get(0).section());
+        assertTrue(p.get(0).message().contains("larger than 1048576 bytes"), p.get(0).message());
+    }
+
+    @Test
+    void tooManyElementsHitTheElementLimit() throws Exception {
+        String good = resource("/good/sample-scaler.xml");
+        String many = good.replace("</attributes>", "<attribute name=\"a\" value=\"b\"/>".repeat(10_001) + "</attributes>");
+        List<Problem> p = PARSER.validate(many, "many.xml");
+        assertEquals(1, p.size(), p.toString());
+        assertEquals("2.1", p.get(0).section());
+        assertTrue(p.get(0).message().contains("limit"), p.get(0).message());
+    }
+
+    @Test
+    void longTextNodeHitsTheTextLimit() throws Exception {
+        String good = resource("/good/sample-scaler.xml");
+        String longText = good.replace("<description>", "<description>" + "y".repeat(70_000));
+        List<Problem> p = PARSER.validate(longText, "long.xml");
+        assertEquals("2.1", p.get(0).section(), p.toString());
+    }
+
+    @Test
+    void serviceWithoutTimingGetsZeroTimingAndRoundTrips() throws Exception {
+        Contract c = PARSER.parse(resource("/good/debug-monitor.xml"), "debug-monitor.xml");
+        assertEquals(Contract.TaskType.SERVICE, c.taskType());
+        assertEquals(new Timing(0, 0, 0, 0, List.of()), c.timing());
+        assertEquals(10L * 1024, c.resources().networkBps());
+        assertEquals(c, PARSER.parse(ContractWriter.create().write(c), "debug-monitor.xml"));
+    }
+
+    @Test
+    void deadlineDefaultsToPeriodAndCpuListsExpand() throws Exception {
+        Contract c = PARSER.parse(resource("/good/joint-trajectory.xml"), "jt.xml");
+        assertEquals(c.timing().periodNs(), c.timing().deadlineNs());
+        assertEquals(List.of(0, 2, 3), c.timing().cpus());
+        assertEquals(1_000_000L, c.resources().networkBps());
+        assertEquals("Interpolates joint targets into a 1 kHz joint reference.", c.description());
+        assertEquals(Binding.filter("(&(role=robot)(|(sim=true)(sim=false))(!(degraded=*)))"),
+                c.port("state").orElseThrow().binding().orElseThrow());
+        assertTrue(c.port("safety").orElseThrow().optional());
+        assertEquals(PortSpec.Overflow.DROP_NEWEST, c.port("log").orElseThrow().overflow());
+        assertEquals(PropertySpec.Value.ofInt(6), c.property("axes").orElseThrow().defaultValue());
+        assertEquals(PropertySpec.Value.ofBool(false), c.property("dry_run").orElseThrow().defaultValue());
+        assertEquals(0.001, c.property("blend.radius").orElseThrow().defaultValue().asDouble());
+        assertEquals(FaultPolicy.SafeOutput.ZERO, c.fault().safeOutput());
+        assertEquals(3, c.fault().intensity());
+        assertEquals(List.of("state", "safety"), c.inputs().stream().map(PortSpec::name).toList());
+    }
+
+    @Test
+    void sha256IsNormalisedToLowerCase() throws Exception {
+        Contract c = PARSER.parse(resource("/good/camera.xml"), "camera.xml");
+        assertEquals("e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855", c.update().orElseThrow().sha256());
+        assertEquals("https", c.update().orElseThrow().url().getScheme());
+    }
+
+    @Test
+    void unknownPortTypeWithACustomRegistryIsKnown() throws Exception {
+        String xml = resource("/good/sample-scaler.xml");
+        ContractParser noTypes = ContractParser.create(PortTypes.of(List.of()));
+        List<Problem> p = noTypes.validate(xml, "s.xml");
+        assertEquals(2, p.size(), p.toString());
+        assertTrue(p.stream().allMatch(x -> x.section().equals("6.2")));
+    }
 }

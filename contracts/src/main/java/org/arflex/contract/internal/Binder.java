@@ -4,6 +4,7 @@ import com.fasterxml.jackson.annotation.JsonAutoDetect;
 import com.fasterxml.jackson.annotation.PropertyAccessor;
 import com.fasterxml.jackson.core.JsonLocation;
 import com.fasterxml.jackson.core.JsonParser;
+import com.fasterxml.jackson.core.JsonStreamContext;
 import com.fasterxml.jackson.core.JsonToken;
 import com.fasterxml.jackson.databind.BeanDescription;
 import com.fasterxml.jackson.databind.DeserializationConfig;
@@ -61,7 +62,10 @@ public final class Binder {
             public boolean handleUnknownProperty(DeserializationContext ctxt, JsonParser p,
                     JsonDeserializer<?> deserializer, Object beanOrClass, String propertyName) throws IOException {
                 JsonLocation loc = p.currentTokenLocation();
-                String owner = beanOrClass instanceof Located l ? elementName(l) : "element";
+                JsonStreamContext ctx = p.getParsingContext();
+                JsonStreamContext parent = ctx == null ? null : ctx.getParent();
+                String owner = parent != null && parent.getCurrentName() != null ? parent.getCurrentName()
+                        : beanOrClass instanceof Located l ? elementName(l) : "element";
                 String msg = propertyName.isEmpty()
                         ? "text is not allowed inside <" + owner + ">"
                         : "unknown element or attribute '" + propertyName + "' in <" + owner + ">";

@@ -119,6 +119,14 @@ public final class SecureXml {
                                 "processing instruction <?" + r.getPITarget() + "?> is not allowed");
                         return false;
                     }
+                    case XMLStreamConstants.CHARACTERS, XMLStreamConstants.CDATA, XMLStreamConstants.SPACE -> {
+                        if (r.getTextLength() > MAX_TEXT_LENGTH) {
+                            add(problems, source, r.getLocation(), "2.1", "(document)",
+                                    "document exceeds a parser limit: a text node is longer than " + MAX_TEXT_LENGTH
+                                            + " characters");
+                            return false;
+                        }
+                    }
                     case XMLStreamConstants.START_ELEMENT -> {
                         String ns = r.getNamespaceURI() == null ? "" : r.getNamespaceURI();
                         if (!seenRoot) {
@@ -152,7 +160,11 @@ public final class SecureXml {
                 problems.add(new Problem(source, 1, 1, "2.3", "(root)", "document has no root element"));
             }
         } catch (XMLStreamException e) {
-            add(problems, source, e.getLocation(), "2.1", "(document)", describe(e));
+            Location loc = e.getLocation();
+            if (loc == null && r != null) {
+                loc = r.getLocation();
+            }
+            add(problems, source, loc, "2.1", "(document)", describe(e));
         } finally {
             if (r != null) {
                 try {
