@@ -197,11 +197,12 @@ public final class Resolver {
                 ch.prevStatus.putIfAbsent(c.name(), old.satisfied);
                 detach(c.name(), ch);
                 ch.replaced.add(c.name());
+                // Start from the old status: if it still holds, nothing downstream is disturbed.
+                attach(c, ch).satisfied = old.satisfied;
             } else {
-                ch.prevStatus.putIfAbsent(c.name(), null);
                 ch.added.add(c.name());
+                attach(c, ch);
             }
-            attach(c, ch);
         }
         return finish(ch);
     }
@@ -261,7 +262,7 @@ public final class Resolver {
         ch.dirty.remove(name);
     }
 
-    private void attach(Contract c, Change ch) {
+    private Node attach(Contract c, Change ch) {
         Node node = new Node(c);
         nodes.put(c.name(), node);
         for (PortSpec p : c.outputs()) {
@@ -303,6 +304,7 @@ public final class Resolver {
             rewire(in, ch);
         }
         ch.dirty.add(c.name());
+        return node;
     }
 
     private void addCandidate(In in, Out o) {
@@ -461,16 +463,20 @@ public final class Resolver {
         }
         TreeSet<String> up = new TreeSet<>();
         TreeSet<String> down = new TreeSet<>();
+        for (String a : ch.added) {
+            Node n = nodes.get(a);
+            if (n != null) {
+                (n.satisfied ? up : down).add(a);
+            }
+        }
         for (Map.Entry<String, Boolean> e : ch.prevStatus.entrySet()) {
             Node n = nodes.get(e.getKey());
-            if (n == null) {
+            if (n == null || ch.added.contains(e.getKey())) {
                 continue;
             }
-            boolean before = e.getValue() != null && e.getValue();
-            boolean existed = e.getValue() != null;
-            if (n.satisfied && (!before || !existed)) {
+            if (n.satisfied && !e.getValue()) {
                 up.add(n.name());
-            } else if (!n.satisfied && (before || !existed)) {
+            } else if (!n.satisfied && e.getValue()) {
                 down.add(n.name());
             }
         }
