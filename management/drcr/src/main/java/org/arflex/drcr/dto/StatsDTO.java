@@ -12,8 +12,8 @@ public class StatsDTO {
     public long maxLatencyNs;
     /** Largest execution time observed, nanoseconds. */
     public long maxExecNs;
-    /** Last execution time, nanoseconds. */
-    public long lastExecNs;
+    /** Mean execution time, nanoseconds. */
+    public long meanExecNs;
     /** RT-half state as the RT half reports it. */
     public String rtState;
     /** Age of the RT half's heartbeat when read, milliseconds. */

@@ -130,6 +130,15 @@ public final class ControlBlock implements AutoCloseable {
      * config, descriptors, applied values = defaults, metric minima = UINT64_MAX.
      */
     public static ControlBlock create(String name, Config cfg, List<Param> params) throws IOException {
+        return create(name, cfg, params, false);
+    }
+
+    /**
+     * As {@link #create(String, Config, List)}; {@code resetRequired} sets
+     * ARFLEX_FLAG_RESET_REQUIRED before the spawn (a restarted component that moves hardware).
+     */
+    public static ControlBlock create(String name, Config cfg, List<Param> params, boolean resetRequired)
+            throws IOException {
         if (params.size() > PARAM_SLOTS) {
             throw new IOException("control block " + name + ": " + params.size() + " parameters, at most " + PARAM_SLOTS);
         }
@@ -163,7 +172,7 @@ public final class ControlBlock implements AutoCloseable {
                 s.putLong(o + SLOT_DEFAULT, p.defaultBits());
                 s.putLong(o + SLOT_APPLIED_VALUE, p.defaultBits());
             }
-            if (cfg.cfgFlags() != 0 && (cfg.cfgFlags() & CFG_MOVES_HARDWARE) != 0) {
+            if (resetRequired) {
                 // control.h: before the spawn the manager may set RESET_REQUIRED.
                 s.putInt(OFF_FLAGS, FLAG_RESET_REQUIRED);
             }

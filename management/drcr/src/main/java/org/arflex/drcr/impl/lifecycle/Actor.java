@@ -26,6 +26,12 @@ public interface Actor {
     /** The clock the actor's timers follow. */
     Clock clock();
 
+    /**
+     * Runs {@code c} on the actor thread and waits up to {@code timeoutMs} for its result
+     * (directly when already on the actor thread). Exceptions of {@code c} are rethrown.
+     */
+    <T> T call(java.util.concurrent.Callable<T> c, long timeoutMs);
+
     /** Throws IllegalStateException unless called on the actor thread. */
     default void checkThread() {
         if (!inActor()) {

@@ -66,6 +66,7 @@ public final class ThreadActor implements Actor {
      * Runs {@code c} on the actor thread and waits for its result (from another thread), or
      * runs it directly when already on the actor thread.
      */
+    @Override
     public <T> T call(Callable<T> c, long timeoutMs) {
         if (inActor()) {
             try {

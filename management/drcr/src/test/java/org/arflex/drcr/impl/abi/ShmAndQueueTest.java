@@ -25,7 +25,7 @@ class ShmAndQueueTest {
         ControlBlock.Param gain = new ControlBlock.Param("gain", ControlBlock.PARAM_DOUBLE, true,
                 Double.doubleToRawLongBits(0.0), Double.doubleToRawLongBits(10.0), Double.doubleToRawLongBits(2.5));
         try (ControlBlock cb = ControlBlock.create(name, new ControlBlock.Config(1_000_000, 1_000_000, 500_000_000L, 1,
-                10, 0, 0, ControlBlock.CFG_MOVES_HARDWARE), List.of(gain))) {
+                10, 0, 0, ControlBlock.CFG_MOVES_HARDWARE), List.of(gain), true)) {
             assertTrue(Files.exists(file));
             assertEquals("rw-------", PosixFilePermissions.toString(Files.getPosixFilePermissions(file)));
             assertEquals(ControlBlock.SIZE, Files.size(file));

@@ -110,6 +110,21 @@ public final class ManualActor implements Actor {
         }
     }
 
+    @Override
+    public <T> T call(java.util.concurrent.Callable<T> c, long timeoutMs) {
+        boolean was = stepping;
+        stepping = true;
+        try {
+            return c.call();
+        } catch (RuntimeException e) {
+            throw e;
+        } catch (Exception e) {
+            throw new IllegalStateException(e);
+        } finally {
+            stepping = was;
+        }
+    }
+
     /** Pending timers. */
     public int pendingTimers() {
         return timers.size();

@@ -1,0 +1,157 @@
+package org.arflex.drcr.impl;
+
+import java.time.LocalTime;
+import java.util.ArrayList;
+import java.util.Hashtable;
+import java.util.List;
+import java.util.concurrent.ScheduledExecutorService;
+import java.util.concurrent.ScheduledThreadPoolExecutor;
+import java.util.concurrent.TimeUnit;
+import java.util.function.Consumer;
+import java.util.regex.Pattern;
+import org.arflex.contract.PortTypes;
+import org.arflex.drcr.DrcrService;
+import org.arflex.drcr.ResourceManager;
+import org.arflex.drcr.UpdateService;
+import org.arflex.drcr.impl.abi.Posix;
+import org.arflex.drcr.impl.extender.ContractExtender;
+import org.arflex.drcr.impl.lifecycle.ThreadActor;
+import org.arflex.drcr.impl.runtime.Cell;
+import org.arflex.drcr.impl.runtime.ContractReader;
+import org.arflex.drcr.impl.services.ResourceManagerImpl;
+import org.arflex.drcr.impl.services.Services;
+import org.arflex.drcr.impl.shell.Commands;
+import org.arflex.drcr.impl.supervisor.ProcessLauncher;
+import org.arflex.planner.Planner;
+import org.osgi.annotation.bundle.Header;
+import org.osgi.framework.Bundle;
+import org.osgi.framework.BundleActivator;
+import org.osgi.framework.BundleContext;
+import org.osgi.framework.Constants;
+import org.osgi.framework.ServiceRegistration;
+import org.osgi.util.tracker.BundleTracker;
+
+/**
+ * Starts the DRCR: sweeps what dead runtimes left, builds the cell (actor, planner, launcher),
+ * registers the services and Gogo commands, starts the heartbeat thread and the extender. Stop
+ * undoes all of it and leaves no process or shared object behind.
+ *
+ * <p>Framework properties: {@code arflex.runtime.id} (default {@code rt<pid>}),
+ * {@code arflex.cpus} (default all), {@code arflex.cpu.cap} (utilisation cap per CPU, default
+ * 1.0), {@code arflex.memory} (default 1g), {@code arflex.network} (default 125m B/s),
+ * {@code arflex.ready.timeout.ms} (default 5000), {@code arflex.nomlock} (true: RT halves skip
+ * mlockall, for tests with many instances).
+ */
+@Header(name = Constants.BUNDLE_ACTIVATOR, value = "${@class}")
+public final class Activator implements BundleActivator {
+
+    private static final Pattern RID = Pattern.compile("[a-z0-9-]{1,40}");
+    private static final long HEARTBEAT_MS = 20;
+    private static final long SAMPLE_MS = 1_000;
+
+    private ThreadActor actor;
+    private Cell cell;
+    private Services services;
+    private ScheduledExecutorService ticker;
+    private BundleTracker<List<String>> tracker;
+    private final List<ServiceRegistration<?>> regs = new ArrayList<>();
+    private String rid;
+    private final Consumer<String> log = line -> System.err.println(LocalTime.now() + " " + line);
+
+    private static String prop(BundleContext ctx, String key, String def) {
+        String v = ctx.getProperty(key);
+        return v == null || v.isBlank() ? def : v.trim();
+    }
+
+    @Override
+    public void start(BundleContext ctx) throws Exception {
+        rid = prop(ctx, "arflex.runtime.id", "rt" + ProcessHandle.current().pid());
+        if (!RID.matcher(rid).matches()) {
+            throw new IllegalArgumentException("arflex.runtime.id '" + rid + "' must match [a-z0-9-]{1,40}");
+        }
+        Sweeper.sweep(rid, log);
+        PortTypes types = PortTypes.builtin();
+        double cap = Double.parseDouble(prop(ctx, "arflex.cpu.cap", "1.0"));
+        List<Integer> cpus = prop(ctx, "arflex.cpus", "").isEmpty() ? allCpus() : Commands.parseCpus(prop(ctx, "arflex.cpus", ""));
+        long memory = Commands.parseSize(prop(ctx, "arflex.memory", "1g"));
+        long network = Commands.parseSize(prop(ctx, "arflex.network", "125000000"));
+        actor = new ThreadActor(log);
+        Cell.Config cfg = new Cell.Config(rid, Long.parseLong(prop(ctx, "arflex.ready.timeout.ms", "5000")), 3_000,
+                Boolean.parseBoolean(prop(ctx, "arflex.nomlock", "false")), types, Posix::monotonicNs);
+        // The cell is built on the actor so that the planner is only ever touched there.
+        ResourceManagerImpl[] rm = new ResourceManagerImpl[1];
+        cell = actor.call(() -> {
+            ResourceManagerImpl tmp = new ResourceManagerImpl(null, cap);
+            Planner planner = new Planner(tmp.capacities(cpus, memory, network));
+            Cell c = new Cell(cfg, actor, new ProcessLauncher(log), planner, log);
+            rm[0] = new ResourceManagerImpl(c, cap);
+            return c;
+        }, 10_000);
+        ContractReader reader = new ContractReader(types);
+        services = new Services(cell, rm[0], reader, ctx, log);
+        cell.onChange(services::sync);
+        regs.add(ctx.registerService(DrcrService.class, services, null));
+        regs.add(ctx.registerService(UpdateService.class, services, null));
+        regs.add(ctx.registerService(ResourceManager.class, rm[0], null));
+        Hashtable<String, Object> shell = new Hashtable<>();
+        shell.put("osgi.command.scope", Commands.SCOPE);
+        shell.put("osgi.command.function", Commands.FUNCTIONS);
+        regs.add(ctx.registerService(Commands.class, new Commands(services, rm[0], services, services::management), shell));
+        ticker = new ScheduledThreadPoolExecutor(1, r -> {
+            Thread t = new Thread(r, "arflex-drcr-heartbeat");
+            t.setDaemon(true);
+            return t;
+        });
+        ticker.scheduleAtFixedRate(() -> {
+            try {
+                cell.monitor().check(Posix.monotonicNs());
+            } catch (RuntimeException e) {
+                log.accept("arflex: heartbeat round failed: " + e);
+            }
+        }, HEARTBEAT_MS, HEARTBEAT_MS, TimeUnit.MILLISECONDS);
+        ticker.scheduleAtFixedRate(() -> actor.submit(() -> rm[0].overruns(cell.sample())), SAMPLE_MS, SAMPLE_MS,
+                TimeUnit.MILLISECONDS);
+        tracker = new BundleTracker<>(ctx, Bundle.ACTIVE, new ContractExtender(cell, reader, ctx, log));
+        tracker.open();
+        log.accept("arflex: DRCR started, runtime id " + rid + ", cpus " + cpus + ", memory " + memory + ", network "
+                + network);
+    }
+
+    private static List<Integer> allCpus() {
+        List<Integer> l = new ArrayList<>();
+        for (int i = 0; i < Runtime.getRuntime().availableProcessors(); i++) {
+            l.add(i);
+        }
+        return l;
+    }
+
+    @Override
+    public void stop(BundleContext ctx) throws Exception {
+        if (tracker != null) {
+            tracker.close();
+        }
+        for (ServiceRegistration<?> r : regs) {
+            try {
+                r.unregister();
+            } catch (IllegalStateException ignored) {
+                // already gone
+            }
+        }
+        regs.clear();
+        if (cell != null) {
+            actor.call(() -> {
+                cell.shutdownAll("DRCR stopping");
+                services.unregisterAll();
+                return null;
+            }, 120_000);
+        }
+        if (ticker != null) {
+            ticker.shutdownNow();
+        }
+        if (actor != null) {
+            actor.shutdown(10_000);
+        }
+        Sweeper.sweep(rid, log);
+        log.accept("arflex: DRCR stopped");
+    }
+}

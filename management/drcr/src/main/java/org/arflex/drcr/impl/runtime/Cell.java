@@ -1,0 +1,601 @@
+package org.arflex.drcr.impl.runtime;
+
+import java.io.IOException;
+import java.nio.file.Path;
+import java.util.ArrayList;
+import java.util.LinkedHashMap;
+import java.util.List;
+import java.util.Map;
+import java.util.Optional;
+import java.util.concurrent.atomic.AtomicLong;
+import java.util.function.Consumer;
+import java.util.function.LongSupplier;
+import org.arflex.contract.Contract;
+import org.arflex.contract.FaultPolicy;
+import org.arflex.contract.PortSpec;
+import org.arflex.contract.PortType;
+import org.arflex.contract.PortTypes;
+import org.arflex.contract.PropertySpec;
+import org.arflex.drcr.impl.abi.ControlBlock;
+import org.arflex.drcr.impl.abi.PortSegment;
+import org.arflex.drcr.impl.lifecycle.Actor;
+import org.arflex.drcr.impl.lifecycle.State;
+import org.arflex.drcr.impl.supervisor.HeartbeatMonitor;
+import org.arflex.drcr.impl.supervisor.RestartPolicy;
+import org.arflex.drcr.impl.supervisor.RtHalf;
+import org.arflex.drcr.impl.supervisor.RtLauncher;
+import org.arflex.planner.Capacities;
+import org.arflex.planner.Change;
+import org.arflex.planner.Plan;
+import org.arflex.planner.Planner;
+import org.arflex.planner.Wire;
+
+/**
+ * The running cell: instances, their RT halves and the planner that decides what runs. Every
+ * method that changes something runs on the actor thread (checked); the planner is the only
+ * place that decides wiring, admission and start/stop order, and the cell only executes its
+ * plans, so the dry run ({@code plan}) and the real run cannot disagree.
+ *
+ * <p>Failure handling: an unexpected exit of an RT half (crash, kill, hang) blocks the
+ * component in the planner (its dependents stop as if the provider were gone), then the restart
+ * policy either schedules an unblock after the backoff or leaves it blocked as Failed.
+ */
+public final class Cell {
+
+    /** Static configuration of a cell. */
+    public record Config(String runtimeId, long readyTimeoutMs, long shutdownMs, boolean noMlock,
+                         PortTypes types, LongSupplier monotonicNs) {
+    }
+
+    private final Config cfg;
+    private final Actor actor;
+    private final RtLauncher launcher;
+    private final Planner planner;
+    private final Consumer<String> log;
+    private final HeartbeatMonitor monitor;
+    private final Map<String, Instance> instances = new LinkedHashMap<>();
+    private final List<String> problems = new ArrayList<>();
+    private final AtomicLong generation = new AtomicLong();
+    private volatile Runnable onChange = () -> { };
+
+    public Cell(Config cfg, Actor actor, RtLauncher launcher, Planner planner, Consumer<String> log) {
+        this.cfg = cfg;
+        this.actor = actor;
+        this.launcher = launcher;
+        this.planner = planner;
+        this.log = log;
+        this.monitor = new HeartbeatMonitor((half, why) -> actor.submit(() -> onHang(half, why)));
+    }
+
+    /** Called after every change (on the actor thread): service registrations follow it. */
+    public void onChange(Runnable r) {
+        onChange = r;
+    }
+
+    public Config config() {
+        return cfg;
+    }
+
+    public Actor actor() {
+        return actor;
+    }
+
+    public Planner planner() {
+        return planner;
+    }
+
+    public HeartbeatMonitor monitor() {
+        return monitor;
+    }
+
+    long generation() {
+        return generation.get();
+    }
+
+    /** Records a problem (bad contract...) for the DTO and the log. */
+    public void problem(String p) {
+        log.accept("arflex: " + p);
+        synchronized (problems) {
+            problems.add(p);
+            if (problems.size() > 100) {
+                problems.remove(0);
+            }
+        }
+        changed();
+    }
+
+    List<String> problems() {
+        synchronized (problems) {
+            return List.copyOf(problems);
+        }
+    }
+
+    /** Instances in install order (actor thread, or for snapshots). */
+    List<Instance> instances() {
+        return List.copyOf(instances.values());
+    }
+
+    public Optional<Instance> instance(String name) {
+        return Optional.ofNullable(instances.get(name));
+    }
+
+    /** Names of the instances. */
+    public List<String> names() {
+        return List.copyOf(instances.keySet());
+    }
+
+    private void changed() {
+        generation.incrementAndGet();
+        try {
+            onChange.run();
+        } catch (RuntimeException e) {
+            log.accept("arflex: change listener failed: " + e);
+        }
+    }
+
+    // ---- install / uninstall ---------------------------------------------------------------
+
+    /**
+     * Installs (or, for the same bundle, replaces) a component. A name already used by another
+     * bundle is refused with a problem; nothing else changes.
+     *
+     * @return false when refused
+     */
+    public boolean install(Contract c, long bundleId, Path exe) {
+        actor.checkThread();
+        Instance existing = instances.get(c.name());
+        if (existing != null && existing.bundleId != bundleId) {
+            problem(c.source() + ": component '" + c.name() + "' is already installed by bundle " + existing.bundleId
+                    + "; the contract of bundle " + bundleId + " is skipped");
+            return false;
+        }
+        if (c.name().length() > 40) {
+            problem(c.source() + ": component name '" + c.name() + "' is longer than 40 characters, the limit of "
+                    + "shared object names (rt-core ABI); skipped");
+            return false;
+        }
+        Plan plan;
+        try {
+            plan = planner.apply(existing != null ? Change.replace(c) : Change.install(c));
+        } catch (RuntimeException e) {
+            problem(c.source() + ": planner refused '" + c.name() + "': " + e.getMessage());
+            return false;
+        }
+        Instance inst = existing;
+        if (inst == null) {
+            inst = new Instance(c, bundleId, exe, actor, log);
+            instances.put(c.name(), inst);
+        } else {
+            inst.contract = c;
+            inst.executable = exe;
+            inst.policy = new RestartPolicy(c.fault(), actor.clock());
+            inst.params = Instance.defaults(c);
+            closeOutputs(inst);
+        }
+        inst.life.target(State.ACTIVE);
+        inst.life.to(State.UNSATISFIED, "resolving");
+        log.accept("arflex: " + plan.title() + "\n" + plan.toText());
+        execute(plan);
+        changed();
+        return true;
+    }
+
+    /** Removes a component for good: stops it (and what depends on it), removes its objects. */
+    public void uninstall(String name, String why) {
+        actor.checkThread();
+        Instance inst = instances.get(name);
+        if (inst == null) {
+            return;
+        }
+        inst.life.target(State.DESTROYED);
+        cancelRestart(inst);
+        Plan plan;
+        try {
+            plan = planner.apply(Change.uninstall(name));
+            execute(plan);
+        } catch (RuntimeException e) {
+            log.accept("arflex: planner failed on uninstall of " + name + ": " + e);
+        }
+        stopHalf(inst, why);
+        closeOutputs(inst);
+        inst.life.to(State.DESTROYED, why);
+        instances.remove(name);
+        changed();
+    }
+
+    /** Uninstalls everything (DRCR stop): leaves no process and no shared object behind. */
+    public void shutdownAll(String why) {
+        actor.checkThread();
+        List<String> names = new ArrayList<>(instances.keySet());
+        java.util.Collections.reverse(names);
+        for (String n : names) {
+            uninstall(n, why);
+        }
+    }
+
+    /** Names of the components that bundle {@code bundleId} installed. */
+    public List<String> namesOfBundle(long bundleId) {
+        List<String> out = new ArrayList<>();
+        for (Instance i : instances.values()) {
+            if (i.bundleId == bundleId) {
+                out.add(i.name);
+            }
+        }
+        return out;
+    }
+
+    // ---- plans -------------------------------------------------------------------------------
+
+    /** Applies a change (capacities, measured WCET...) and executes the plan. */
+    public Plan apply(Change change) {
+        actor.checkThread();
+        Plan p = planner.apply(change);
+        if (!p.isEmpty()) {
+            log.accept("arflex: " + p.title() + "\n" + p.toText());
+        }
+        execute(p);
+        changed();
+        return p;
+    }
+
+    /** A dry run. */
+    public Plan dryRun(Change change) {
+        actor.checkThread();
+        return planner.plan(change);
+    }
+
+    private void execute(Plan plan) {
+        for (String name : plan.stopOrder()) {
+            Instance inst = instances.get(name);
+            if (inst != null) {
+                String why = plan.inactiveAfter().getOrDefault(name,
+                        plan.action(name).map(Plan.Action::reason).orElse("stopped by plan"));
+                stopHalf(inst, why);
+            }
+        }
+        for (String name : plan.startOrder()) {
+            Instance inst = instances.get(name);
+            if (inst != null && inst.half == null && inst.life.state() != State.FAILED) {
+                startHalf(inst, plan.cpuAssignment().getOrDefault(name, -1), plan.wiringOf(name));
+            }
+        }
+        // Everything the plan leaves inactive shows the planner's reason.
+        for (var e : plan.inactiveAfter().entrySet()) {
+            Instance inst = instances.get(e.getKey());
+            if (inst != null && inst.half == null && inst.life.state() != State.FAILED
+                    && inst.life.state() != State.DESTROYED) {
+                if (inst.restartTimer == null || inst.life.reason() == null) {
+                    inst.life.to(State.UNSATISFIED, e.getValue());
+                }
+            }
+        }
+    }
+
+    // ---- RT halves -----------------------------------------------------------------------------
+
+    private String segmentOf(String provider, String port) {
+        return "/arflex." + cfg.runtimeId() + "." + provider + ".out." + port;
+    }
+
+    private void ensureOutputs(Instance inst) throws IOException {
+        for (PortSpec p : inst.contract.outputs()) {
+            if (inst.outputs.containsKey(p.name())) {
+                continue;
+            }
+            PortType t = cfg.types().find(p.type()).orElseThrow(() -> new IOException(
+                    "output " + p.name() + ": port type " + p.type() + " is not known to this runtime"));
+            int elem = (int) (t.size() + t.maxPayload());
+            int method = switch (p.method()) {
+                case STATE -> PortSegment.METHOD_STATE;
+                case STREAM -> PortSegment.METHOD_STREAM;
+                case FRAME -> PortSegment.METHOD_FRAME;
+            };
+            int overflow = p.overflow() == PortSpec.Overflow.DROP_NEWEST ? PortSegment.OVERFLOW_DROP_NEWEST
+                    : PortSegment.OVERFLOW_DROP_OLDEST;
+            inst.outputs.put(p.name(), launcher.createOutput(segmentOf(inst.name, p.name()), method, t.name(),
+                    t.version().major(), t.version().minor(), elem, Math.max(1, p.depth()), overflow));
+        }
+    }
+
+    private void closeOutputs(Instance inst) {
+        for (RtLauncher.Output o : inst.outputs.values()) {
+            o.close();
+        }
+        inst.outputs.clear();
+    }
+
+    static ControlBlock.Config controlConfig(Contract c, int cpu, boolean noMlock) {
+        int flags = (c.movesHardware() ? ControlBlock.CFG_MOVES_HARDWARE : 0) | (noMlock ? ControlBlock.CFG_NO_MLOCK : 0);
+        int taskType = switch (c.taskType()) {
+            case PERIODIC -> 0;
+            case SPORADIC -> 1;
+            case SERVICE -> 2;
+        };
+        return new ControlBlock.Config(c.timing().periodNs(), c.timing().deadlineNs(),
+                c.fault().heartbeatTimeoutMs() * 1_000_000L, cpu >= 0 ? 1L << cpu : 0L,
+                c.taskType() == Contract.TaskType.SERVICE ? 0 : c.timing().priority(), taskType,
+                c.fault().safeOutput() == FaultPolicy.SafeOutput.ZERO ? 1 : 0, flags);
+    }
+
+    static List<ControlBlock.Param> controlParams(Contract c, long[] values) {
+        List<ControlBlock.Param> out = new ArrayList<>();
+        for (int i = 0; i < c.properties().size(); i++) {
+            PropertySpec p = c.properties().get(i);
+            int type = switch (p.type()) {
+                case BOOL -> ControlBlock.PARAM_BOOL;
+                case INT -> ControlBlock.PARAM_INT64;
+                case DOUBLE -> ControlBlock.PARAM_DOUBLE;
+            };
+            long min = bound(p, p.min(), true);
+            long max = bound(p, p.max(), false);
+            out.add(new ControlBlock.Param(p.name(), type, p.mutable(), min, max, values[i]));
+        }
+        return out;
+    }
+
+    private static long bound(PropertySpec p, Optional<Double> b, boolean lower) {
+        return switch (p.type()) {
+            case BOOL -> lower ? 0 : 1;
+            case INT -> b.map(Double::longValue).orElse(lower ? Long.MIN_VALUE : Long.MAX_VALUE);
+            case DOUBLE -> Double.doubleToRawLongBits(b.orElse(lower ? -Double.MAX_VALUE : Double.MAX_VALUE));
+        };
+    }
+
+    private void startHalf(Instance inst, int cpu, List<Wire> wires) {
+        Contract c = inst.contract;
+        RtHalf half = null;
+        try {
+            ensureOutputs(inst);
+            boolean resetRequired = c.movesHardware() && inst.everStarted;
+            half = launcher.launch(new RtLauncher.Spec(cfg.runtimeId(), inst.name, inst.executable,
+                    controlConfig(c, cpu, cfg.noMlock()), controlParams(c, inst.params), resetRequired,
+                    cfg.readyTimeoutMs()));
+            inst.bound.clear();
+            for (Wire w : wires) {
+                String seg = segmentOf(w.provider(), w.outPort());
+                half.bind(w.inPort(), seg);
+                inst.bound.put(w.inPort(), seg);
+            }
+            half.runtimeHeartbeat(cfg.monotonicNs().getAsLong());
+            half.start();
+        } catch (IOException | RuntimeException e) {
+            if (half != null) {
+                half.shutdown(cfg.shutdownMs());
+            }
+            inst.bound.clear();
+            log.accept("arflex: " + inst.name + ": start failed: " + e.getMessage());
+            failed(inst, true, "start failed: " + e.getMessage());
+            return;
+        }
+        inst.half = half;
+        inst.cpu = cpu;
+        inst.awaitingReset = c.movesHardware() && inst.everStarted;
+        inst.everStarted = true;
+        inst.life.to(State.ACTIVE, inst.awaitingReset ? "restarted: waits for an operator reset before motion" : null);
+        RtHalf h = half;
+        half.exit().thenAccept(ex -> actor.submit(() -> onExit(inst, h, ex)));
+        monitor.watch(inst.name, half, c.fault().heartbeatTimeoutMs(), cfg.monotonicNs().getAsLong());
+        log.accept("arflex: " + inst.name + " ACTIVE (pid " + half.pid() + ", cpu " + cpu + ", inputs " + inst.bound + ")");
+    }
+
+    private void stopHalf(Instance inst, String why) {
+        RtHalf half = inst.half;
+        if (half == null) {
+            return;
+        }
+        inst.half = null; // from here its exit is expected and ignored by onExit
+        monitor.unwatch(half);
+        for (String port : List.copyOf(inst.bound.keySet())) {
+            try {
+                half.unbind(port);
+            } catch (IOException e) {
+                log.accept("arflex: " + inst.name + ": " + e.getMessage());
+            }
+        }
+        inst.bound.clear();
+        half.shutdown(cfg.shutdownMs());
+        inst.cpu = -1;
+        if (inst.life.state() == State.ACTIVE) {
+            inst.life.to(State.UNSATISFIED, why);
+        }
+        log.accept("arflex: " + inst.name + " stopped: " + why);
+    }
+
+    private void onHang(RtHalf half, String why) {
+        for (Instance inst : instances.values()) {
+            if (inst.half == half) {
+                log.accept("arflex: " + inst.name + ": " + why + "; killing pid " + half.pid());
+                inst.hangReason = why;
+                half.kill();
+            }
+        }
+    }
+
+    private void onExit(Instance inst, RtHalf half, RtHalf.Exit exit) {
+        actor.checkThread();
+        if (inst.half != half) {
+            return; // an orderly stop, already handled
+        }
+        inst.half = null;
+        monitor.unwatch(half);
+        half.cleanup();
+        inst.bound.clear();
+        inst.cpu = -1;
+        String what = inst.hangReason != null ? inst.hangReason : exit.description();
+        inst.hangReason = null;
+        log.accept("arflex: " + inst.name + " (pid " + half.pid() + ") " + what);
+        failed(inst, exit.abnormal(), "RT half " + what);
+        changed();
+    }
+
+    /** The restart policy decides after a crash, hang or failed start. */
+    private void failed(Instance inst, boolean abnormal, String what) {
+        RestartPolicy.Decision d = inst.policy.onExit(abnormal, what);
+        if (d.restart()) {
+            inst.restarts++;
+            String why = "restarting in " + d.delayMs() + " ms (" + d.reason() + ")";
+            inst.life.to(State.UNSATISFIED, why);
+            execute(planner.apply(Change.block(inst.name, why)));
+            inst.life.reason(why);
+            cancelRestart(inst);
+            inst.restartTimer = actor.schedule(() -> {
+                inst.restartTimer = null;
+                if (instances.get(inst.name) == inst && inst.life.state() != State.FAILED) {
+                    inst.life.reason("restarting");
+                    execute(planner.apply(Change.unblock(inst.name)));
+                    changed();
+                }
+            }, d.delayMs());
+        } else {
+            inst.life.to(State.FAILED, d.reason());
+            execute(planner.apply(Change.block(inst.name, "failed: " + d.reason())));
+        }
+    }
+
+    private void cancelRestart(Instance inst) {
+        if (inst.restartTimer != null) {
+            inst.restartTimer.cancel();
+            inst.restartTimer = null;
+        }
+    }
+
+    // ---- management ------------------------------------------------------------------------------
+
+    /**
+     * Operator reset: a Failed instance gets a new chance; a running one that moves hardware is
+     * allowed to drive outputs again (RESET command).
+     */
+    public String reset(String name) {
+        actor.checkThread();
+        Instance inst = require(name);
+        if (inst.life.state() == State.FAILED) {
+            inst.policy.reset();
+            inst.life.to(State.UNSATISFIED, "reset by operator");
+            execute(planner.apply(Change.unblock(name)));
+            changed();
+            return name + ": reset from FAILED, now " + inst.life.state();
+        }
+        RtHalf half = inst.half;
+        if (half == null) {
+            return name + ": nothing to reset (" + inst.life.state() + ")";
+        }
+        try {
+            half.reset();
+        } catch (IOException e) {
+            throw new IllegalStateException(name + ": RESET failed: " + e.getMessage());
+        }
+        inst.awaitingReset = false;
+        if (inst.life.state() == State.ACTIVE) {
+            inst.life.reason(null);
+        }
+        changed();
+        return name + ": reset sent, outputs enabled";
+    }
+
+    /**
+     * Sets a parameter with type, range and mutability checks; returns the applied value.
+     *
+     * @throws IllegalArgumentException naming the parameter and what is wrong
+     */
+    public String setParam(String name, String param, String text) {
+        actor.checkThread();
+        Instance inst = require(name);
+        Contract c = inst.contract;
+        int idx = -1;
+        for (int i = 0; i < c.properties().size(); i++) {
+            if (c.properties().get(i).name().equals(param)) {
+                idx = i;
+            }
+        }
+        if (idx < 0) {
+            throw new IllegalArgumentException(name + ": no parameter '" + param + "' (has "
+                    + c.properties().stream().map(PropertySpec::name).toList() + ")");
+        }
+        PropertySpec p = c.properties().get(idx);
+        long bits = Params.parse(p, text);
+        RtHalf half = inst.half;
+        if (half != null && !p.mutable()) {
+            throw new IllegalArgumentException(name + "." + param + " is immutable while " + inst.life.state()
+                    + " (mutable=false)");
+        }
+        long applied = bits;
+        if (half != null) {
+            try {
+                applied = half.setParam(idx, bits);
+            } catch (IOException e) {
+                throw new IllegalStateException(name + "." + param + ": " + e.getMessage());
+            }
+            applied = half.paramValue(idx);
+        }
+        long[] v = inst.params.clone();
+        v[idx] = applied;
+        inst.params = v;
+        changed();
+        return Params.format(p, applied);
+    }
+
+    /** Reads a parameter as applied (control block when running, configuration otherwise). */
+    public String getParam(String name, String param) {
+        Instance inst = require(name);
+        List<PropertySpec> props = inst.contract.properties();
+        for (int i = 0; i < props.size(); i++) {
+            if (props.get(i).name().equals(param)) {
+                RtHalf half = inst.half;
+                long bits = half != null ? half.paramValue(i) : inst.params[i];
+                return Params.format(props.get(i), bits);
+            }
+        }
+        throw new IllegalArgumentException(name + ": no parameter '" + param + "'");
+    }
+
+    /** Records a measured execution time above the declared WCET and re-plans with it. */
+    public void measuredWcet(String name, long ns) {
+        actor.checkThread();
+        Instance inst = instances.get(name);
+        if (inst == null || ns <= inst.contract.timing().wcetNs() || ns <= inst.measuredWcetNs) {
+            return;
+        }
+        inst.measuredWcetNs = ns;
+        log.accept("arflex: " + name + ": measured execution time " + ns + " ns above declared WCET "
+                + inst.contract.timing().wcetNs() + " ns; re-planning");
+        apply(Change.measuredWcet(name, ns));
+    }
+
+    /**
+     * Periodic sampling on the actor thread: the largest measured execution time of each
+     * running RT half against its declared WCET (a larger one is recorded and re-planned).
+     *
+     * @return total cycles whose execution time exceeded the declared WCET
+     */
+    public long sample() {
+        actor.checkThread();
+        long over = 0;
+        for (Instance inst : List.copyOf(instances.values())) {
+            RtHalf h = inst.half;
+            if (h == null) {
+                continue;
+            }
+            ControlBlock.Stats s = h.stats(inst.contract.timing().wcetNs());
+            if (s != null) {
+                over += s.execOverWcet();
+                if (s.execCount() > 0 && s.execMaxNs() > inst.contract.timing().wcetNs()) {
+                    measuredWcet(inst.name, s.execMaxNs());
+                }
+            }
+        }
+        return over;
+    }
+
+    /** New capacities: re-plan (the lowest criticality goes first). */
+    public Plan capacities(Capacities c) {
+        return apply(Change.capacities(c));
+    }
+
+    Instance require(String name) {
+        Instance inst = instances.get(name);
+        if (inst == null) {
+            throw new IllegalArgumentException("no component '" + name + "' (installed: " + instances.keySet() + ")");
+        }
+        return inst;
+    }
+}

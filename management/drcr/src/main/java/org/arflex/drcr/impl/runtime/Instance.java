@@ -1,0 +1,65 @@
+package org.arflex.drcr.impl.runtime;
+
+import java.nio.file.Path;
+import java.util.LinkedHashMap;
+import java.util.Map;
+import java.util.TreeMap;
+import org.arflex.contract.Contract;
+import org.arflex.contract.PropertySpec;
+import org.arflex.drcr.impl.lifecycle.Actor;
+import org.arflex.drcr.impl.lifecycle.Lifecycle;
+import org.arflex.drcr.impl.supervisor.RestartPolicy;
+import org.arflex.drcr.impl.supervisor.RtHalf;
+import org.arflex.drcr.impl.supervisor.RtLauncher;
+
+/**
+ * One component instance: its contract, lifecycle, restart policy, RT half and output
+ * segments. Owned by the {@link Cell}; mutated on the actor thread only. Fields read by DTO
+ * snapshots from other threads are volatile.
+ */
+public final class Instance {
+    /** The contract (for services). */
+    public Contract contract() {
+        return contract;
+    }
+
+    final String name;
+    volatile Contract contract;
+    public volatile long bundleId;
+    volatile Path executable;
+    final Lifecycle life;
+    volatile RestartPolicy policy;
+    volatile RtHalf half;
+    /** Output port name -> segment; created at the first start, kept until destroyed. */
+    final Map<String, RtLauncher.Output> outputs = new LinkedHashMap<>();
+    /** Input port -> provider segment it is bound to. */
+    final Map<String, String> bound = new TreeMap<>();
+    /** Configured value bits per parameter (contract order). */
+    volatile long[] params;
+    volatile boolean awaitingReset;
+    volatile boolean everStarted;
+    volatile int cpu = -1;
+    volatile int restarts;
+    volatile String hangReason;
+    Actor.Cancellable restartTimer;
+    volatile long measuredWcetNs;
+
+    Instance(Contract c, long bundleId, Path exe, Actor actor, java.util.function.Consumer<String> log) {
+        this.name = c.name();
+        this.contract = c;
+        this.bundleId = bundleId;
+        this.executable = exe;
+        this.life = new Lifecycle(c.name(), actor, log);
+        this.policy = new RestartPolicy(c.fault(), actor.clock());
+        this.params = defaults(c);
+    }
+
+    static long[] defaults(Contract c) {
+        long[] p = new long[c.properties().size()];
+        for (int i = 0; i < p.length; i++) {
+            PropertySpec ps = c.properties().get(i);
+            p[i] = ps.defaultValue().bits();
+        }
+        return p;
+    }
+}

@@ -1,0 +1,55 @@
+package org.arflex.drcr.impl.services;
+
+import org.arflex.drcr.ComponentManagement;
+import org.arflex.drcr.dto.InstanceDTO;
+import org.arflex.drcr.dto.StatsDTO;
+import org.arflex.drcr.impl.runtime.Cell;
+import org.arflex.drcr.impl.runtime.Snapshots;
+
+/** The management service of one instance; every call runs on the actor thread. */
+final class ComponentManagementImpl implements ComponentManagement {
+
+    private final String name;
+    private final Cell cell;
+
+    ComponentManagementImpl(String name, Cell cell) {
+        this.name = name;
+        this.cell = cell;
+    }
+
+    @Override
+    public String name() {
+        return name;
+    }
+
+    @Override
+    public InstanceDTO instance() {
+        return cell.actor().call(() -> Snapshots.instance(cell, name)
+                .orElseThrow(() -> new IllegalStateException("component '" + name + "' is gone")), Services.CALL_MS);
+    }
+
+    @Override
+    public String state() {
+        return instance().state;
+    }
+
+    @Override
+    public String get(String param) {
+        return cell.actor().call(() -> cell.getParam(name, param), Services.CALL_MS);
+    }
+
+    @Override
+    public String set(String param, String value) {
+        return cell.actor().call(() -> cell.setParam(name, param, value), Services.CALL_MS);
+    }
+
+    @Override
+    public StatsDTO stats() {
+        return instance().stats;
+    }
+
+    @Override
+    public void reset() {
+        cell.actor().call(() -> cell.reset(name), Services.CALL_MS);
+    }
+}

@@ -1,0 +1,279 @@
+package org.arflex.drcr.impl.services;
+
+import java.io.ByteArrayInputStream;
+import java.io.ByteArrayOutputStream;
+import java.io.IOException;
+import java.io.InputStream;
+import java.net.URI;
+import java.net.URL;
+import java.net.URLConnection;
+import java.security.MessageDigest;
+import java.security.NoSuchAlgorithmException;
+import java.util.ArrayList;
+import java.util.HashMap;
+import java.util.HexFormat;
+import java.util.Hashtable;
+import java.util.List;
+import java.util.Map;
+import java.util.Optional;
+import java.util.function.Consumer;
+import java.util.jar.JarEntry;
+import java.util.jar.JarInputStream;
+import java.util.jar.Manifest;
+import org.arflex.contract.Contract;
+import org.arflex.contract.UpdateSpec;
+import org.arflex.drcr.ComponentManagement;
+import org.arflex.drcr.DrcrService;
+import org.arflex.drcr.ResourceManager;
+import org.arflex.drcr.UpdateService;
+import org.arflex.drcr.dto.CellDTO;
+import org.arflex.drcr.dto.ContractDTO;
+import org.arflex.drcr.dto.InstanceDTO;
+import org.arflex.drcr.impl.runtime.Cell;
+import org.arflex.drcr.impl.runtime.ContractReader;
+import org.arflex.drcr.impl.runtime.Snapshots;
+import org.arflex.planner.Capacities;
+import org.arflex.planner.Change;
+import org.osgi.framework.Bundle;
+import org.osgi.framework.BundleContext;
+import org.osgi.framework.BundleException;
+import org.osgi.framework.ServiceRegistration;
+
+/**
+ * The DRCR's services: the read-only {@link DrcrService}, the {@link UpdateService}, and the
+ * registrations of one {@link ComponentManagement} per instance, kept in step with the cell.
+ */
+public final class Services implements DrcrService, UpdateService {
+
+    /** Timeout of a call into the actor (starting a component can take a few seconds). */
+    static final long CALL_MS = 60_000;
+    /** Largest bundle accepted by plan install and update. */
+    static final int MAX_JAR = 64 << 20;
+
+    private final Cell cell;
+    private final ResourceManagerImpl resources;
+    private final ContractReader reader;
+    private final BundleContext context;
+    private final Consumer<String> log;
+    private final Map<String, ServiceRegistration<ComponentManagement>> regs = new HashMap<>();
+
+    public Services(Cell cell, ResourceManagerImpl resources, ContractReader reader, BundleContext context,
+                    Consumer<String> log) {
+        this.cell = cell;
+        this.resources = resources;
+        this.reader = reader;
+        this.context = context;
+        this.log = log;
+    }
+
+    // ---- per-instance registrations ---------------------------------------------------------
+
+    /** Brings the ComponentManagement registrations in line with the cell (actor thread). */
+    public void sync() {
+        if (context == null) {
+            return;
+        }
+        List<String> names = cell.names();
+        for (String n : List.copyOf(regs.keySet())) {
+            if (!names.contains(n)) {
+                unregister(regs.remove(n));
+            }
+        }
+        for (String n : names) {
+            if (!regs.containsKey(n)) {
+                Hashtable<String, Object> props = new Hashtable<>();
+                props.put(ComponentManagement.COMPONENT_PROPERTY, n);
+                try {
+                    regs.put(n, context.registerService(ComponentManagement.class, new ComponentManagementImpl(n, cell), props));
+                } catch (IllegalStateException e) {
+                    return; // the DRCR bundle is stopping
+                }
+            }
+        }
+    }
+
+    /** Unregisters every ComponentManagement service. */
+    public void unregisterAll() {
+        for (var r : regs.values()) {
+            unregister(r);
+        }
+        regs.clear();
+    }
+
+    private static void unregister(ServiceRegistration<?> r) {
+        try {
+            r.unregister();
+        } catch (IllegalStateException ignored) {
+            // already gone with the bundle
+        }
+    }
+
+    /** The management service of one instance (for the shell, without a registry lookup). */
+    public Optional<ComponentManagement> management(String name) {
+        return cell.actor().call(() -> cell.names().contains(name)
+                ? Optional.<ComponentManagement>of(new ComponentManagementImpl(name, cell)) : Optional.empty(), CALL_MS);
+    }
+
+    // ---- DrcrService -------------------------------------------------------------------------
+
+    @Override
+    public CellDTO cell() {
+        ResourceManager r = resources;
+        var res = r.resources();
+        return cell.actor().call(() -> Snapshots.cell(cell, res), CALL_MS);
+    }
+
+    @Override
+    public Optional<InstanceDTO> instance(String name) {
+        return cell.actor().call(() -> Snapshots.instance(cell, name), CALL_MS);
+    }
+
+    @Override
+    public Optional<ContractDTO> contract(String name) {
+        return cell.actor().call(() -> Snapshots.contract(cell, name), CALL_MS);
+    }
+
+    @Override
+    public String planInstall(String location) {
+        byte[] jar;
+        try {
+            jar = download(URI.create(location));
+        } catch (IOException | IllegalArgumentException e) {
+            throw new IllegalArgumentException("cannot read " + location + ": " + e.getMessage());
+        }
+        ContractReader.Result r = readJar(location, jar);
+        StringBuilder sb = new StringBuilder();
+        for (String p : r.problems()) {
+            sb.append("problem: ").append(p).append('\n');
+        }
+        if (r.contracts().isEmpty()) {
+            return sb.append("no valid contract in ").append(location).toString();
+        }
+        Change.Builder b = Change.builder();
+        r.contracts().forEach(b::put);
+        return sb + cell.actor().call(() -> cell.dryRun(b.build()).toText(), CALL_MS);
+    }
+
+    @Override
+    public String planUninstall(String name) {
+        return cell.actor().call(() -> {
+            Long bundle = cell.instance(name).map(i -> i.bundleId).orElseThrow(
+                    () -> new IllegalArgumentException("no component '" + name + "'"));
+            Change.Builder b = Change.builder();
+            cell.namesOfBundle(bundle).forEach(b::uninstall);
+            return cell.dryRun(b.build()).toText();
+        }, CALL_MS);
+    }
+
+    @Override
+    public String planCapacity(List<Integer> cpus, long memoryBytes, long networkBps) {
+        Capacities caps = resources.capacities(cpus, memoryBytes, networkBps);
+        return cell.actor().call(() -> cell.dryRun(Change.capacities(caps)).toText(), CALL_MS);
+    }
+
+    // ---- UpdateService -----------------------------------------------------------------------
+
+    @Override
+    public String update(String name) {
+        record Target(UpdateSpec spec, long bundleId) {
+        }
+        Target t = cell.actor().call(() -> {
+            var inst = cell.instance(name).orElseThrow(() -> new IllegalArgumentException("no component '" + name + "'"));
+            UpdateSpec u = inst.contract().update().orElseThrow(() -> new IllegalStateException(
+                    name + ": its contract has no update URL"));
+            return new Target(u, inst.bundleId);
+        }, CALL_MS);
+        byte[] jar;
+        try {
+            jar = download(t.spec().url());
+        } catch (IOException | IllegalArgumentException e) {
+            throw new IllegalStateException(name + ": update not installed, the old version keeps running: cannot download "
+                    + t.spec().url() + ": " + e.getMessage());
+        }
+        String got = sha256(jar);
+        if (!got.equalsIgnoreCase(t.spec().sha256())) {
+            throw new IllegalStateException(name + ": update not installed, the old version keeps running: SHA-256 of "
+                    + t.spec().url() + " is " + got + ", the contract pins " + t.spec().sha256());
+        }
+        ContractReader.Result r = readJar(t.spec().url().toString(), jar);
+        if (!r.problems().isEmpty() || r.contracts().stream().noneMatch(c -> c.name().equals(name))) {
+            throw new IllegalStateException(name + ": update not installed, the old version keeps running: the new bundle "
+                    + (r.problems().isEmpty() ? "has no contract for " + name : "is broken:\n" + String.join("\n", r.problems())));
+        }
+        Bundle b = context.getBundle(t.bundleId());
+        if (b == null) {
+            throw new IllegalStateException(name + ": bundle " + t.bundleId() + " is gone");
+        }
+        try {
+            b.update(new ByteArrayInputStream(jar));
+        } catch (BundleException e) {
+            throw new IllegalStateException(name + ": bundle update failed, the old version keeps running: " + e.getMessage());
+        }
+        String v = r.contracts().stream().filter(c -> c.name().equals(name)).map(Contract::version).findFirst().orElse("?");
+        log.accept("arflex: updated bundle " + t.bundleId() + " from " + t.spec().url() + " (sha256 " + got + ")");
+        return name + ": updated to " + v + " from " + t.spec().url() + " (sha256 verified)";
+    }
+
+    static String sha256(byte[] data) {
+        try {
+            return HexFormat.of().formatHex(MessageDigest.getInstance("SHA-256").digest(data));
+        } catch (NoSuchAlgorithmException e) {
+            throw new IllegalStateException(e);
+        }
+    }
+
+    /** Reads a whole file: or https: URL (other schemes are refused), at most {@link #MAX_JAR} bytes. */
+    static byte[] download(URI uri) throws IOException {
+        String scheme = uri.getScheme() == null ? "" : uri.getScheme().toLowerCase();
+        if (!scheme.equals("file") && !scheme.equals("https")) {
+            throw new IOException("scheme '" + scheme + "' refused: only https and file URLs are allowed");
+        }
+        URL url = uri.toURL();
+        URLConnection conn = url.openConnection();
+        conn.setConnectTimeout(10_000);
+        conn.setReadTimeout(30_000);
+        try (InputStream in = conn.getInputStream()) {
+            ByteArrayOutputStream out = new ByteArrayOutputStream();
+            byte[] buf = new byte[65536];
+            int n;
+            while ((n = in.read(buf)) > 0) {
+                out.write(buf, 0, n);
+                if (out.size() > MAX_JAR) {
+                    throw new IOException("larger than " + MAX_JAR + " bytes");
+                }
+            }
+            return out.toByteArray();
+        }
+    }
+
+    /** Reads the contracts of a jar held in memory (a broken jar is a problem, not an exception). */
+    ContractReader.Result readJar(String label, byte[] jar) {
+        Map<String, byte[]> entries = new HashMap<>();
+        String header;
+        try (JarInputStream in = new JarInputStream(new ByteArrayInputStream(jar))) {
+            Manifest m = in.getManifest();
+            if (m == null) {
+                return new ContractReader.Result(List.of(), List.of(label + ": not a bundle (no manifest)"));
+            }
+            header = m.getMainAttributes().getValue(ContractReader.HEADER);
+            JarEntry e;
+            while ((e = in.getNextJarEntry()) != null) {
+                if (!e.isDirectory()) {
+                    entries.put(e.getName(), in.readAllBytes());
+                }
+            }
+        } catch (IOException | RuntimeException e) {
+            return new ContractReader.Result(List.of(), List.of(label + ": broken jar: " + e.getMessage()));
+        }
+        if (header == null) {
+            return new ContractReader.Result(List.of(), List.of(label + ": no " + ContractReader.HEADER + " header"));
+        }
+        List<String> problems = new ArrayList<>();
+        ContractReader.Result r = reader.read(label, header, p -> {
+            byte[] b = entries.get(p);
+            return b == null ? null : new ByteArrayInputStream(b);
+        });
+        problems.addAll(r.problems());
+        return new ContractReader.Result(r.contracts(), problems);
+    }
+}

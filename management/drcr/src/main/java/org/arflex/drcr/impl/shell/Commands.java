@@ -1,0 +1,307 @@
+package org.arflex.drcr.impl.shell;
+
+import java.util.ArrayList;
+import java.util.Arrays;
+import java.util.List;
+import java.util.Optional;
+import java.util.function.Function;
+import org.arflex.drcr.ComponentManagement;
+import org.arflex.drcr.DrcrService;
+import org.arflex.drcr.ResourceManager;
+import org.arflex.drcr.UpdateService;
+import org.arflex.drcr.dto.BindingDTO;
+import org.arflex.drcr.dto.CellDTO;
+import org.arflex.drcr.dto.InstanceDTO;
+import org.arflex.drcr.dto.ParamDTO;
+import org.arflex.drcr.dto.ResourcesDTO;
+import org.arflex.drcr.dto.StatsDTO;
+
+/**
+ * The Gogo commands of scope {@code arflex}. Plain public methods (Gogo finds them by name);
+ * each returns the text to print. They use the DRCR's public services only, exactly as the web
+ * console does. Errors come back as a line starting with {@code error:} (Gogo would otherwise
+ * print a stack trace).
+ */
+public final class Commands {
+
+    /** Service property values for the Gogo registration. */
+    public static final String SCOPE = "arflex";
+    public static final String[] FUNCTIONS = {"list", "info", "bindings", "get", "set", "plan", "update",
+        "resources", "stats", "reset", "dto"};
+
+    private final DrcrService drcr;
+    private final ResourceManager resources;
+    private final UpdateService updates;
+    private final Function<String, Optional<ComponentManagement>> management;
+
+    public Commands(DrcrService drcr, ResourceManager resources, UpdateService updates,
+                    Function<String, Optional<ComponentManagement>> management) {
+        this.drcr = drcr;
+        this.resources = resources;
+        this.updates = updates;
+        this.management = management;
+    }
+
+    /** One line per instance: name, state, pid, cpu, reason. */
+    public String list() {
+        CellDTO c = drcr.cell();
+        if (c.instances.length == 0) {
+            return "no components";
+        }
+        int w = 4;
+        for (InstanceDTO i : c.instances) {
+            w = Math.max(w, i.name.length());
+        }
+        StringBuilder sb = new StringBuilder(String.format("%-" + w + "s  %-11s  %7s  %3s  %s%n", "NAME", "STATE", "PID", "CPU", "REASON"));
+        for (InstanceDTO i : c.instances) {
+            sb.append(String.format("%-" + w + "s  %-11s  %7s  %3s  %s%n", i.name, i.state, i.pid == 0 ? "-" : Long.toString(i.pid),
+                    i.cpu < 0 ? "-" : Integer.toString(i.cpu), i.failureReason == null ? "" : i.failureReason));
+        }
+        for (String p : c.problems) {
+            sb.append("problem: ").append(p).append('\n');
+        }
+        return sb.toString().stripTrailing();
+    }
+
+    /** Contract and instance details of one component. */
+    public String info(String name) {
+        Optional<InstanceDTO> oi = drcr.instance(name);
+        if (oi.isEmpty()) {
+            return "error: no component '" + name + "'";
+        }
+        InstanceDTO i = oi.get();
+        var c = drcr.contract(name).orElseThrow();
+        StringBuilder sb = new StringBuilder();
+        sb.append(c.name).append(' ').append(c.version).append(" (bundle ").append(c.bundleId).append(", ").append(c.source).append(")\n");
+        sb.append("  state ").append(i.state).append(", target ").append(i.targetState);
+        if (i.failureReason != null) {
+            sb.append(", reason: ").append(i.failureReason);
+        }
+        sb.append('\n');
+        sb.append("  pid ").append(i.pid == 0 ? "-" : i.pid).append(", cpu ").append(i.cpu < 0 ? "-" : i.cpu)
+                .append(", restarts ").append(i.restarts).append(" (").append(i.restartsLeft).append(" left)")
+                .append(i.awaitingReset ? ", awaiting operator reset" : "").append('\n');
+        sb.append("  timing: ").append(c.taskType).append(" period ").append(c.periodNs).append(" ns, deadline ")
+                .append(c.deadlineNs).append(" ns, wcet ").append(c.wcetNs).append(" ns, priority ").append(c.priority).append('\n');
+        sb.append("  fault: ").append(c.restart).append(" intensity ").append(c.intensity).append("/").append(c.windowMs)
+                .append(" ms, backoff ").append(c.backoffMs).append(" ms, safe ").append(c.safeOutput)
+                .append(c.movesHardware ? ", moves hardware" : "").append('\n');
+        for (var p : c.ports) {
+            sb.append("  ").append(p.direction.toLowerCase()).append(' ').append(p.name).append(": ").append(p.type)
+                    .append(' ').append(p.typeVersion).append(' ').append(p.method.toLowerCase());
+            if (p.binding != null) {
+                sb.append(" from ").append(p.binding);
+            }
+            sb.append('\n');
+        }
+        for (ParamDTO p : i.params) {
+            sb.append("  param ").append(p.name).append(" = ").append(p.value).append(p.unit.isEmpty() ? "" : " " + p.unit)
+                    .append(" (").append(p.type.toLowerCase()).append(p.mutable ? ", mutable" : ", immutable").append(")\n");
+        }
+        return sb.toString().stripTrailing();
+    }
+
+    /** Every wire of the cell. */
+    public String bindings() {
+        CellDTO c = drcr.cell();
+        if (c.bindings.length == 0) {
+            return "no bindings";
+        }
+        StringBuilder sb = new StringBuilder();
+        for (BindingDTO b : c.bindings) {
+            sb.append(b.consumer).append('.').append(b.input).append(" <- ").append(b.provider).append('.').append(b.output).append('\n');
+        }
+        return sb.toString().stripTrailing();
+    }
+
+    /** A parameter as the RT half applied it. */
+    public String get(String name, String param) {
+        return guard(() -> cm(name).get(param));
+    }
+
+    /** Sets a parameter; prints the applied value. */
+    public String set(String name, String param, String value) {
+        return guard(() -> name + "." + param + " = " + cm(name).set(param, value));
+    }
+
+    /** Dry runs: {@code plan install <url>}, {@code plan uninstall <name>}, {@code plan cpus 0,1 [memory m] [network n]}. */
+    public String plan(String... args) {
+        return guard(() -> {
+            if (args.length == 2 && args[0].equals("install")) {
+                return drcr.planInstall(args[1]);
+            }
+            if (args.length == 2 && args[0].equals("uninstall")) {
+                return drcr.planUninstall(args[1]);
+            }
+            if (args.length >= 1 && (args[0].equals("cpus") || args[0].equals("memory") || args[0].equals("network"))) {
+                ResourcesDTO r = resources.resources();
+                Caps caps = parseCaps(args, r);
+                return drcr.planCapacity(caps.cpus, caps.memory, caps.network);
+            }
+            return "usage: plan install <jar-url> | plan uninstall <name> | plan [cpus <list>] [memory <bytes>] [network <B/s>]";
+        });
+    }
+
+    /** Pulls the update of a component from its contract's update URL. */
+    public String update(String name) {
+        return guard(() -> updates.update(name));
+    }
+
+    /** {@code resources} prints capacities; {@code resources set cpus 0,1 memory 512m network 10m} changes them. */
+    public String resources(String... args) {
+        return guard(() -> {
+            if (args.length == 0) {
+                ResourcesDTO r = resources.resources();
+                StringBuilder sb = new StringBuilder();
+                sb.append("cpus:");
+                for (int k = 0; k < r.cpus.length; k++) {
+                    sb.append(String.format(" %d(U=%.3f)", r.cpus[k], r.cpuUtilisation[k]));
+                }
+                sb.append("\nmemory: ").append(r.memoryUsed).append(" of ").append(r.memoryBytes).append(" bytes\n");
+                sb.append("network: ").append(r.networkUsed).append(" of ").append(r.networkBps).append(" B/s\n");
+                sb.append("wcet overruns: ").append(r.wcetOverruns);
+                return sb.toString();
+            }
+            if (!args[0].equals("set") || args.length < 3) {
+                return "usage: resources | resources set [cpus <list>] [memory <bytes>] [network <B/s>]";
+            }
+            ResourcesDTO r = resources.resources();
+            Caps caps = parseCaps(Arrays.copyOfRange(args, 1, args.length), r);
+            if (!caps.cpus.equals(toList(r.cpus))) {
+                resources.setCpus(caps.cpus);
+            }
+            if (caps.memory != r.memoryBytes) {
+                resources.setMemory(caps.memory);
+            }
+            if (caps.network != r.networkBps) {
+                resources.setNetwork(caps.network);
+            }
+            return "resources: cpus " + caps.cpus + ", memory " + caps.memory + ", network " + caps.network;
+        });
+    }
+
+    /** RT statistics of one component. */
+    public String stats(String name) {
+        return guard(() -> {
+            StatsDTO s = cm(name).stats();
+            if (s == null) {
+                return name + ": no RT half running";
+            }
+            return name + ": rt " + s.rtState + ", cycles " + s.cycles + ", overruns " + s.overruns + ", wcet overruns "
+                    + s.wcetOverruns + ", latency max " + s.maxLatencyNs + " ns, exec max " + s.maxExecNs + " ns, exec mean "
+                    + s.meanExecNs + " ns, heartbeat age " + s.heartbeatAgeMs + " ms";
+        });
+    }
+
+    /** Operator reset. */
+    public String reset(String name) {
+        return guard(() -> {
+            cm(name).reset();
+            return name + ": reset; now " + drcr.instance(name).map(i -> i.state).orElse("?");
+        });
+    }
+
+    /** The whole cell as one line of JSON. */
+    public String dto() {
+        return Json.write(drcr.cell());
+    }
+
+    private ComponentManagement cm(String name) {
+        return management.apply(name).orElseThrow(() -> new IllegalArgumentException("no component '" + name + "'"));
+    }
+
+    private interface Body {
+        String run();
+    }
+
+    private static String guard(Body b) {
+        try {
+            return b.run();
+        } catch (RuntimeException e) {
+            return "error: " + e.getMessage();
+        }
+    }
+
+    private record Caps(List<Integer> cpus, long memory, long network) {
+    }
+
+    private static List<Integer> toList(int[] a) {
+        List<Integer> l = new ArrayList<>();
+        for (int x : a) {
+            l.add(x);
+        }
+        return l;
+    }
+
+    private static Caps parseCaps(String[] args, ResourcesDTO current) {
+        List<Integer> cpus = toList(current.cpus);
+        long mem = current.memoryBytes;
+        long net = current.networkBps;
+        if (args.length % 2 != 0) {
+            throw new IllegalArgumentException("expected pairs of <cpus|memory|network> <value>, got " + Arrays.toString(args));
+        }
+        for (int i = 0; i < args.length; i += 2) {
+            switch (args[i]) {
+                case "cpus" -> cpus = parseCpus(args[i + 1]);
+                case "memory" -> mem = parseSize(args[i + 1]);
+                case "network" -> net = parseSize(args[i + 1]);
+                default -> throw new IllegalArgumentException("unknown resource '" + args[i] + "' (cpus, memory, network)");
+            }
+        }
+        return new Caps(cpus, mem, net);
+    }
+
+    /** {@code 0,1}, {@code 1-3}, {@code none}. */
+    public static List<Integer> parseCpus(String s) {
+        List<Integer> out = new ArrayList<>();
+        if (s.equals("none") || s.isBlank()) {
+            return out;
+        }
+        for (String part : s.split(",")) {
+            String p = part.trim();
+            try {
+                int dash = p.indexOf('-');
+                if (dash > 0) {
+                    int a = Integer.parseInt(p.substring(0, dash));
+                    int b = Integer.parseInt(p.substring(dash + 1));
+                    if (a > b || b - a > 1024) {
+                        throw new IllegalArgumentException("bad cpu range '" + p + "'");
+                    }
+                    for (int k = a; k <= b; k++) {
+                        out.add(k);
+                    }
+                } else {
+                    out.add(Integer.parseInt(p));
+                }
+            } catch (NumberFormatException e) {
+                throw new IllegalArgumentException("bad cpu list '" + s + "' (examples: 0,1 or 1-3 or none)");
+            }
+        }
+        return out;
+    }
+
+    /** Bytes with optional k/m/g suffix (binary multiples). */
+    public static long parseSize(String s) {
+        String t = s.trim().toLowerCase();
+        long mul = 1;
+        if (t.endsWith("k")) {
+            mul = 1L << 10;
+        } else if (t.endsWith("m")) {
+            mul = 1L << 20;
+        } else if (t.endsWith("g")) {
+            mul = 1L << 30;
+        }
+        if (mul != 1) {
+            t = t.substring(0, t.length() - 1);
+        }
+        try {
+            long v = Long.parseLong(t);
+            if (v < 0) {
+                throw new NumberFormatException();
+            }
+            return Math.multiplyExact(v, mul);
+        } catch (NumberFormatException | ArithmeticException e) {
+            throw new IllegalArgumentException("bad size '" + s + "' (a number of bytes, k/m/g suffix allowed)");
+        }
+    }
+}

@@ -1,0 +1,338 @@
+package org.arflex.drcr.impl.supervisor;
+
+import java.io.BufferedReader;
+import java.io.IOException;
+import java.io.InputStreamReader;
+import java.nio.charset.StandardCharsets;
+import java.util.ArrayDeque;
+import java.util.Deque;
+import java.util.concurrent.CompletableFuture;
+import java.util.concurrent.TimeUnit;
+import java.util.concurrent.locks.LockSupport;
+import java.util.function.Consumer;
+import org.arflex.drcr.impl.abi.ControlBlock;
+import org.arflex.drcr.impl.abi.Mailbox;
+import org.arflex.drcr.impl.abi.PortSegment;
+
+/**
+ * Spawns RT halves as child processes. The child's stdout and stderr go, line by line, to the
+ * log through one reader thread per process ({@code arflex-rt-<instance>}); the last lines are
+ * kept for the failure reason.
+ */
+public final class ProcessLauncher implements RtLauncher {
+
+    /** Mailbox call timeout. */
+    static final long CALL_TIMEOUT_MS = 2_000;
+    private static final int TAIL_LINES = 8;
+
+    private final Consumer<String> log;
+
+    public ProcessLauncher(Consumer<String> log) {
+        this.log = log;
+    }
+
+    /** The name of a shared object of an instance. */
+    public static String objectName(String rid, String inst, String channel) {
+        return "/arflex." + rid + "." + inst + "." + channel;
+    }
+
+    @Override
+    public Output createOutput(String segmentName, int method, String typeName, int major, int minor, int elemSize,
+                               int depth, int overflow) throws IOException {
+        PortSegment seg = PortSegment.create(segmentName, method, typeName, major, minor, elemSize, depth, overflow);
+        return new Output() {
+            private boolean closed;
+
+            @Override
+            public String name() {
+                return seg.name();
+            }
+
+            @Override
+            public synchronized long published() {
+                return closed ? 0 : seg.head();
+            }
+
+            @Override
+            public synchronized void close() {
+                if (!closed) {
+                    closed = true;
+                    seg.close();
+                }
+            }
+        };
+    }
+
+    @Override
+    public RtHalf launch(Spec spec) throws IOException {
+        String rid = spec.runtimeId();
+        String inst = spec.instance();
+        ControlBlock ctl = ControlBlock.create(objectName(rid, inst, "ctl"), spec.config(), spec.params(),
+                spec.resetRequired());
+        Mailbox mb;
+        try {
+            mb = Mailbox.create(objectName(rid, inst, "cmd"), objectName(rid, inst, "rsp"));
+        } catch (IOException e) {
+            ctl.close();
+            throw e;
+        }
+        Process p;
+        try {
+            ProcessBuilder pb = new ProcessBuilder(spec.executable().toString(), "--runtime", rid, "--instance", inst)
+                    .redirectErrorStream(true)
+                    .redirectInput(ProcessBuilder.Redirect.PIPE);
+            p = pb.start();
+            p.getOutputStream().close();
+        } catch (IOException e) {
+            mb.close();
+            ctl.close();
+            throw new IOException("cannot spawn " + spec.executable() + ": " + e.getMessage(), e);
+        }
+        ProcessRtHalf half = new ProcessRtHalf(inst, p, ctl, mb);
+        half.pumpOutput(log);
+        // Wait for READY (or a failure) with a deadline; the RT half attaches, configures and
+        // declares its ports in between.
+        long deadline = System.nanoTime() + spec.readyTimeoutMs() * 1_000_000L;
+        while (true) {
+            int st = ctl.state();
+            if (st == ControlBlock.STATE_READY) {
+                return half;
+            }
+            if (st == ControlBlock.STATE_FAILED || !p.isAlive() || System.nanoTime() - deadline > 0) {
+                String why = !p.isAlive() ? "exited with status " + exitOf(p)
+                        : st == ControlBlock.STATE_FAILED ? "reported FAILED" : "not READY within " + spec.readyTimeoutMs() + " ms";
+                int err = ctl.exitStatus();
+                half.kill();
+                try {
+                    p.waitFor(2, TimeUnit.SECONDS);
+                } catch (InterruptedException e) {
+                    Thread.currentThread().interrupt();
+                }
+                half.cleanup();
+                throw new IOException("RT half " + inst + " " + why + (err != 0 ? ", error " + err : "")
+                        + " (state " + ControlBlock.stateName(st) + ")" + half.tailText());
+            }
+            LockSupport.parkNanos(500_000);
+        }
+    }
+
+    private static String exitOf(Process p) {
+        try {
+            return Integer.toString(p.exitValue());
+        } catch (IllegalThreadStateException e) {
+            return "?";
+        }
+    }
+
+    /** Describes an exit status as the JVM reports it (128+n for signal n). */
+    static RtHalf.Exit describe(int status, boolean requested) {
+        if (status > 128 && status < 160) {
+            return new RtHalf.Exit(status, true, "killed by signal " + (status - 128));
+        }
+        if (status == 0) {
+            return new RtHalf.Exit(0, false, requested ? "exited normally after SHUTDOWN" : "exited with status 0");
+        }
+        return new RtHalf.Exit(status, true, "exited with status " + status);
+    }
+
+    static final class ProcessRtHalf implements RtHalf {
+        private final String inst;
+        private final Process process;
+        private final ControlBlock ctl;
+        private final Mailbox mb;
+        private final Deque<String> tail = new ArrayDeque<>();
+        private final CompletableFuture<Exit> exit;
+        private volatile boolean stopping;
+        // Guards the mapping: readers on the heartbeat thread must never touch an unmapped
+        // control block, so every ctl access and the cleanup hold this object's lock.
+        private boolean cleaned;
+
+        ProcessRtHalf(String inst, Process process, ControlBlock ctl, Mailbox mb) {
+            this.inst = inst;
+            this.process = process;
+            this.ctl = ctl;
+            this.mb = mb;
+            this.exit = process.onExit().thenApply(pr -> describe(pr.exitValue(), stopping));
+        }
+
+        void pumpOutput(Consumer<String> log) {
+            Thread t = new Thread(() -> {
+                try (BufferedReader r = new BufferedReader(
+                        new InputStreamReader(process.getInputStream(), StandardCharsets.UTF_8))) {
+                    String line;
+                    while ((line = r.readLine()) != null) {
+                        synchronized (tail) {
+                            tail.addLast(line);
+                            if (tail.size() > TAIL_LINES) {
+                                tail.removeFirst();
+                            }
+                        }
+                        log.accept("[" + inst + " pid " + process.pid() + "] " + line);
+                    }
+                } catch (IOException ignored) {
+                    // the pipe closes when the process exits
+                }
+            }, "arflex-rt-" + inst);
+            t.setDaemon(true);
+            t.start();
+        }
+
+        String tailText() {
+            synchronized (tail) {
+                return tail.isEmpty() ? "" : "; last output: " + String.join(" | ", tail);
+            }
+        }
+
+        @Override
+        public long pid() {
+            return process.pid();
+        }
+
+        @Override
+        public CompletableFuture<Exit> exit() {
+            return exit;
+        }
+
+        private Mailbox.Reply call(Mailbox.Cmd c) throws IOException {
+            Mailbox.Reply r = mb.call(c, CALL_TIMEOUT_MS);
+            if (r.status() != 0) {
+                throw new IOException(c + " refused by " + inst + ": status " + r.status());
+            }
+            return r;
+        }
+
+        @Override
+        public void bind(String port, String segment) throws IOException {
+            Mailbox.Reply r = mb.bind(port, segment, CALL_TIMEOUT_MS);
+            if (r.status() != 0) {
+                throw new IOException("BIND " + inst + "." + port + " to " + segment + " refused: status " + r.status());
+            }
+        }
+
+        @Override
+        public void unbind(String port) throws IOException {
+            Mailbox.Reply r = mb.unbind(port, CALL_TIMEOUT_MS);
+            if (r.status() != 0) {
+                throw new IOException("UNBIND " + inst + "." + port + " refused: status " + r.status());
+            }
+        }
+
+        @Override
+        public void start() throws IOException {
+            call(Mailbox.Cmd.START);
+        }
+
+        @Override
+        public void reset() throws IOException {
+            call(Mailbox.Cmd.RESET);
+        }
+
+        @Override
+        public long setParam(int index, long bits) throws IOException {
+            Mailbox.Reply r = mb.setParam(index, bits, CALL_TIMEOUT_MS);
+            if (r.status() != 0) {
+                throw new IOException("SET_PARAM refused by " + inst + ": status " + r.status() + " ("
+                        + errnoName(-r.status()) + ")");
+            }
+            return r.payloadLong(Mailbox.PARAM_VALUE);
+        }
+
+        @Override
+        public synchronized long paramValue(int index) {
+            if (cleaned) {
+                return 0;
+            }
+            return ctl.paramValue(index);
+        }
+
+        @Override
+        public synchronized int rtState() {
+            if (cleaned) {
+                return ControlBlock.STATE_EXITED;
+            }
+            return ctl.state();
+        }
+
+        @Override
+        public synchronized int flags() {
+            if (cleaned) {
+                return 0;
+            }
+            return ctl.flags();
+        }
+
+        @Override
+        public synchronized long rtHeartbeatNs() {
+            if (cleaned) {
+                return 0;
+            }
+            return ctl.rtHeartbeatNs();
+        }
+
+        @Override
+        public synchronized void runtimeHeartbeat(long nowNs) {
+            if (cleaned) {
+                return;
+            }
+            ctl.runtimeHeartbeat(nowNs);
+        }
+
+        @Override
+        public synchronized ControlBlock.Stats stats(long wcetNs) {
+            if (cleaned) {
+                return null;
+            }
+            return ctl.stats(wcetNs);
+        }
+
+        @Override
+        public void shutdown(long deadlineMs) {
+            stopping = true;
+            if (process.isAlive()) {
+                try {
+                    if (rtState() == ControlBlock.STATE_RUNNING) {
+                        mb.call(Mailbox.Cmd.STOP, Math.min(CALL_TIMEOUT_MS, deadlineMs));
+                    }
+                    mb.call(Mailbox.Cmd.SHUTDOWN, Math.min(CALL_TIMEOUT_MS, deadlineMs));
+                } catch (IOException e) {
+                    // no answer: the deadline below and SIGKILL take over
+                }
+                try {
+                    if (!process.waitFor(deadlineMs, TimeUnit.MILLISECONDS)) {
+                        process.destroyForcibly();
+                        process.waitFor(deadlineMs, TimeUnit.MILLISECONDS);
+                    }
+                } catch (InterruptedException e) {
+                    process.destroyForcibly();
+                    Thread.currentThread().interrupt();
+                }
+            }
+            cleanup();
+        }
+
+        @Override
+        public void kill() {
+            process.destroyForcibly();
+        }
+
+        @Override
+        public synchronized void cleanup() {
+            if (!cleaned) {
+                cleaned = true;
+                mb.close();
+                ctl.close();
+            }
+        }
+    }
+
+    static String errnoName(int e) {
+        return switch (e) {
+            case 1 -> "EPERM: not mutable while running";
+            case 22 -> "EINVAL: invalid value";
+            case 34 -> "ERANGE: out of range";
+            case 2 -> "ENOENT: no such parameter";
+            case 11 -> "EAGAIN";
+            default -> "errno " + e;
+        };
+    }
+}

@@ -1,0 +1,73 @@
+package org.arflex.drcr.impl.supervisor;
+
+import java.io.IOException;
+import java.util.concurrent.CompletableFuture;
+import org.arflex.drcr.impl.abi.ControlBlock;
+
+/**
+ * A running RT half as the DRCR sees it: its process, its control block and its mailbox. Made
+ * by an {@link RtLauncher}. Methods that talk to the mailbox block for at most their timeout and
+ * are called from the actor thread; the read accessors may be called from any thread.
+ */
+public interface RtHalf {
+
+    /** Process id. */
+    long pid();
+
+    /** Completes with the exit description when the process has exited (crash or not). */
+    CompletableFuture<Exit> exit();
+
+    /** BIND input {@code port} to the provider segment {@code segment}. */
+    void bind(String port, String segment) throws IOException;
+
+    /** UNBIND input {@code port}. */
+    void unbind(String port) throws IOException;
+
+    /** START the RT loop. */
+    void start() throws IOException;
+
+    /** Operator RESET (leave safe mode, clear reset-required). */
+    void reset() throws IOException;
+
+    /**
+     * SET_PARAM of slot {@code index}.
+     *
+     * @return the value in force after the RT half handled it
+     * @throws IOException when the RT half refused it (status) or did not answer
+     */
+    long setParam(int index, long bits) throws IOException;
+
+    /** The value in force of slot {@code index}, read from the control block. */
+    long paramValue(int index);
+
+    /** RT state word (ControlBlock.STATE_*). */
+    int rtState();
+
+    /** Control block flags. */
+    int flags();
+
+    /** The RT thread's heartbeat, CLOCK_MONOTONIC ns (0 before its first cycle). */
+    long rtHeartbeatNs();
+
+    /** Writes the runtime heartbeat into the control block. */
+    void runtimeHeartbeat(long nowNs);
+
+    /** Statistics snapshot, or null when the seqlock could not be read. */
+    ControlBlock.Stats stats(long wcetNs);
+
+    /**
+     * Orderly end: STOP, SHUTDOWN, wait for the exit until {@code deadlineMs}, SIGKILL if it is
+     * still there, then remove the control block and queues. Never throws; idempotent.
+     */
+    void shutdown(long deadlineMs);
+
+    /** SIGKILL now (hang), without waiting; the exit future completes when it is gone. */
+    void kill();
+
+    /** Removes the control block and the queues (after the exit). Idempotent. */
+    void cleanup();
+
+    /** How a process ended. */
+    record Exit(int status, boolean abnormal, String description) {
+    }
+}
