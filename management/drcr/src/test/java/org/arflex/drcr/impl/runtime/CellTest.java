@@ -1,0 +1,262 @@
+package org.arflex.drcr.impl.runtime;
+
+import static org.junit.jupiter.api.Assertions.assertEquals;
+import static org.junit.jupiter.api.Assertions.assertFalse;
+import static org.junit.jupiter.api.Assertions.assertNotNull;
+import static org.junit.jupiter.api.Assertions.assertThrows;
+import static org.junit.jupiter.api.Assertions.assertTrue;
+
+import java.nio.file.Path;
+import java.util.ArrayList;
+import java.util.List;
+import org.arflex.contract.Contract;
+import org.arflex.contract.ContractParser;
+import org.arflex.contract.PortTypes;
+import org.arflex.drcr.dto.CellDTO;
+import org.arflex.drcr.dto.InstanceDTO;
+import org.arflex.drcr.impl.lifecycle.ManualActor;
+import org.arflex.drcr.impl.lifecycle.State;
+import org.arflex.planner.Capacities;
+import org.arflex.planner.Planner;
+import org.junit.jupiter.api.AfterEach;
+import org.junit.jupiter.api.Test;
+
+/**
+ * The cell with a fake launcher, a steppable actor and a simulated clock: wiring, cascades,
+ * restart policy, Failed, reset, parameters, hang detection. Deterministic, no processes.
+ */
+class CellTest {
+
+    private final ManualActor actor = new ManualActor();
+    private final FakeLauncher launcher = new FakeLauncher();
+    private final List<String> log = new ArrayList<>();
+    private long nowNs = 1_000_000_000L;
+    private final Cell cell = new Cell(new Cell.Config("t", 1000, 1000, true, PortTypes.builtin(), () -> nowNs),
+            actor, launcher, new Planner(Capacities.of(2, 1.0, 1L << 30, 1_000_000_000L)), log::add);
+
+    static String contract(String name, String extraPorts, String fault, boolean moves, int criticality, String wcet) {
+        return "<component xmlns=\"urn:arflex:contract:1\" name=\"" + name + "\" version=\"1.0.0\">"
+                + "<implementation executable=\"" + name + "\" task=\"periodic\" movesHardware=\"" + moves + "\"/>"
+                + "<ports>" + extraPorts + "</ports>"
+                + "<properties><property name=\"gain\" type=\"double\" default=\"2.0\" min=\"-10\" max=\"10\" mutable=\"true\"/>"
+                + "<property name=\"mode\" type=\"int\" default=\"1\" min=\"0\" max=\"3\" mutable=\"false\"/></properties>"
+                + "<timing period=\"1ms\" deadline=\"1ms\" wcet=\"" + wcet + "\" priority=\"80\"/>"
+                + "<resources memory=\"1MiB\" network=\"0\"/><criticality>" + criticality + "</criticality>"
+                + "<fault " + fault + " safe=\"hold\" heartbeatTimeout=\"100ms\"/></component>";
+    }
+
+    static final String PERMANENT = "restart=\"permanent\" intensity=\"2\" window=\"10s\" backoff=\"100ms\"";
+    static final String PROVIDER_PORTS = "<out name=\"y\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\"/>";
+    static final String CONSUMER_PORTS = "<in name=\"x\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\">"
+            + "<bind component=\"prov\" port=\"y\"/></in>"
+            + "<out name=\"z\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\"/>";
+
+    private Contract parse(String xml) throws Exception {
+        return ContractParser.create(PortTypes.builtin()).parse(xml, "test.xml");
+    }
+
+    private void install(String xml) throws Exception {
+        Contract c = parse(xml);
+        assertTrue(actor.call(() -> cell.install(c, c.name().hashCode(), Path.of("/nonexistent/" + c.name())), 0), log::toString);
+        actor.runAll();
+    }
+
+    private State state(String n) {
+        return cell.instance(n).orElseThrow().life.state();
+    }
+
+    private String reason(String n) {
+        return cell.instance(n).orElseThrow().life.reason();
+    }
+
+    private void installBoth() throws Exception {
+        install(contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us"));
+        install(contract("cons", CONSUMER_PORTS, PERMANENT, false, 3, "50us"));
+    }
+
+    @AfterEach
+    void nothingLeaks() {
+        actor.call(() -> {
+            cell.shutdownAll("test end");
+            return null;
+        }, 0);
+        actor.runAll();
+        assertTrue(launcher.running.isEmpty(), "RT halves left running: " + launcher.running.keySet());
+        assertTrue(launcher.openOutputs.isEmpty(), "segments left: " + launcher.openOutputs);
+    }
+
+    @Test
+    void consumerFirstWaitsThenBothActiveWithBinding() throws Exception {
+        install(contract("cons", CONSUMER_PORTS, PERMANENT, false, 3, "50us"));
+        assertEquals(State.UNSATISFIED, state("cons"));
+        assertTrue(reason("cons").contains("prov"), reason("cons"));
+        assertTrue(launcher.running.isEmpty());
+        install(contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us"));
+        assertEquals(State.ACTIVE, state("prov"));
+        assertEquals(State.ACTIVE, state("cons"));
+        assertTrue(launcher.events.contains("cons BIND x /arflex.t.prov.out.y"), launcher.events.toString());
+        // the provider's segment exists before the consumer is bound, and starts come after binds
+        assertTrue(launcher.events.indexOf("CREATE /arflex.t.prov.out.y arflex.Sample 16") >= 0
+                || launcher.events.stream().anyMatch(e -> e.startsWith("CREATE /arflex.t.prov.out.y arflex.Sample")),
+                launcher.events.toString());
+        assertTrue(launcher.events.indexOf("cons BIND x /arflex.t.prov.out.y") < launcher.events.indexOf("cons START"));
+        CellDTO dto = Snapshots.cell(cell, null);
+        assertEquals(1, dto.bindings.length);
+        assertEquals("prov", dto.bindings[0].provider);
+    }
+
+    @Test
+    void uninstallProviderTakesConsumerDownAndReinstallBringsItBack() throws Exception {
+        installBoth();
+        actor.call(() -> {
+            cell.uninstall("prov", "bundle stopped");
+            return null;
+        }, 0);
+        assertEquals(State.UNSATISFIED, state("cons"));
+        assertTrue(launcher.events.contains("cons UNBIND x"), launcher.events.toString());
+        assertFalse(launcher.running.containsKey("cons"));
+        install(contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us"));
+        assertEquals(State.ACTIVE, state("cons"));
+    }
+
+    @Test
+    void crashCascadesAndBackoffRestartsAll() throws Exception {
+        installBoth();
+        long consPid = launcher.running.get("cons").pid;
+        launcher.running.get("prov").crash(137, "killed by signal 9");
+        actor.runAll();
+        assertEquals(State.UNSATISFIED, state("prov"));
+        assertTrue(reason("prov").contains("restarting"), reason("prov"));
+        assertEquals(State.UNSATISFIED, state("cons"), "dependent must go down with its provider");
+        assertFalse(launcher.running.containsKey("cons"));
+        actor.advance(99);
+        assertEquals(State.UNSATISFIED, state("prov"), "restart must wait for the backoff");
+        actor.advance(1);
+        assertEquals(State.ACTIVE, state("prov"));
+        assertEquals(State.ACTIVE, state("cons"));
+        assertTrue(launcher.running.get("cons").pid != consPid);
+        InstanceDTO p = Snapshots.instance(cell, "prov").orElseThrow();
+        assertEquals(1, p.restarts);
+        assertEquals(1, p.restartsLeft);
+    }
+
+    @Test
+    void crashLoopEndsInFailedAndResetRevives() throws Exception {
+        installBoth();
+        for (int i = 0; i < 3; i++) {
+            launcher.running.get("prov").crash(139, "killed by signal 11");
+            actor.runAll();
+            actor.advance(10_000 / 4 > 0 ? 500 : 0);
+        }
+        assertEquals(State.FAILED, state("prov"));
+        assertTrue(reason("prov").contains("restart intensity exceeded"), reason("prov"));
+        assertEquals(State.UNSATISFIED, state("cons"));
+        actor.advance(60_000);
+        assertEquals(State.FAILED, state("prov"), "Failed is final until reset");
+        actor.call(() -> cell.reset("prov"), 0);
+        assertEquals(State.ACTIVE, state("prov"));
+        assertEquals(State.ACTIVE, state("cons"));
+    }
+
+    @Test
+    void failingStartUsesTheRestartPolicy() throws Exception {
+        launcher.failLaunches.put("prov", 1);
+        install(contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us"));
+        assertEquals(State.UNSATISFIED, state("prov"));
+        assertTrue(reason("prov").contains("start failed"), reason("prov"));
+        actor.advance(100);
+        assertEquals(State.ACTIVE, state("prov"));
+    }
+
+    @Test
+    void temporaryIsNotRestarted() throws Exception {
+        install(contract("prov", PROVIDER_PORTS, "restart=\"temporary\" intensity=\"1\" window=\"1s\" backoff=\"10ms\"", false, 5, "50us"));
+        launcher.running.get("prov").crash(1, "exited with status 1");
+        actor.runAll();
+        actor.advance(5_000);
+        assertEquals(State.FAILED, state("prov"));
+        assertTrue(reason("prov").contains("temporary"), reason("prov"));
+    }
+
+    @Test
+    void movingHardwareNeedsResetAfterRestart() throws Exception {
+        install(contract("prov", PROVIDER_PORTS, PERMANENT, true, 5, "50us"));
+        assertFalse(launcher.specs.get(0).resetRequired(), "the first start needs no reset");
+        launcher.running.get("prov").crash(137, "killed by signal 9");
+        actor.runAll();
+        actor.advance(100);
+        assertEquals(State.ACTIVE, state("prov"));
+        assertTrue(launcher.specs.get(1).resetRequired(), "a restart must set RESET_REQUIRED before the spawn");
+        assertTrue(cell.instance("prov").orElseThrow().awaitingReset);
+        actor.call(() -> cell.reset("prov"), 0);
+        assertTrue(launcher.events.contains("prov RESET"));
+        assertFalse(cell.instance("prov").orElseThrow().awaitingReset);
+    }
+
+    @Test
+    void parametersAreCheckedForRangeTypeAndMutability() throws Exception {
+        install(contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us"));
+        assertEquals("3.5", actor.call(() -> cell.setParam("prov", "gain", "3.5"), 0));
+        assertEquals("3.5", cell.getParam("prov", "gain"));
+        IllegalArgumentException range = assertThrows(IllegalArgumentException.class,
+                () -> actor.call(() -> cell.setParam("prov", "gain", "11"), 0));
+        assertTrue(range.getMessage().contains("out of range"), range.getMessage());
+        IllegalArgumentException type = assertThrows(IllegalArgumentException.class,
+                () -> actor.call(() -> cell.setParam("prov", "gain", "abc"), 0));
+        assertTrue(type.getMessage().contains("not a number"), type.getMessage());
+        IllegalArgumentException imm = assertThrows(IllegalArgumentException.class,
+                () -> actor.call(() -> cell.setParam("prov", "mode", "2"), 0));
+        assertTrue(imm.getMessage().contains("immutable"), imm.getMessage());
+        assertThrows(IllegalArgumentException.class, () -> actor.call(() -> cell.setParam("prov", "nope", "1"), 0));
+        // a restart keeps the value that was set
+        launcher.running.get("prov").crash(137, "killed by signal 9");
+        actor.runAll();
+        actor.advance(100);
+        assertEquals("3.5", cell.getParam("prov", "gain"));
+    }
+
+    @Test
+    void staleRtHeartbeatIsAHang() throws Exception {
+        install(contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us"));
+        FakeLauncher.FakeHalf h = launcher.running.get("prov");
+        h.rtHb = nowNs;
+        nowNs += 50_000_000L;
+        cell.monitor().check(nowNs);
+        actor.runAll();
+        assertEquals(State.ACTIVE, state("prov"));
+        assertEquals(nowNs, h.runtimeHb, "the monitor writes the runtime heartbeat");
+        nowNs += 200_000_000L;
+        cell.monitor().check(nowNs);
+        actor.runAll();
+        assertTrue(launcher.events.contains("prov SIGKILL"));
+        assertTrue(reason("prov").contains("hung"), reason("prov"));
+        actor.advance(100);
+        assertEquals(State.ACTIVE, state("prov"));
+    }
+
+    @Test
+    void shrinkingCpusStopsLowestCriticalityFirst() throws Exception {
+        install(contract("hi", PROVIDER_PORTS.replace("\"y\"", "\"a\""), PERMANENT, false, 9, "600us"));
+        install(contract("lo", PROVIDER_PORTS.replace("\"y\"", "\"b\""), PERMANENT, false, 1, "600us"));
+        assertEquals(State.ACTIVE, state("hi"));
+        assertEquals(State.ACTIVE, state("lo"));
+        String dry = actor.call(() -> cell.dryRun(org.arflex.planner.Change.capacities(
+                Capacities.of(1, 1.0, 1L << 30, 1_000_000_000L))).toText(), 0);
+        assertTrue(dry.contains("lo"), dry);
+        actor.call(() -> cell.capacities(Capacities.of(1, 1.0, 1L << 30, 1_000_000_000L)), 0);
+        assertEquals(State.ACTIVE, state("hi"));
+        assertEquals(State.UNSATISFIED, state("lo"));
+        assertNotNull(reason("lo"));
+        actor.call(() -> cell.capacities(Capacities.of(2, 1.0, 1L << 30, 1_000_000_000L)), 0);
+        assertEquals(State.ACTIVE, state("lo"));
+    }
+
+    @Test
+    void nameOwnedByAnotherBundleIsRefused() throws Exception {
+        install(contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us"));
+        Contract c = parse(contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us"));
+        assertFalse(actor.call(() -> cell.install(c, 4242, Path.of("/x")), 0));
+        assertTrue(cell.problems().get(0).contains("already installed by bundle"), cell.problems().toString());
+        assertEquals(State.ACTIVE, state("prov"));
+    }
+}

@@ -1,0 +1,176 @@
+package org.arflex.drcr.impl.runtime;
+
+import java.io.IOException;
+import java.util.ArrayList;
+import java.util.HashMap;
+import java.util.List;
+import java.util.Map;
+import java.util.concurrent.CompletableFuture;
+import org.arflex.drcr.impl.abi.ControlBlock;
+import org.arflex.drcr.impl.supervisor.RtHalf;
+import org.arflex.drcr.impl.supervisor.RtLauncher;
+
+/** An RT launcher without processes: records every command; tests end processes at will. */
+final class FakeLauncher implements RtLauncher {
+
+    final List<String> events = new ArrayList<>();
+    final Map<String, FakeHalf> running = new HashMap<>();
+    final List<Spec> specs = new ArrayList<>();
+    final Map<String, Integer> openOutputs = new HashMap<>();
+    /** Instances whose next launches fail. */
+    final Map<String, Integer> failLaunches = new HashMap<>();
+    private long nextPid = 1000;
+
+    final class FakeHalf implements RtHalf {
+        final String inst;
+        final long pid = nextPid++;
+        final CompletableFuture<Exit> exit = new CompletableFuture<>();
+        final long[] params;
+        long rtHb;
+        long runtimeHb;
+        boolean started;
+        boolean cleaned;
+
+        FakeHalf(Spec s) {
+            inst = s.instance();
+            params = s.params().stream().mapToLong(ControlBlock.Param::defaultBits).toArray();
+        }
+
+        @Override
+        public long pid() {
+            return pid;
+        }
+
+        @Override
+        public CompletableFuture<Exit> exit() {
+            return exit;
+        }
+
+        @Override
+        public void bind(String port, String segment) {
+            events.add(inst + " BIND " + port + " " + segment);
+        }
+
+        @Override
+        public void unbind(String port) {
+            events.add(inst + " UNBIND " + port);
+        }
+
+        @Override
+        public void start() {
+            started = true;
+            events.add(inst + " START");
+        }
+
+        @Override
+        public void reset() {
+            events.add(inst + " RESET");
+        }
+
+        @Override
+        public long setParam(int index, long bits) {
+            events.add(inst + " SET_PARAM " + index);
+            params[index] = bits;
+            return bits;
+        }
+
+        @Override
+        public long paramValue(int index) {
+            return params[index];
+        }
+
+        @Override
+        public int rtState() {
+            return started ? ControlBlock.STATE_RUNNING : ControlBlock.STATE_READY;
+        }
+
+        @Override
+        public int flags() {
+            return 0;
+        }
+
+        @Override
+        public long rtHeartbeatNs() {
+            return rtHb;
+        }
+
+        @Override
+        public void runtimeHeartbeat(long nowNs) {
+            runtimeHb = nowNs;
+        }
+
+        @Override
+        public ControlBlock.Stats stats(long wcetNs) {
+            return new ControlBlock.Stats(0, 0, 0, 0, 0, 0, 0, 0, 0);
+        }
+
+        @Override
+        public void shutdown(long deadlineMs) {
+            events.add(inst + " SHUTDOWN");
+            running.remove(inst);
+            exit.complete(new Exit(0, false, "exited normally after SHUTDOWN"));
+            cleanup();
+        }
+
+        @Override
+        public void kill() {
+            events.add(inst + " SIGKILL");
+            crash(137, "killed by signal 9");
+        }
+
+        /** Simulates an unexpected exit. */
+        void crash(int status, String what) {
+            running.remove(inst);
+            exit.complete(new Exit(status, true, what));
+        }
+
+        @Override
+        public void cleanup() {
+            cleaned = true;
+        }
+    }
+
+    @Override
+    public RtHalf launch(Spec spec) throws IOException {
+        specs.add(spec);
+        int fails = failLaunches.getOrDefault(spec.instance(), 0);
+        if (fails > 0) {
+            failLaunches.put(spec.instance(), fails - 1);
+            events.add(spec.instance() + " LAUNCH-FAILED");
+            throw new IOException("RT half " + spec.instance() + " exited with status 4");
+        }
+        FakeHalf h = new FakeHalf(spec);
+        running.put(spec.instance(), h);
+        events.add(spec.instance() + " LAUNCH");
+        return h;
+    }
+
+    @Override
+    public Output createOutput(String segmentName, int method, String typeName, int major, int minor, int elemSize,
+                               int depth, int overflow) {
+        openOutputs.merge(segmentName, 1, Integer::sum);
+        events.add("CREATE " + segmentName + " " + typeName + " " + elemSize);
+        return new Output() {
+            boolean closed;
+
+            @Override
+            public String name() {
+                return segmentName;
+            }
+
+            @Override
+            public long published() {
+                return 0;
+            }
+
+            @Override
+            public void close() {
+                if (!closed) {
+                    closed = true;
+                    openOutputs.merge(segmentName, -1, Integer::sum);
+                    openOutputs.remove(segmentName, 0);
+                }
+            }
+        };
+    }
+}
