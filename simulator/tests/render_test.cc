@@ -4,9 +4,14 @@
 #include <apriltag/tag36h11.h>
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <map>
+#include <mutex>
 #include <set>
+#include <thread>
 
 #include "arflex_sim/cell.h"
 #include "arflex_sim/render.h"
@@ -221,6 +226,63 @@ TEST_F(RenderTest, RendersFromACopyOfTheStateNotFromTheCell) {
   renderer_->SetState(snapshot.data());
   ASSERT_EQ(renderer_->Render(0, b.data(), nullptr), 0);
   EXPECT_EQ(a, b);  // rendering is deterministic for a given state
+}
+
+TEST(RenderThreadTest, PhysicsStepsWhileARenderThreadDraws) {
+  // The intended deployment: the physics thread steps and publishes qpos snapshots; a render
+  // thread owns the Renderer (its OSMesa context is current there) and draws the latest
+  // snapshot. Physics never waits for a frame.
+  std::string error;
+  auto cell = Cell::Create(DefaultCellConfig(), {0.0, 0.5, 0.3, 0.0, 0.8, 0.0}, &error);
+  ASSERT_NE(cell, nullptr) << error;
+  const int nq = cell->model()->nq;
+  std::mutex mu;
+  std::condition_variable cv;
+  std::vector<double> snapshot(cell->qpos(), cell->qpos() + nq);
+  int frames = 0;
+  std::string render_error;
+  std::atomic<bool> stop{false};
+  std::thread render([&] {
+    std::string err;
+    auto renderer = Renderer::Create(cell->model(), 320, 240, &err);
+    std::vector<uint8_t> rgb(320 * 240 * 3);
+    std::vector<double> local(nq);
+    while (renderer && !stop.load()) {
+      {
+        std::lock_guard<std::mutex> lock(mu);
+        local = snapshot;
+      }
+      renderer->SetState(local.data());
+      if (renderer->Render(frames % 4, rgb.data(), nullptr) != 0) err = "render failed";
+      std::lock_guard<std::mutex> lock(mu);
+      ++frames;
+      cv.notify_all();
+    }
+    std::lock_guard<std::mutex> lock(mu);
+    render_error = renderer ? err : "renderer: " + err;
+    cv.notify_all();
+  });
+  JointVector ref = {0.0, 0.5, 0.3, 0.0, 0.8, 0.0};
+  for (int k = 0; k < 3000; ++k) {
+    ref[0] = 0.2 * k / 3000.0;
+    cell->SetJointReference(ref);
+    cell->Step(1);
+    if (k % 10 == 0) {
+      std::lock_guard<std::mutex> lock(mu);
+      std::copy(cell->qpos(), cell->qpos() + nq, snapshot.begin());
+    }
+  }
+  EXPECT_EQ(cell->step_count(), 3000u);
+  {
+    std::unique_lock<std::mutex> lock(mu);
+    const bool drew = cv.wait_until(lock, std::chrono::steady_clock::now() + std::chrono::seconds(60),
+                                    [&] { return frames >= 4 || !render_error.empty(); });
+    EXPECT_TRUE(drew) << "no frames within 60 s; frames = " << frames;
+  }
+  stop.store(true);
+  render.join();
+  EXPECT_EQ(render_error, "");
+  EXPECT_GE(frames, 4);
 }
 
 }  // namespace
