@@ -71,6 +71,8 @@ struct arflex_task {
 	int dma_fd;
 	pthread_t thread;
 	bool thread_live;
+	pthread_mutex_t lock;                 /**< start handshake only (not on the hot path) */
+	pthread_cond_t cond;
 };
 
 /** Initialises @t with @o (copied). Resets the statistics. Returns 0 or -EINVAL (period 0,

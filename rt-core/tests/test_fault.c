@@ -1,0 +1,197 @@
+/* Fault injection: fail the N-th system call on the set-up paths, for every N. */
+#include <errno.h>
+#include <setjmp.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+#include "arflex/host.h"
+#include "helper.h"
+
+#define SEC 1000000000ull
+#define INJECTED ENOTRECOVERABLE
+
+extern char **environ;
+
+static char rid[64];
+
+static void fill_opts(struct arflex_host_opts *o, struct arflex_param_slot *p,
+		      struct arflex_host_output *out, const char *inst)
+{
+	th_track(rid, inst);
+	memset(p, 0, sizeof(*p));
+	strcpy(p->name, "gain");
+	p->type = ARFLEX_PARAM_INT64;
+	p->flags = ARFLEX_PARAM_MUTABLE;
+	p->min_bits = (uint64_t)-1000;
+	p->max_bits = 1000;
+	p->default_bits = 1;
+	memset(out, 0, sizeof(*out));
+	out->port = "out";
+	out->spec.method = ARFLEX_PORT_STATE;
+	out->spec.type = (struct arflex_port_type){ "test.ProbeOut", 1, 0, 64 };
+	memset(o, 0, sizeof(*o));
+	o->runtime = rid;
+	o->instance = inst;
+	o->config.period_ns = 1000000;
+	o->config.cfg_flags = ARFLEX_CFG_NO_MLOCK | ARFLEX_CFG_NO_DMA_LATENCY;
+	o->params = p;
+	o->nparams = 1;
+	o->outputs = out;
+	o->noutputs = 1;
+}
+
+static void host_create_every_call_fails(void **state)
+{
+	struct arflex_host_output outs[3];
+	struct arflex_param_slot p;
+	struct arflex_host_opts o;
+	struct arflex_host h;
+	long n, failures = 0;
+
+	(void)state;
+	th_rid(rid, sizeof(rid), "fhost");
+	fill_opts(&o, &p, &outs[0], "inst");
+	outs[1] = outs[0];
+	outs[1].port = "second";
+	outs[2] = outs[0];
+	outs[2].port = "third";
+	outs[2].spec.method = ARFLEX_PORT_STREAM;
+	outs[2].spec.depth = 8;
+	outs[2].spec.overflow = ARFLEX_OVERFLOW_DROP_OLDEST;
+	o.outputs = outs;
+	o.noutputs = 3;
+	for (n = 1; n < 200; n++) {
+		int r;
+
+		arflex_sys_fault_set(n, INJECTED);
+		r = arflex_host_create(&h, &o);
+		arflex_sys_fault_set(0, 0);
+		if (r == 0) {
+			arflex_host_destroy(&h);
+			th_assert_clean(rid);
+			break;
+		}
+		assert_int_equal(r, -INJECTED);
+		failures++;
+		/* nothing of the instance exists after a failed create */
+		th_assert_clean(rid);
+	}
+	print_message("host create: %ld set-up calls, each failed once\n", failures);
+	/* 3 shm ctl (open, truncate, map) + 2 mq + 3 per port */
+	assert_int_equal(failures, 3 + 2 + 3 * 3);
+}
+
+static char *envp[256];
+static char env_nth[64];
+
+static void make_env(long n)
+{
+	int k = 0;
+
+	for (char **e = environ; *e && k < 250; e++)
+		if (strncmp(*e, "ARFLEX_", 7))
+			envp[k++] = *e;
+	snprintf(env_nth, sizeof(env_nth), "ARFLEX_FAULT_NTH=%ld", n);
+	envp[k++] = env_nth;
+	envp[k] = NULL;
+}
+
+/* The RT process's attach and configure path: with the N-th call failing the probe either
+ * exits with an attach or configure error, or (N past its set-up) comes up and shuts down
+ * normally. Every case leaves nothing behind after the manager's destroy. */
+static void component_attach_every_call_fails(void **state)
+{
+	struct arflex_host_output out;
+	struct arflex_param_slot p;
+	struct arflex_host_opts o;
+	long n;
+	int attach_fail = 0, configure_fail = 0, came_up = 0;
+
+	(void)state;
+	th_rid(rid, sizeof(rid), "fcomp");
+	fill_opts(&o, &p, &out, "probe");
+	/* the probe's output must match its type exactly */
+	out.spec.type.elem_size = 64;
+	for (n = 1; n <= 16; n++) {
+		struct arflex_host h;
+		int r, st;
+
+		assert_int_equal(arflex_host_create(&h, &o), 0);
+		make_env(n);
+		assert_int_equal(arflex_host_spawn(&h, ARFLEX_PROBE_EXE, NULL, envp), 0);
+		r = arflex_host_wait_state(&h, ARFLEX_STATE_READY, 10 * SEC);
+		if (r == -ECHILD) {
+			st = arflex_host_exit_status(&h);
+			assert_true(WIFEXITED(st));
+			if (WEXITSTATUS(st) == ARFLEX_EXIT_ATTACH) {
+				attach_fail++;
+			} else {
+				assert_int_equal(WEXITSTATUS(st), ARFLEX_EXIT_CONFIGURE);
+				assert_int_equal(arflex_ctl_state(h.ctl), ARFLEX_STATE_FAILED);
+				assert_true(h.ctl->exit_status < 0);
+				configure_fail++;
+			}
+		} else {
+			assert_int_equal(r, 0);
+			came_up++;
+			/* the fault may hit a later mailbox call; the manager's way out is
+			 * SHUTDOWN, and SIGTERM if the reply got lost */
+			if (arflex_host_shutdown(&h, 2 * SEC) == 0)
+				assert_int_equal(arflex_host_wait_exit(&h, 10 * SEC), 0);
+		}
+		arflex_host_destroy(&h);
+		assert_true(h.reaped);
+		th_assert_clean(rid);
+	}
+	print_message("component: %d attach failures, %d configure failures, %d came up\n",
+		      attach_fail, configure_fail, came_up);
+	/* ctl: open, fstat, mmap; queues: 2 opens, 2 getattr */
+	assert_int_equal(attach_fail, 7);
+	/* output port: open, fstat, mmap */
+	assert_int_equal(configure_fail, 3);
+	assert_true(came_up >= 1);
+}
+
+static void env_var_enables_injection(void **state)
+{
+	(void)state;
+	/* arflex_sys_fault_set overrides the environment; disabled means inert */
+	arflex_sys_fault_set(0, 0);
+	for (int i = 0; i < 10; i++) {
+		int fd = arflex_sys_open("/dev/null", 0, 0);
+
+		assert_true(fd >= 0);
+		arflex_sys_close(fd);
+	}
+	assert_false(arflex_sys_fault_fired());
+	arflex_sys_fault_set(2, 0);
+	{
+		int a = arflex_sys_open("/dev/null", 0, 0), b = arflex_sys_open("/dev/null", 0, 0);
+
+		assert_true(a >= 0);
+		assert_int_equal(b, -EMFILE);
+		assert_true(arflex_sys_fault_fired());
+		assert_int_equal(arflex_sys_fault_calls(), 2);
+		arflex_sys_close(a);
+	}
+	arflex_sys_fault_set(0, 0);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(env_var_enables_injection),
+		cmocka_unit_test(host_create_every_call_fails),
+		cmocka_unit_test(component_attach_every_call_fails),
+	};
+
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,428 @@
+/* Ports under a writer and readers in separate processes. */
+#include <errno.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+#include "arflex/port.h"
+#include "helper.h"
+
+#define UPDATES 1000000u
+#define READERS 2
+
+struct sample {
+	uint64_t seq;
+	uint64_t data[6];
+	uint64_t check;
+};
+
+static const struct arflex_port_type sample_type = {
+	.name = "test.Sample", .major = 1, .minor = 0, .elem_size = sizeof(struct sample),
+};
+
+static void fill(struct sample *s, uint64_t i)
+{
+	s->seq = i;
+	s->check = i * 0x9e3779b97f4a7c15u;
+	for (int k = 0; k < 6; k++) {
+		s->data[k] = (i + (uint64_t)k) * 0xff51afd7ed558ccdu;
+		s->check ^= s->data[k];
+	}
+}
+
+static bool intact(const struct sample *s)
+{
+	uint64_t c = s->seq * 0x9e3779b97f4a7c15u;
+
+	for (int k = 0; k < 6; k++) {
+		if (s->data[k] != (s->seq + (uint64_t)k) * 0xff51afd7ed558ccdu)
+			return false;
+		c ^= s->data[k];
+	}
+	return c == s->check;
+}
+
+static char rid[64];
+
+static void name_of(char *buf, const char *port)
+{
+	snprintf(buf, ARFLEX_OBJ_NAME_SIZE, "/arflex.%s.w.out.%s", rid, port);
+}
+
+/* Child: state reader. Exit 0 when it saw the final value with no torn or backwards read. */
+static int state_reader(const char *name)
+{
+	struct arflex_port p;
+	struct sample s;
+	uint64_t last = 0, seq, reads = 0;
+
+	if (arflex_port_open(&p, name, false, false, ARFLEX_PORT_STATE, &sample_type))
+		return 10;
+	for (;;) {
+		int r = arflex_state_read(&p, &s, sizeof(s), &seq);
+
+		if (r < 0)
+			return 11;
+		if (r == 0)
+			continue;
+		reads++;
+		if (!intact(&s))
+			return 12; /* torn */
+		if (s.seq + 1 != seq || s.seq < last)
+			return 13; /* out of order / seq mismatch */
+		if (last && s.seq == last)
+			return 14; /* "new" value that is not new */
+		last = s.seq;
+		if (s.seq == UPDATES - 1)
+			break;
+	}
+	arflex_port_close(&p);
+	return reads > 0 ? 0 : 15;
+}
+
+static int state_writer(const char *name)
+{
+	struct arflex_port p;
+	struct sample s;
+
+	if (arflex_port_open(&p, name, true, true, ARFLEX_PORT_STATE, &sample_type))
+		return 20;
+	for (uint64_t i = 0; i < UPDATES; i++) {
+		fill(&s, i);
+		if (arflex_state_write(&p, &s, sizeof(s)))
+			return 21;
+	}
+	arflex_port_close(&p);
+	return 0;
+}
+
+static pid_t child(int (*fn)(const char *), const char *name)
+{
+	pid_t pid = fork();
+
+	if (pid == 0)
+		_exit(fn(name));
+	assert_true(pid > 0);
+	return pid;
+}
+
+static int wait_child(pid_t pid)
+{
+	int st;
+
+	assert_int_equal(waitpid(pid, &st, 0), pid);
+	return WIFEXITED(st) ? WEXITSTATUS(st) : 100 + WTERMSIG(st);
+}
+
+static void state_port_no_torn_no_lost(void **state)
+{
+	struct arflex_port_spec spec = { .method = ARFLEX_PORT_STATE, .type = sample_type };
+	struct arflex_port mgr, dup;
+	char name[ARFLEX_OBJ_NAME_SIZE];
+	pid_t readers[READERS], writer;
+	struct sample last;
+
+	(void)state;
+	th_rid(rid, sizeof(rid), "state");
+	name_of(name, "pose");
+	assert_int_equal(arflex_port_create(&mgr, name, &spec), 0);
+	assert_int_equal(arflex_port_create(&dup, name, &spec), -EEXIST);
+
+	for (int i = 0; i < READERS; i++)
+		readers[i] = child(state_reader, name);
+	writer = child(state_writer, name);
+	assert_int_equal(wait_child(writer), 0);
+	for (int i = 0; i < READERS; i++)
+		assert_int_equal(wait_child(readers[i]), 0);
+	assert_int_equal(mgr.hdr->head, UPDATES);
+	mgr.last_seq = 0;
+	assert_int_equal(arflex_state_read(&mgr, &last, sizeof(last), NULL), 1);
+	assert_int_equal(last.seq, UPDATES - 1);
+	assert_int_equal(arflex_port_destroy(&mgr), 0);
+	th_assert_clean(rid);
+}
+
+static void port_open_checks_type(void **state)
+{
+	struct arflex_port_spec spec = { .method = ARFLEX_PORT_STATE, .type = sample_type };
+	struct arflex_port_type t = sample_type;
+	struct arflex_port mgr, p;
+	char name[ARFLEX_OBJ_NAME_SIZE];
+
+	(void)state;
+	th_rid(rid, sizeof(rid), "type");
+	name_of(name, "x");
+	spec.type.minor = 2;
+	spec.type.elem_size = sizeof(struct sample) + 8;
+	assert_int_equal(arflex_port_create(&mgr, name, &spec), 0);
+	/* consumer of 1.0 with a smaller element: accepted */
+	assert_int_equal(arflex_port_open(&p, name, false, false, ARFLEX_PORT_STATE, &t), 0);
+	arflex_port_close(&p);
+	/* producer must match exactly */
+	assert_int_equal(arflex_port_open(&p, name, true, true, ARFLEX_PORT_STATE, &t),
+			 -EPROTOTYPE);
+	t.minor = 3;
+	assert_int_equal(arflex_port_open(&p, name, false, false, ARFLEX_PORT_STATE, &t),
+			 -EPROTOTYPE);
+	t = sample_type;
+	t.major = 2;
+	assert_int_equal(arflex_port_open(&p, name, false, false, ARFLEX_PORT_STATE, &t),
+			 -EPROTOTYPE);
+	t = sample_type;
+	t.name = "test.Other";
+	assert_int_equal(arflex_port_open(&p, name, false, false, ARFLEX_PORT_STATE, &t),
+			 -EPROTOTYPE);
+	assert_int_equal(arflex_port_open(&p, name, false, false, ARFLEX_PORT_STREAM, NULL),
+			 -EPROTOTYPE);
+	mgr.hdr->magic ^= 1;
+	assert_int_equal(arflex_port_open(&p, name, false, false, ARFLEX_PORT_STATE, NULL),
+			 -EPROTO);
+	assert_int_equal(arflex_port_destroy(&mgr), 0);
+	assert_int_equal(arflex_port_open(&p, name, false, false, ARFLEX_PORT_STATE, NULL),
+			 -ENOENT);
+	th_assert_clean(rid);
+}
+
+static int stream_consumer(const char *name)
+{
+	struct arflex_port p;
+	struct sample s;
+	struct arflex_stream_counts c;
+	uint64_t got = 0, last = 0;
+	bool first = true;
+
+	if (arflex_port_open(&p, name, true, false, ARFLEX_PORT_STREAM, &sample_type))
+		return 30;
+	for (;;) {
+		int r = arflex_stream_pop(&p, &s, sizeof(s));
+
+		if (r < 0)
+			return 31;
+		if (r == 1) {
+			if (!intact(&s))
+				return 32;
+			if (!first && s.seq <= last)
+				return 33; /* duplicate or reordered */
+			first = false;
+			last = s.seq;
+			got++;
+			continue;
+		}
+		arflex_stream_counts(&p, &c);
+		if (c.written == UPDATES && c.tail == c.published)
+			break;
+	}
+	arflex_stream_counts(&p, &c);
+	if (c.delivered != got)
+		return 34;
+	arflex_port_close(&p);
+	return 0;
+}
+
+static int stream_producer(const char *name)
+{
+	struct arflex_port p;
+	struct sample s;
+
+	if (arflex_port_open(&p, name, true, true, ARFLEX_PORT_STREAM, &sample_type))
+		return 40;
+	for (uint64_t i = 0; i < UPDATES; i++) {
+		fill(&s, i);
+		if (arflex_stream_push(&p, &s, sizeof(s)) < 0)
+			return 41;
+	}
+	arflex_port_close(&p);
+	return 0;
+}
+
+static void stream_counts_exact(enum arflex_port_overflow policy, const char *tag)
+{
+	struct arflex_port_spec spec = {
+		.method = ARFLEX_PORT_STREAM, .type = sample_type, .depth = 64, .overflow = policy,
+	};
+	struct arflex_port mgr;
+	struct arflex_stream_counts c;
+	char name[ARFLEX_OBJ_NAME_SIZE];
+	pid_t prod, cons;
+
+	th_rid(rid, sizeof(rid), tag);
+	name_of(name, "events");
+	assert_int_equal(arflex_port_create(&mgr, name, &spec), 0);
+	cons = child(stream_consumer, name);
+	prod = child(stream_producer, name);
+	assert_int_equal(wait_child(prod), 0);
+	assert_int_equal(wait_child(cons), 0);
+	arflex_stream_counts(&mgr, &c);
+	print_message("%s: written %llu delivered %llu dropped %llu lost %llu\n", tag,
+		      (unsigned long long)c.written, (unsigned long long)c.delivered,
+		      (unsigned long long)c.dropped, (unsigned long long)c.lost);
+	assert_int_equal(c.written, UPDATES);
+	assert_int_equal(c.delivered + c.dropped + c.lost, UPDATES);
+	assert_true(c.delivered > 0);
+	if (policy == ARFLEX_OVERFLOW_DROP_NEWEST)
+		assert_int_equal(c.lost, 0);
+	else
+		assert_int_equal(c.dropped, 0);
+	assert_int_equal(arflex_port_destroy(&mgr), 0);
+	th_assert_clean(rid);
+}
+
+static void stream_drop_newest_exact_counts(void **state)
+{
+	(void)state;
+	stream_counts_exact(ARFLEX_OVERFLOW_DROP_NEWEST, "newest");
+}
+
+static void stream_drop_oldest_exact_counts(void **state)
+{
+	(void)state;
+	stream_counts_exact(ARFLEX_OVERFLOW_DROP_OLDEST, "oldest");
+}
+
+static void stream_single_process_semantics(void **state)
+{
+	struct arflex_port_spec spec = {
+		.method = ARFLEX_PORT_STREAM, .type = sample_type, .depth = 4,
+		.overflow = ARFLEX_OVERFLOW_DROP_OLDEST,
+	};
+	struct arflex_port mgr;
+	struct sample s;
+	char name[ARFLEX_OBJ_NAME_SIZE];
+
+	(void)state;
+	th_rid(rid, sizeof(rid), "sp");
+	name_of(name, "q");
+	assert_int_equal(arflex_port_create(&mgr, name, &spec), 0);
+	for (uint64_t i = 0; i < 10; i++) {
+		fill(&s, i);
+		assert_int_equal(arflex_stream_push(&mgr, &s, sizeof(s)), 1);
+	}
+	assert_int_equal(arflex_stream_peek(&mgr, &s, sizeof(s)), 1);
+	assert_int_equal(s.seq, 9);
+	for (uint64_t i = 6; i < 10; i++) {
+		assert_int_equal(arflex_stream_pop(&mgr, &s, sizeof(s)), 1);
+		assert_int_equal(s.seq, i); /* the 4 newest survive, oldest first */
+	}
+	assert_int_equal(arflex_stream_pop(&mgr, &s, sizeof(s)), 0);
+	assert_int_equal(mgr.hdr->lost, 6);
+	assert_int_equal(arflex_port_destroy(&mgr), 0);
+
+	spec.overflow = ARFLEX_OVERFLOW_DROP_NEWEST;
+	assert_int_equal(arflex_port_create(&mgr, name, &spec), 0);
+	for (uint64_t i = 0; i < 10; i++) {
+		fill(&s, i);
+		assert_int_equal(arflex_stream_push(&mgr, &s, sizeof(s)), i < 4 ? 1 : 0);
+	}
+	for (uint64_t i = 0; i < 4; i++) {
+		assert_int_equal(arflex_stream_pop(&mgr, &s, sizeof(s)), 1);
+		assert_int_equal(s.seq, i); /* the 4 oldest kept */
+	}
+	assert_int_equal(mgr.hdr->dropped, 6);
+	assert_int_equal(arflex_port_destroy(&mgr), 0);
+	th_assert_clean(rid);
+}
+
+#define FRAME_BYTES (256u * 1024u)
+#define FRAMES 3000u
+
+static int frame_reader(const char *name)
+{
+	const struct arflex_port_type t = { "test.Frame", 1, 0, FRAME_BYTES };
+	struct arflex_port p;
+	struct arflex_frame_view v;
+	uint64_t valid = 0, last = 0;
+	bool first = true;
+
+	if (arflex_port_open(&p, name, false, false, ARFLEX_PORT_FRAME, &t))
+		return 50;
+	for (;;) {
+		int r = arflex_frame_acquire(&p, &v);
+		const uint32_t *w;
+		bool ok = true;
+
+		if (r < 0)
+			return 51;
+		if (r == 0) {
+			if (__atomic_load_n(&p.hdr->head, __ATOMIC_ACQUIRE) == FRAMES)
+				break;
+			continue;
+		}
+		if (!first && v.index <= last)
+			return 52;
+		first = false;
+		last = v.index;
+		w = v.data;
+		for (uint32_t k = 0; k < v.length / 4; k += 997)
+			if (w[k] != (uint32_t)v.index + k)
+				ok = false;
+		if (arflex_frame_valid(&v)) {
+			if (!ok || v.length != FRAME_BYTES)
+				return 53; /* validated but wrong: a real error */
+			valid++;
+		}
+	}
+	arflex_port_close(&p);
+	return valid > 0 ? 0 : 54;
+}
+
+static int frame_writer(const char *name)
+{
+	const struct arflex_port_type t = { "test.Frame", 1, 0, FRAME_BYTES };
+	struct arflex_port p;
+
+	if (arflex_port_open(&p, name, true, true, ARFLEX_PORT_FRAME, &t))
+		return 60;
+	for (uint32_t i = 0; i < FRAMES; i++) {
+		uint32_t *w = arflex_frame_begin(&p);
+
+		for (uint32_t k = 0; k < FRAME_BYTES / 4; k++)
+			w[k] = i + k;
+		if (arflex_frame_commit(&p, FRAME_BYTES))
+			return 61;
+	}
+	arflex_port_close(&p);
+	return 0;
+}
+
+static void frame_port_zero_copy(void **state)
+{
+	struct arflex_port_spec spec = {
+		.method = ARFLEX_PORT_FRAME, .type = { "test.Frame", 1, 0, FRAME_BYTES }, .depth = 4,
+	};
+	struct arflex_port mgr;
+	char name[ARFLEX_OBJ_NAME_SIZE];
+	pid_t r, w;
+
+	(void)state;
+	th_rid(rid, sizeof(rid), "frame");
+	name_of(name, "image");
+	assert_int_equal(arflex_port_create(&mgr, name, &spec), 0);
+	r = child(frame_reader, name);
+	w = child(frame_writer, name);
+	assert_int_equal(wait_child(w), 0);
+	assert_int_equal(wait_child(r), 0);
+	assert_int_equal(mgr.hdr->head, FRAMES);
+	assert_int_equal(arflex_port_destroy(&mgr), 0);
+	th_assert_clean(rid);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(state_port_no_torn_no_lost),
+		cmocka_unit_test(port_open_checks_type),
+		cmocka_unit_test(stream_single_process_semantics),
+		cmocka_unit_test(stream_drop_newest_exact_counts),
+		cmocka_unit_test(stream_drop_oldest_exact_counts),
+		cmocka_unit_test(frame_port_zero_copy),
+	};
+
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
