@@ -162,4 +162,13 @@ class ContractParserTest {
         assertEquals(2, p.size(), p.toString());
         assertTrue(p.stream().allMatch(x -> x.section().equals("6.2")));
     }
+
+    @Test
+    void predefinedEntitiesAndCharacterReferencesStillWork() throws Exception {
+        String xml = resource("/good/sample-scaler.xml").replace("Multiplies every sample by a gain.",
+                "R&amp;D &lt;scaler&gt; &#x263A; &quot;q&quot; &apos;a&apos;");
+        Contract c = PARSER.parse(xml, "s.xml");
+        assertEquals("R&D <scaler> \u263A \"q\" 'a'", c.description());
+        assertEquals(c, PARSER.parse(ContractWriter.create().write(c), "s.xml"));
+    }
 }
