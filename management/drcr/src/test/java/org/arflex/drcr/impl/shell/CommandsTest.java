@@ -1,0 +1,226 @@
+package org.arflex.drcr.impl.shell;
+
+import static org.junit.jupiter.api.Assertions.assertEquals;
+import static org.junit.jupiter.api.Assertions.assertFalse;
+import static org.junit.jupiter.api.Assertions.assertThrows;
+import static org.junit.jupiter.api.Assertions.assertTrue;
+
+import java.util.ArrayList;
+import java.util.List;
+import java.util.Optional;
+import org.arflex.drcr.ComponentManagement;
+import org.arflex.drcr.DrcrService;
+import org.arflex.drcr.ResourceManager;
+import org.arflex.drcr.UpdateService;
+import org.arflex.drcr.dto.BindingDTO;
+import org.arflex.drcr.dto.CellDTO;
+import org.arflex.drcr.dto.ContractDTO;
+import org.arflex.drcr.dto.InstanceDTO;
+import org.arflex.drcr.dto.ParamDTO;
+import org.arflex.drcr.dto.PortDTO;
+import org.arflex.drcr.dto.ResourcesDTO;
+import org.arflex.drcr.dto.StatsDTO;
+import org.junit.jupiter.api.Test;
+
+/** Shell output over stub services: the commands' text and the one-line JSON of {@code dto}. */
+class CommandsTest {
+
+    private final List<String> calls = new ArrayList<>();
+    private final ResourcesDTO res = new ResourcesDTO();
+    private final CellDTO cell = new CellDTO();
+
+    CommandsTest() {
+        res.cpus = new int[] {0, 1};
+        res.cpuUtilisation = new double[] {0.05, 0.0};
+        res.memoryBytes = 1 << 30;
+        res.networkBps = 1000;
+        InstanceDTO i = new InstanceDTO();
+        i.name = "cons";
+        i.state = "UNSATISFIED";
+        i.targetState = "ACTIVE";
+        i.failureReason = "input x: no provider \"prov\"\n";
+        i.cpu = -1;
+        ParamDTO p = new ParamDTO();
+        p.name = "gain";
+        p.type = "DOUBLE";
+        p.value = "2.0";
+        p.unit = "";
+        p.mutable = true;
+        i.params = new ParamDTO[] {p};
+        i.bindings = new BindingDTO[0];
+        cell.runtimeId = "t";
+        cell.instances = new InstanceDTO[] {i};
+        cell.contracts = new ContractDTO[0];
+        BindingDTO b = new BindingDTO();
+        b.consumer = "cons";
+        b.input = "x";
+        b.provider = "prov";
+        b.output = "y";
+        cell.bindings = new BindingDTO[] {b};
+        cell.resources = res;
+        cell.problems = new String[] {"bad.xml:3:4: [§5] name: missing"};
+    }
+
+    private final DrcrService drcr = new DrcrService() {
+        @Override
+        public CellDTO cell() {
+            return cell;
+        }
+
+        @Override
+        public Optional<InstanceDTO> instance(String name) {
+            return name.equals("cons") ? Optional.of(cell.instances[0]) : Optional.empty();
+        }
+
+        @Override
+        public Optional<ContractDTO> contract(String name) {
+            ContractDTO c = new ContractDTO();
+            c.name = name;
+            c.version = "1.0.0";
+            c.ports = new PortDTO[0];
+            c.taskType = "PERIODIC";
+            c.restart = "PERMANENT";
+            c.safeOutput = "HOLD";
+            return Optional.of(c);
+        }
+
+        @Override
+        public String planInstall(String location) {
+            return "plan install " + location;
+        }
+
+        @Override
+        public String planUninstall(String name) {
+            return "plan uninstall " + name;
+        }
+
+        @Override
+        public String planCapacity(List<Integer> cpus, long memoryBytes, long networkBps) {
+            return "plan cpus " + cpus + " memory " + memoryBytes + " network " + networkBps;
+        }
+    };
+
+    private final ResourceManager rm = new ResourceManager() {
+        @Override
+        public ResourcesDTO resources() {
+            return res;
+        }
+
+        @Override
+        public void setCpus(List<Integer> cpus) {
+            calls.add("cpus " + cpus);
+        }
+
+        @Override
+        public void setMemory(long bytes) {
+            calls.add("memory " + bytes);
+        }
+
+        @Override
+        public void setNetwork(long bps) {
+            calls.add("network " + bps);
+        }
+    };
+
+    private final UpdateService upd = name -> {
+        throw new IllegalStateException(name + ": SHA-256 mismatch");
+    };
+
+    private final ComponentManagement cm = new ComponentManagement() {
+        @Override
+        public String name() {
+            return "cons";
+        }
+
+        @Override
+        public InstanceDTO instance() {
+            return cell.instances[0];
+        }
+
+        @Override
+        public String state() {
+            return "UNSATISFIED";
+        }
+
+        @Override
+        public String get(String param) {
+            return "2.0";
+        }
+
+        @Override
+        public String set(String param, String value) {
+            if (value.equals("99")) {
+                throw new IllegalArgumentException("gain: 99 is out of range [-10.0, 10.0]");
+            }
+            return value;
+        }
+
+        @Override
+        public StatsDTO stats() {
+            return null;
+        }
+
+        @Override
+        public void reset() {
+            calls.add("reset");
+        }
+    };
+
+    private final Commands cmd = new Commands(drcr, rm, upd, n -> n.equals("cons") ? Optional.of(cm) : Optional.empty());
+
+    @Test
+    void listShowsStateReasonAndProblems() {
+        String out = cmd.list();
+        assertTrue(out.startsWith("NAME"), out);
+        assertTrue(out.contains("cons  UNSATISFIED"), out);
+        assertTrue(out.contains("no provider"), out);
+        assertTrue(out.contains("problem: bad.xml:3:4: [§5] name: missing"), out);
+    }
+
+    @Test
+    void getSetAndErrorsAreOneLine() {
+        assertEquals("2.0", cmd.get("cons", "gain"));
+        assertEquals("cons.gain = 3", cmd.set("cons", "gain", "3"));
+        assertEquals("error: gain: 99 is out of range [-10.0, 10.0]", cmd.set("cons", "gain", "99"));
+        assertEquals("error: no component 'nope'", cmd.get("nope", "gain"));
+        assertEquals("error: cons: SHA-256 mismatch", cmd.update("cons"));
+        assertEquals("cons: no RT half running", cmd.stats("cons"));
+    }
+
+    @Test
+    void bindingsAndPlan() {
+        assertEquals("cons.x <- prov.y", cmd.bindings());
+        assertEquals("plan install file:/x.jar", cmd.plan("install", "file:/x.jar"));
+        assertEquals("plan cpus [0] memory 1073741824 network 1000", cmd.plan("cpus", "0"));
+        assertTrue(cmd.plan("bogus").startsWith("usage:"));
+    }
+
+    @Test
+    void resourcesSetOnlyChangesWhatDiffers() {
+        String out = cmd.resources("set", "cpus", "1-1", "memory", "512m");
+        assertEquals(List.of("cpus [1]", "memory " + (512L << 20)), calls, out);
+        assertTrue(cmd.resources().contains("cpus: 0(U=0.050) 1(U=0.000)"), cmd.resources());
+        assertTrue(cmd.resources("set", "disk", "1").startsWith("error: unknown resource 'disk'"));
+    }
+
+    @Test
+    void dtoIsOneLineOfValidJson() {
+        String json = cmd.dto();
+        assertFalse(json.contains("\n"), json);
+        assertTrue(json.startsWith("{\"runtimeId\":\"t\","), json);
+        assertTrue(json.contains("\"failureReason\":\"input x: no provider \\\"prov\\\"\\n\""), json);
+        assertTrue(json.contains("\"cpus\":[0,1]"), json);
+        assertTrue(json.contains("\"stats\":null"), json);
+        assertTrue(json.contains("\"problems\":[\"bad.xml:3:4: [§5] name: missing\"]"), json);
+    }
+
+    @Test
+    void sizesAndCpuListsParseOrNameTheMistake() {
+        assertEquals(List.of(0, 2, 3, 4), Commands.parseCpus("0,2-4"));
+        assertEquals(List.of(), Commands.parseCpus("none"));
+        assertEquals(3L << 30, Commands.parseSize("3g"));
+        assertThrows(IllegalArgumentException.class, () -> Commands.parseSize("-1"));
+        IllegalArgumentException e = assertThrows(IllegalArgumentException.class, () -> Commands.parseCpus("a,b"));
+        assertTrue(e.getMessage().contains("a,b"));
+    }
+}
