@@ -8,10 +8,10 @@ set -euo pipefail
 PACKAGES=(
   openjdk-17-jdk-headless maven          # Java build (Java 17: SPI Fly/Jetty break on 25)
   gcc g++ cmake ninja-build pkg-config   # native build
-  libcmocka-dev                          # C unit tests
+  libcmocka-dev libgtest-dev             # C and C++ unit tests
   libmujoco-dev libqhull-dev             # physics (MuJoCo's CMake config needs qhull)
   libosmesa6-dev                         # headless offscreen rendering
-  libapriltag-dev libeigen3-dev          # fiducials, linear algebra
+  libapriltag-dev libeigen3-dev          # fiducials (the apriltag-utils library is in it), linear algebra
   libopencv-core-dev libopencv-imgproc-dev libopencv-calib3d-dev
   rt-tests stress-ng                     # cyclictest reference and load for benchmarks
   python3                                # benchmark reports
