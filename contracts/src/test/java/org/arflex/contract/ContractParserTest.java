@@ -171,4 +171,24 @@ class ContractParserTest {
         assertEquals("R&D <scaler> \u263A \"q\" 'a'", c.description());
         assertEquals(c, PARSER.parse(ContractWriter.create().write(c), "s.xml"));
     }
+
+    @Test
+    void portsKeepDocumentOrderAcrossInAndOutAndEmptyContainersAreEmpty() throws Exception {
+        String good = resource("/good/sample-scaler.xml");
+        String xml = good.replace("<out name=\"y\"",
+                "<in name=\"z\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\"/>\n<out name=\"y\"")
+                .replace("</ports>", "<in name=\"w\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\"/></ports>");
+        Contract c = PARSER.parse(xml, "o.xml");
+        assertEquals(List.of("x", "z", "y", "w"), c.ports().stream().map(PortSpec::name).toList());
+        assertEquals(List.of("x", "z", "w"), c.inputs().stream().map(PortSpec::name).toList());
+        String empty = good.replaceAll("(?s)<ports>.*</ports>", "<ports/>")
+                .replaceAll("(?s)<properties>.*</properties>", "<properties></properties>")
+                .replaceAll("(?s)<attributes>.*</attributes>", "<attributes>\n  </attributes>")
+                .replace("<description>Multiplies every sample by a gain.</description>", "<description/>");
+        Contract e = PARSER.parse(empty, "e.xml");
+        assertTrue(e.ports().isEmpty());
+        assertTrue(e.properties().isEmpty());
+        assertTrue(e.attributes().isEmpty());
+        assertEquals("", e.description());
+    }
 }
