@@ -1,0 +1,500 @@
+/*
+ * test_samples - CTest rt.sample.*: sample-counter and sample-scaler under the rt-core host
+ * API, wired together as the DRCR would wire them (counter.count -> scaler.x).
+ *
+ *   test_samples <case> <sample-counter exe> <sample-scaler exe>
+ *   cases: counter, scale, set_param, unbind
+ *
+ * Every case creates its objects under its own runtime id, and ends by checking that no
+ * /dev/shm/arflex.<rid>.* or /dev/mqueue/arflex.<rid>.* object and no child process is left.
+ * Waits are on conditions with deadlines; nothing asserts on timing.
+ */
+#define _GNU_SOURCE
+#include <dirent.h>
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "arflex/host.h"
+
+#include "sample_type.h"
+
+#define SEC UINT64_C(1000000000)
+#define MS UINT64_C(1000000)
+#define CALL_TIMEOUT (2 * SEC)
+#define WAIT_TIMEOUT (10 * SEC)
+
+static char rid[ARFLEX_ID_MAX + 1];
+static const char *counter_exe, *scaler_exe;
+static struct arflex_host counter_h, scaler_h;
+static int failures;
+
+#define CHECK(cond, ...)                                                                   \
+	do {                                                                               \
+		if (!(cond)) {                                                             \
+			fprintf(stderr, "FAIL %s:%d: %s: ", __FILE__, __LINE__, #cond);    \
+			fprintf(stderr, __VA_ARGS__);                                      \
+			fputc('\n', stderr);                                               \
+			failures++;                                                        \
+			goto out;                                                          \
+		}                                                                          \
+	} while (0)
+
+static struct arflex_param_slot param_f64(const char *name, double def, double lo, double hi,
+					  bool mutable_)
+{
+	struct arflex_param_slot s;
+
+	memset(&s, 0, sizeof(s));
+	snprintf(s.name, sizeof(s.name), "%s", name);
+	s.type = ARFLEX_PARAM_DOUBLE;
+	s.flags = mutable_ ? ARFLEX_PARAM_MUTABLE : 0;
+	s.min_bits = arflex_f64_bits(lo);
+	s.max_bits = arflex_f64_bits(hi);
+	s.default_bits = arflex_f64_bits(def);
+	return s;
+}
+
+static struct arflex_ctl_config test_config(uint32_t safe_mode)
+{
+	struct arflex_ctl_config c;
+
+	memset(&c, 0, sizeof(c));
+	c.period_ns = 1 * MS;
+	c.priority = 0; /* tests share the machine: SCHED_OTHER */
+	c.safe_mode = safe_mode;
+	c.cfg_flags = ARFLEX_CFG_NO_MLOCK | ARFLEX_CFG_NO_DMA_LATENCY;
+	return c;
+}
+
+static int make_counter(void)
+{
+	struct arflex_param_slot p[2] = {
+		param_f64("amplitude", 2.0, -100.0, 100.0, true),
+		param_f64("frequency", 5.0, 0.0, 500.0, true),
+	};
+	struct arflex_host_output out = {
+		.port = "count",
+		.spec = { .method = ARFLEX_PORT_STATE, .type = sample_port_type, .depth = 1 },
+	};
+	struct arflex_host_opts o = {
+		.runtime = rid, .instance = "counter", .config = test_config(ARFLEX_SAFE_HOLD),
+		.params = p, .nparams = 2, .outputs = &out, .noutputs = 1,
+	};
+	int ret = arflex_host_create(&counter_h, &o);
+
+	if (ret < 0)
+		return ret;
+	return arflex_host_spawn(&counter_h, counter_exe, NULL, NULL);
+}
+
+static int make_scaler(double gain)
+{
+	struct arflex_param_slot p[1] = { param_f64("gain", gain, -10.0, 10.0, true) };
+	struct arflex_host_output out = {
+		.port = "y",
+		.spec = { .method = ARFLEX_PORT_STATE, .type = sample_port_type, .depth = 1 },
+	};
+	struct arflex_host_opts o = {
+		.runtime = rid, .instance = "scaler", .config = test_config(ARFLEX_SAFE_ZERO),
+		.params = p, .nparams = 1, .outputs = &out, .noutputs = 1,
+	};
+	int ret = arflex_host_create(&scaler_h, &o);
+
+	if (ret < 0)
+		return ret;
+	return arflex_host_spawn(&scaler_h, scaler_exe, NULL, NULL);
+}
+
+/* A reader of one output port of a host, with its own handle (own last_seq). */
+struct reader {
+	struct arflex_port port;
+	struct sample_value v;
+	uint64_t n; /* new values seen */
+};
+
+static int reader_open(struct reader *r, struct arflex_host *h, const char *port)
+{
+	const char *name = arflex_host_output_name(h, port);
+
+	memset(r, 0, sizeof(*r));
+	if (!name)
+		return -ENOENT;
+	return arflex_port_open(&r->port, name, false, false, ARFLEX_PORT_STATE,
+				&sample_port_type);
+}
+
+/* 1 if a new value was read into r->v. */
+static int reader_poll(struct reader *r)
+{
+	int ret = arflex_state_read(&r->port, &r->v, sizeof(r->v), NULL);
+
+	if (ret == 1)
+		r->n++;
+	return ret;
+}
+
+/* Ring of recently seen counter samples, to look an input value up by its seq. */
+#define HIST 8192
+static struct sample_value xhist[HIST];
+
+static void xhist_put(const struct sample_value *s)
+{
+	xhist[s->seq % HIST] = *s;
+}
+
+static const struct sample_value *xhist_get(uint64_t seq)
+{
+	const struct sample_value *s = &xhist[seq % HIST];
+
+	return s->seq == seq ? s : NULL;
+}
+
+static bool leaked(void)
+{
+	static const char *const dirs[] = { "/dev/shm", "/dev/mqueue" };
+	char prefix[64];
+	bool any = false;
+
+	snprintf(prefix, sizeof(prefix), "arflex.%s.", rid);
+	for (unsigned i = 0; i < 2; i++) {
+		DIR *d = opendir(dirs[i]);
+		struct dirent *e;
+
+		if (!d)
+			continue;
+		while ((e = readdir(d))) {
+			if (strncmp(e->d_name, prefix, strlen(prefix)) == 0) {
+				fprintf(stderr, "leak: %s/%s\n", dirs[i], e->d_name);
+				any = true;
+			}
+		}
+		closedir(d);
+	}
+	if (waitpid(-1, NULL, WNOHANG) != -1 || errno != ECHILD) {
+		fprintf(stderr, "leak: a child process is left\n");
+		any = true;
+	}
+	return any;
+}
+
+static int start_pair(bool bind)
+{
+	int ret;
+
+	ret = arflex_host_wait_state(&counter_h, ARFLEX_STATE_READY, WAIT_TIMEOUT);
+	if (ret < 0)
+		return fprintf(stderr, "counter not READY: %d\n", ret), ret;
+	ret = arflex_host_wait_state(&scaler_h, ARFLEX_STATE_READY, WAIT_TIMEOUT);
+	if (ret < 0)
+		return fprintf(stderr, "scaler not READY: %d\n", ret), ret;
+	if (bind) {
+		ret = arflex_host_bind(&scaler_h, "x", arflex_host_output_name(&counter_h, "count"),
+				       CALL_TIMEOUT);
+		if (ret < 0)
+			return fprintf(stderr, "BIND scaler.x: %d\n", ret), ret;
+	}
+	ret = arflex_host_start(&counter_h, CALL_TIMEOUT);
+	if (ret < 0)
+		return fprintf(stderr, "START counter: %d\n", ret), ret;
+	ret = arflex_host_start(&scaler_h, CALL_TIMEOUT);
+	if (ret < 0)
+		return fprintf(stderr, "START scaler: %d\n", ret), ret;
+	return 0;
+}
+
+static void dump(void)
+{
+	fprintf(stderr, "counter state %u, scaler state %u\n",
+		counter_h.ctl ? arflex_ctl_state(counter_h.ctl) : 99u,
+		scaler_h.ctl ? arflex_ctl_state(scaler_h.ctl) : 99u);
+}
+
+/* rt.sample.counter: seq grows, t_ns grows, |value| <= amplitude; an amplitude change shows. */
+static int case_counter(void)
+{
+	struct reader x;
+	uint64_t deadline, last_seq = 0, applied = 0;
+	int64_t last_t = 0;
+	double maxabs = 0.0;
+	bool open = false;
+
+	CHECK(make_counter() == 0, "counter create/spawn");
+	CHECK(arflex_host_wait_state(&counter_h, ARFLEX_STATE_READY, WAIT_TIMEOUT) == 0, "READY");
+	CHECK(reader_open(&x, &counter_h, "count") == 0, "open count");
+	open = true;
+	CHECK(arflex_host_start(&counter_h, CALL_TIMEOUT) == 0, "START");
+	deadline = arflex_sys_now_ns() + WAIT_TIMEOUT;
+	while (x.n < 300 && arflex_sys_now_ns() < deadline) {
+		if (reader_poll(&x) != 1)
+			continue;
+		CHECK(x.v.seq > last_seq, "seq %llu after %llu", (unsigned long long)x.v.seq,
+		      (unsigned long long)last_seq);
+		CHECK(x.v.t_ns > last_t, "t_ns not increasing");
+		CHECK(fabs(x.v.value) <= 2.0, "value %g beyond amplitude 2", x.v.value);
+		if (fabs(x.v.value) > maxabs)
+			maxabs = fabs(x.v.value);
+		last_seq = x.v.seq;
+		last_t = x.v.t_ns;
+	}
+	CHECK(x.n >= 300, "only %llu values seen", (unsigned long long)x.n);
+	CHECK(maxabs > 0.5, "the sine does not move (max |value| %g)", maxabs);
+	CHECK(arflex_host_set_param(&counter_h, "amplitude", arflex_f64_bits(0.25), &applied,
+				    CALL_TIMEOUT) == 0, "SET_PARAM amplitude");
+	CHECK(arflex_bits_f64(applied) == 0.25, "applied %g", arflex_bits_f64(applied));
+	for (uint64_t n0 = x.n; x.n < n0 + 300 && arflex_sys_now_ns() < deadline;) {
+		if (reader_poll(&x) == 1)
+			CHECK(fabs(x.v.value) <= 0.25, "value %g beyond new amplitude", x.v.value);
+	}
+	CHECK(arflex_host_shutdown(&counter_h, CALL_TIMEOUT) == 0, "SHUTDOWN");
+	CHECK(arflex_host_wait_exit(&counter_h, WAIT_TIMEOUT) == 0, "exit");
+	CHECK(WIFEXITED(arflex_host_exit_status(&counter_h)) &&
+	      WEXITSTATUS(arflex_host_exit_status(&counter_h)) == 0, "exit status");
+out:
+	if (failures)
+		dump();
+	if (open)
+		arflex_port_close(&x.port);
+	return 0;
+}
+
+/*
+ * Polls x and y for @count matched y values (a y whose seq is in the x history) and checks
+ * each y.value == gain * x.value exactly, where the gain is @g_old before the switch and
+ * @g_new after. @min_new_seq: every y with seq > it must use g_new. Returns the number of
+ * matches with each gain through *n_old, *n_new; -1 on a check failure.
+ */
+static int match_outputs(struct reader *x, struct reader *y, unsigned count, double g_old,
+			 double g_new, uint64_t min_new_seq, unsigned *n_old, unsigned *n_new)
+{
+	uint64_t deadline = arflex_sys_now_ns() + WAIT_TIMEOUT;
+	unsigned matched = 0;
+	bool seen_new = false;
+
+	*n_old = *n_new = 0;
+	while (matched < count && arflex_sys_now_ns() < deadline) {
+		const struct sample_value *in;
+		bool is_new, is_old;
+
+		if (reader_poll(x) == 1)
+			xhist_put(&x->v);
+		if (reader_poll(y) != 1)
+			continue;
+		in = xhist_get(y->v.seq);
+		if (!in)
+			continue;
+		matched++;
+		if (y->v.t_ns != in->t_ns) {
+			fprintf(stderr, "FAIL: y seq %llu t_ns %lld, x t_ns %lld\n",
+				(unsigned long long)y->v.seq, (long long)y->v.t_ns,
+				(long long)in->t_ns);
+			return -1;
+		}
+		is_new = y->v.value == g_new * in->value;
+		is_old = y->v.value == g_old * in->value;
+		if (is_new && is_old) {
+			(*n_new)++; /* x == 0 or equal gains: either gain gives this */
+		} else if (is_new) {
+			seen_new = true;
+			(*n_new)++;
+		} else if (is_old && (seen_new || y->v.seq > min_new_seq)) {
+			fprintf(stderr, "FAIL: y seq %llu still uses the old gain %g (%s)\n",
+				(unsigned long long)y->v.seq, g_old,
+				seen_new ? "after a new-gain output" : "input newer than the reply");
+			return -1;
+		} else if (is_old) {
+			(*n_old)++;
+		} else {
+			fprintf(stderr, "FAIL: y seq %llu = %.17g, x = %.17g, gain %g/%g\n",
+				(unsigned long long)y->v.seq, y->v.value, in->value, g_old, g_new);
+			return -1;
+		}
+	}
+	if (matched < count) {
+		fprintf(stderr, "FAIL: only %u of %u outputs matched an input\n", matched, count);
+		return -1;
+	}
+	return 0;
+}
+
+/* rt.sample.scale: y == gain * x for matching seq, y carries x's seq and t_ns. */
+static int case_scale(void)
+{
+	struct reader x, y;
+	unsigned n_old, n_new;
+	int nopen = 0;
+
+	CHECK(make_counter() == 0, "counter create/spawn");
+	CHECK(make_scaler(1.5) == 0, "scaler create/spawn");
+	CHECK(reader_open(&x, &counter_h, "count") == 0, "open count");
+	nopen++;
+	CHECK(reader_open(&y, &scaler_h, "y") == 0, "open y");
+	nopen++;
+	CHECK(start_pair(true) == 0, "start");
+	CHECK(match_outputs(&x, &y, 200, 1.5, 1.5, UINT64_MAX, &n_old, &n_new) == 0, "match");
+	CHECK(n_new == 200, "%u matches with gain 1.5", n_new);
+	CHECK(arflex_host_shutdown(&scaler_h, CALL_TIMEOUT) == 0, "SHUTDOWN scaler");
+	CHECK(arflex_host_shutdown(&counter_h, CALL_TIMEOUT) == 0, "SHUTDOWN counter");
+out:
+	if (failures)
+		dump();
+	if (nopen > 1)
+		arflex_port_close(&y.port);
+	if (nopen > 0)
+		arflex_port_close(&x.port);
+	return 0;
+}
+
+/* rt.sample.set_param: a gain change while running is applied at a cycle boundary: read back
+ * through SET_PARAM's reply and GET_PARAM, every output after the reply uses the new gain,
+ * and no output after the first new-gain one uses the old gain. */
+static int case_set_param(void)
+{
+	struct reader x, y;
+	unsigned n_old, n_new;
+	uint64_t applied = 0, got = 0, x_seq_after;
+	int nopen = 0;
+
+	CHECK(make_counter() == 0, "counter create/spawn");
+	CHECK(make_scaler(2.0) == 0, "scaler create/spawn");
+	CHECK(reader_open(&x, &counter_h, "count") == 0, "open count");
+	nopen++;
+	CHECK(reader_open(&y, &scaler_h, "y") == 0, "open y");
+	nopen++;
+	CHECK(start_pair(true) == 0, "start");
+	CHECK(match_outputs(&x, &y, 50, 2.0, 2.0, UINT64_MAX, &n_old, &n_new) == 0, "before");
+	CHECK(arflex_host_set_param(&scaler_h, "gain", arflex_f64_bits(-3.25), &applied,
+				    CALL_TIMEOUT) == 0, "SET_PARAM gain");
+	CHECK(arflex_bits_f64(applied) == -3.25, "applied %g", arflex_bits_f64(applied));
+	/* Every x written from now on can only be scaled with the new gain. */
+	x_seq_after = 0;
+	{
+		uint64_t dl = arflex_sys_now_ns() + WAIT_TIMEOUT;
+
+		while (x_seq_after == 0 && arflex_sys_now_ns() < dl)
+			if (reader_poll(&x) == 1) {
+				xhist_put(&x.v);
+				x_seq_after = x.v.seq;
+			}
+	}
+	CHECK(x_seq_after > 0, "no counter value after SET_PARAM");
+	CHECK(match_outputs(&x, &y, 100, 2.0, -3.25, x_seq_after, &n_old, &n_new) == 0, "after");
+	CHECK(n_new >= 90, "only %u of 100 outputs with the new gain", n_new);
+	CHECK(arflex_host_get_param(&scaler_h, "gain", &got, CALL_TIMEOUT) == 0, "GET_PARAM");
+	CHECK(arflex_bits_f64(got) == -3.25, "GET_PARAM gain %g", arflex_bits_f64(got));
+	/* Out of range is refused and changes nothing. */
+	CHECK(arflex_host_set_param(&scaler_h, "gain", arflex_f64_bits(50.0), NULL,
+				    CALL_TIMEOUT) == -ERANGE, "gain 50 accepted");
+	CHECK(arflex_host_get_param(&scaler_h, "gain", &got, CALL_TIMEOUT) == 0, "GET_PARAM");
+	CHECK(arflex_bits_f64(got) == -3.25, "gain %g after a refused change",
+	      arflex_bits_f64(got));
+	CHECK(arflex_host_shutdown(&scaler_h, CALL_TIMEOUT) == 0, "SHUTDOWN scaler");
+	CHECK(arflex_host_shutdown(&counter_h, CALL_TIMEOUT) == 0, "SHUTDOWN counter");
+out:
+	if (failures)
+		dump();
+	if (nopen > 1)
+		arflex_port_close(&y.port);
+	if (nopen > 0)
+		arflex_port_close(&x.port);
+	return 0;
+}
+
+/* rt.sample.unbind: after UNBIND of scaler.x, y gets one zero sample (safe mode "zero") and
+ * then stops changing while the counter goes on; a new BIND resumes scaling. */
+static int case_unbind(void)
+{
+	struct reader x, y;
+	unsigned n_old, n_new;
+	uint64_t deadline, x_seen;
+	int nopen = 0;
+
+	CHECK(make_counter() == 0, "counter create/spawn");
+	CHECK(make_scaler(0.5) == 0, "scaler create/spawn");
+	CHECK(reader_open(&x, &counter_h, "count") == 0, "open count");
+	nopen++;
+	CHECK(reader_open(&y, &scaler_h, "y") == 0, "open y");
+	nopen++;
+	CHECK(start_pair(true) == 0, "start");
+	CHECK(match_outputs(&x, &y, 50, 0.5, 0.5, UINT64_MAX, &n_old, &n_new) == 0, "bound");
+	CHECK(arflex_host_unbind(&scaler_h, "x", CALL_TIMEOUT) == 0, "UNBIND");
+	CHECK(arflex_host_unbind(&scaler_h, "x", CALL_TIMEOUT) == -ENOTCONN,
+	      "second UNBIND not -ENOTCONN");
+	/* Drain until the zero sample shows up. */
+	deadline = arflex_sys_now_ns() + WAIT_TIMEOUT;
+	while (!(y.v.value == 0.0 && y.n > 0) && arflex_sys_now_ns() < deadline)
+		reader_poll(&y);
+	CHECK(y.v.value == 0.0, "no zero output after UNBIND (last %g)", y.v.value);
+	/* The counter goes on for 100 more samples; y must not change any more. */
+	x_seen = 0;
+	deadline = arflex_sys_now_ns() + WAIT_TIMEOUT;
+	while (x_seen < 100 && arflex_sys_now_ns() < deadline) {
+		if (reader_poll(&x) == 1)
+			x_seen++;
+		CHECK(reader_poll(&y) == 0, "y changed after UNBIND: seq %llu value %g",
+		      (unsigned long long)y.v.seq, y.v.value);
+	}
+	CHECK(x_seen == 100, "counter stalled (%llu)", (unsigned long long)x_seen);
+	/* Bind again: scaling resumes. */
+	CHECK(arflex_host_bind(&scaler_h, "x", arflex_host_output_name(&counter_h, "count"),
+			       CALL_TIMEOUT) == 0, "re-BIND");
+	CHECK(match_outputs(&x, &y, 50, 0.5, 0.5, UINT64_MAX, &n_old, &n_new) == 0, "rebound");
+	CHECK(arflex_host_shutdown(&scaler_h, CALL_TIMEOUT) == 0, "SHUTDOWN scaler");
+	CHECK(arflex_host_shutdown(&counter_h, CALL_TIMEOUT) == 0, "SHUTDOWN counter");
+out:
+	if (failures)
+		dump();
+	if (nopen > 1)
+		arflex_port_close(&y.port);
+	if (nopen > 0)
+		arflex_port_close(&x.port);
+	return 0;
+}
+
+int main(int argc, char **argv)
+{
+	static const struct {
+		const char *name;
+		int (*fn)(void);
+	} cases[] = {
+		{ "counter", case_counter },
+		{ "scale", case_scale },
+		{ "set_param", case_set_param },
+		{ "unbind", case_unbind },
+	};
+	int (*fn)(void) = NULL;
+
+	if (argc != 4) {
+		fprintf(stderr, "usage: %s counter|scale|set_param|unbind <sample-counter> "
+			"<sample-scaler>\n", argv[0]);
+		return 2;
+	}
+	for (unsigned i = 0; i < sizeof(cases) / sizeof(cases[0]); i++)
+		if (strcmp(argv[1], cases[i].name) == 0)
+			fn = cases[i].fn;
+	if (!fn) {
+		fprintf(stderr, "test_samples: unknown case '%s'\n", argv[1]);
+		return 2;
+	}
+	counter_exe = argv[2];
+	scaler_exe = argv[3];
+	snprintf(rid, sizeof(rid), "t-sample-%ld", (long)getpid());
+	fn();
+	arflex_host_destroy(&scaler_h);
+	arflex_host_destroy(&counter_h);
+	if (leaked()) {
+		fprintf(stderr, "FAIL: objects or children leaked\n");
+		failures++;
+	}
+	if (failures) {
+		fprintf(stderr, "rt.sample.%s: %d failure(s)\n", argv[1], failures);
+		return 1;
+	}
+	printf("rt.sample.%s: ok\n", argv[1]);
+	return 0;
+}
