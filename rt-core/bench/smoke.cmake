@@ -1,0 +1,16 @@
+# Runs arflex-bench-ipc briefly and checks it wrote JSON and left no arflex.bench-* object.
+execute_process(COMMAND ${EXE} --samples 2000 --mq-samples 500 --warmup 100 --json ${JSON}
+                RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "arflex-bench-ipc exited with ${rc}")
+endif()
+file(READ ${JSON} json)
+string(JSON ratio GET "${json}" ratios state_port_over_raw_shm_p50 value)
+string(JSON mb GET "${json}" cases mailbox samples)
+if(NOT mb EQUAL 500)
+  message(FATAL_ERROR "mailbox samples ${mb}, expected 500")
+endif()
+file(GLOB left /dev/shm/arflex.bench-* /dev/mqueue/arflex.bench-*)
+if(left)
+  message(FATAL_ERROR "left behind: ${left}")
+endif()
