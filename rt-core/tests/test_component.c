@@ -245,7 +245,7 @@ static void safe_when_heartbeat_stops(void **state)
 
 	(void)state;
 	setup_ids("safe");
-	assert_int_equal(probe_host(&h, "probe", 30000000, 0, true), 0);
+	assert_int_equal(probe_host(&h, "probe", 100000000, 0, true), 0);
 	spawn_ready(&h);
 	arflex_host_heartbeat(&h);
 	assert_int_equal(arflex_host_start(&h, T_CALL), 0);
@@ -274,7 +274,7 @@ static void moves_hardware_needs_operator_reset(void **state)
 
 	(void)state;
 	setup_ids("reset");
-	assert_int_equal(probe_host(&h, "arm", 30000000, ARFLEX_CFG_MOVES_HARDWARE, true), 0);
+	assert_int_equal(probe_host(&h, "arm", 100000000, ARFLEX_CFG_MOVES_HARDWARE, true), 0);
 	spawn_ready(&h);
 	arflex_host_heartbeat(&h);
 	assert_int_equal(arflex_host_start(&h, T_CALL), 0);
