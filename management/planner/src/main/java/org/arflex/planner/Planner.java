@@ -357,7 +357,11 @@ public final class Planner {
                 } else if (change.unblocks().contains(n)) {
                     why = "unblocked";
                 } else {
-                    why = "now satisfied and admitted";
+                    List<String> ins = new ArrayList<>();
+                    for (Wire w : newEff.get(n)) {
+                        ins.add(w.inPort() + " <- " + w.source());
+                    }
+                    why = ins.isEmpty() ? "now admitted" : "now satisfied (" + String.join(", ", ins) + ")";
                 }
                 actions.add(new Plan.Action(Plan.Op.START, n, why + "; " + admitted));
                 starting.add(n);
