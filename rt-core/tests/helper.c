@@ -64,7 +64,7 @@ void th_track(const char *rid, const char *inst)
 
 static int probe_tracked(const char *rid, bool remove)
 {
-	char prefix[80], name[128];
+	char prefix[80], name[200];
 	int n = 0;
 
 	snprintf(prefix, sizeof(prefix), "/arflex.%s.", rid);
@@ -74,7 +74,7 @@ static int probe_tracked(const char *rid, bool remove)
 		for (int k = 0; k < 2; k++) {
 			mqd_t q;
 
-			snprintf(name, sizeof(name), "%s%s", tracked[i], k ? "rsp" : "cmd");
+			snprintf(name, sizeof(name), "%.100s%s", tracked[i], k ? "rsp" : "cmd");
 			q = mq_open(name, O_RDONLY);
 			if (q == (mqd_t)-1)
 				continue;

@@ -232,11 +232,12 @@ static inline struct arflex_slot_hdr *slot(const struct arflex_port *p, uint64_t
 static void slot_write(struct arflex_port *p, uint64_t idx, const void *val, size_t len)
 {
 	struct arflex_slot_hdr *s = slot(p, idx);
+	uint64_t stamp = arflex_sys_now_ns(); /* outside the write window: readers retry less */
 
 	STORER(&s->seq, 2 * idx + 1);
 	__atomic_thread_fence(__ATOMIC_RELEASE);
 	memcpy(s + 1, val, len);
-	STORER(&s->stamp_ns, arflex_sys_now_ns());
+	STORER(&s->stamp_ns, stamp);
 	STORER(&s->length, (uint32_t)len);
 	STORE(&s->seq, 2 * idx + 2);
 }
