@@ -81,7 +81,7 @@ static int start(struct arflex_component *c, void *user)
 	(void)user;
 	note("start");
 	pr.logged_update = false;
-	return 0;
+	return getenv("ARFLEX_PROBE_FAIL_START") ? -ENOTSUP : 0;
 }
 
 static int update(struct arflex_component *c, void *user, uint64_t release_ns)

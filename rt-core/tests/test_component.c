@@ -331,6 +331,27 @@ static void failing_configure_leaves_nothing(void **state)
 	th_assert_clean(rid);
 }
 
+static void failing_start_is_refused(void **state)
+{
+	struct arflex_host h;
+	char log[256];
+
+	(void)state;
+	setup_ids("startfail");
+	make_env("ARFLEX_PROBE_FAIL_START=1");
+	assert_int_equal(probe_host(&h, "probe", 0, 0, true), 0);
+	spawn_ready(&h);
+	assert_int_equal(arflex_host_start(&h, T_CALL), -ENOTSUP);
+	assert_int_equal(arflex_ctl_state(h.ctl), ARFLEX_STATE_READY);
+	assert_int_equal(arflex_host_start(&h, T_CALL), -ENOTSUP);
+	shutdown_ok(&h);
+	arflex_host_destroy(&h);
+	assert_true(th_read_file(logpath, log, sizeof(log)) > 0);
+	assert_string_equal(log, "configure\nstart\nstart\ncleanup\n");
+	unlink(logpath);
+	th_assert_clean(rid);
+}
+
 static void bind_and_unbind_while_running(void **state)
 {
 	struct arflex_port feed;
@@ -418,6 +439,42 @@ static void killed_mid_cycle_leaves_nothing(void **state)
 	th_assert_clean(rid);
 }
 
+static void restart_reuses_objects_and_waits_for_reset(void **state)
+{
+	struct arflex_host h;
+	struct probe_out o;
+	uint64_t v, head;
+
+	(void)state;
+	setup_ids("restart");
+	assert_int_equal(probe_host(&h, "arm", 0, ARFLEX_CFG_MOVES_HARDWARE, true), 0);
+	spawn_ready(&h);
+	assert_int_equal(arflex_host_start(&h, T_CALL), 0);
+	assert_int_equal(arflex_host_set_param(&h, "gain", 9, NULL, T_CALL), 0);
+	assert_true(wait_out(&h, gain_is, 9, false));
+	assert_int_equal(arflex_host_kill(&h, SIGKILL), 0);
+	assert_int_equal(arflex_host_wait_exit(&h, 10 * SEC), 0);
+	head = arflex_host_output(&h, "out")->hdr->head;
+
+	/* the supervisor restarts it on the same objects; motion needs the operator */
+	__atomic_or_fetch(&h.ctl->flags, ARFLEX_FLAG_RESET_REQUIRED, __ATOMIC_RELEASE);
+	spawn_ready(&h);
+	assert_int_equal(arflex_ctl_flags(h.ctl), ARFLEX_FLAG_RESET_REQUIRED);
+	assert_int_equal(arflex_host_get_param(&h, "gain", &v, T_CALL), 0);
+	assert_int_equal(v, 9); /* the request survives the restart */
+	assert_int_equal(arflex_host_start(&h, T_CALL), 0);
+	assert_true(wait_out(&h, safe_above, 3, true));
+	assert_true(arflex_ctl_flags(h.ctl) & ARFLEX_FLAG_SAFE_ACTIVE);
+	assert_int_equal(arflex_host_reset(&h, T_CALL), 0);
+	assert_true(read_out(&h, &o));
+	assert_true(wait_out(&h, updates_above, o.updates + 5, true));
+	assert_true(arflex_host_output(&h, "out")->hdr->head > head); /* one sequence */
+	shutdown_ok(&h);
+	arflex_host_destroy(&h);
+	unlink(logpath);
+	th_assert_clean(rid);
+}
+
 static void bad_command_line(void **state)
 {
 	struct arflex_host h;
@@ -443,9 +500,11 @@ int main(void)
 		cmocka_unit_test(safe_when_heartbeat_stops),
 		cmocka_unit_test(moves_hardware_needs_operator_reset),
 		cmocka_unit_test(failing_configure_leaves_nothing),
+		cmocka_unit_test(failing_start_is_refused),
 		cmocka_unit_test(bind_and_unbind_while_running),
 		cmocka_unit_test(sigterm_stops_cleanly),
 		cmocka_unit_test(killed_mid_cycle_leaves_nothing),
+		cmocka_unit_test(restart_reuses_objects_and_waits_for_reset),
 		cmocka_unit_test(bad_command_line),
 	};
 

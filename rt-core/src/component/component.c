@@ -793,6 +793,10 @@ int arflex_component_main(int argc, char **argv, const struct arflex_component_o
 	}
 	STORE(&c->ctl->pid, (int32_t)getpid());
 	STORE(&c->ctl->exit_status, 0);
+	/* a restart reuses the block: keep only the manager's reset-required bit */
+	__atomic_and_fetch(&c->ctl->flags, (uint32_t)ARFLEX_FLAG_RESET_REQUIRED, __ATOMIC_ACQ_REL);
+	for (unsigned k = 0; k < ARFLEX_WARN_KINDS; k++)
+		STORE(&c->ctl->warnings[k], 0);
 	STORE(&c->ctl->state, ARFLEX_STATE_CONFIGURING);
 	init_params(c->ctl);
 	r = arflex_mailbox_attach(&c->mb, c->rid, c->inst);
