@@ -12,6 +12,8 @@
 #define _GNU_SOURCE
 #include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
+#include <mqueue.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -175,6 +177,24 @@ static bool leaked(void)
 			}
 		}
 		closedir(d);
+	}
+	/* /dev/mqueue may not be mounted: check the queues by name as well. */
+	for (unsigned i = 0; i < 2; i++) {
+		static const char *const insts[] = { "counter", "scaler" };
+		static const char *const chans[] = { "cmd", "rsp" };
+
+		for (unsigned j = 0; j < 2; j++) {
+			char name[ARFLEX_OBJ_NAME_SIZE];
+			mqd_t q;
+
+			arflex_ctl_obj_name(name, sizeof(name), rid, insts[i], chans[j]);
+			q = mq_open(name, O_RDONLY);
+			if (q != (mqd_t)-1) {
+				fprintf(stderr, "leak: queue %s\n", name);
+				mq_close(q);
+				any = true;
+			}
+		}
 	}
 	if (waitpid(-1, NULL, WNOHANG) != -1 || errno != ECHILD) {
 		fprintf(stderr, "leak: a child process is left\n");

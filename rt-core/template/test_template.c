@@ -1,0 +1,265 @@
+/*
+ * test_template - CTest rt.template.*: the ported PI loop (ported/pi_velocity.c) run as a
+ * component under the rt-core host API.
+ *
+ *   test_template ported <arflex-pi-velocity exe>
+ *     create control block, queues and ports; spawn; START; wait (condition with deadline)
+ *     until N cycles and check the plant converged to the setpoint; change the setpoint with
+ *     SET_PARAM and check it converges again; SHUTDOWN; check the exit status and that no
+ *     shared object, queue or child process is left.
+ *   test_template template <arflex-template exe>
+ *     the skeleton (template.c): bind its input `in` to a provider segment made by the test,
+ *     write values there, check out = gain * in with the input's seq; SHUTDOWN; nothing left.
+ */
+#define _GNU_SOURCE
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <mqueue.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "arflex/host.h"
+
+#define SEC UINT64_C(1000000000)
+#define MS UINT64_C(1000000)
+#define CALL_TIMEOUT (2 * SEC)
+#define WAIT_TIMEOUT (15 * SEC)
+
+struct sample {
+	uint64_t seq;
+	int64_t t_ns;
+	double value;
+};
+static const struct arflex_port_type sample_type = { "arflex.Sample", 1, 0, 24 };
+
+static char rid[ARFLEX_ID_MAX + 1];
+static struct arflex_host h;
+static struct arflex_port provider; /* template case: the input's provider segment */
+static bool provider_ok;
+static int failures;
+
+#define CHECK(cond, ...)                                                                   \
+	do {                                                                               \
+		if (!(cond)) {                                                             \
+			fprintf(stderr, "FAIL %s:%d: %s: ", __FILE__, __LINE__, #cond);    \
+			fprintf(stderr, __VA_ARGS__);                                      \
+			fputc('\n', stderr);                                               \
+			failures++;                                                        \
+			goto out;                                                          \
+		}                                                                          \
+	} while (0)
+
+static struct arflex_param_slot param_f64(const char *name, double def, double lo, double hi)
+{
+	struct arflex_param_slot s;
+
+	memset(&s, 0, sizeof(s));
+	snprintf(s.name, sizeof(s.name), "%s", name);
+	s.type = ARFLEX_PARAM_DOUBLE;
+	s.flags = ARFLEX_PARAM_MUTABLE;
+	s.min_bits = arflex_f64_bits(lo);
+	s.max_bits = arflex_f64_bits(hi);
+	s.default_bits = arflex_f64_bits(def);
+	return s;
+}
+
+static struct arflex_ctl_config config(void)
+{
+	struct arflex_ctl_config c;
+
+	memset(&c, 0, sizeof(c));
+	c.period_ns = 1 * MS;
+	c.safe_mode = ARFLEX_SAFE_ZERO;
+	c.cfg_flags = ARFLEX_CFG_NO_MLOCK | ARFLEX_CFG_NO_DMA_LATENCY;
+	return c;
+}
+
+/* Waits until the port's value has seq >= @min_seq; returns it in *@v. */
+static int wait_seq(struct arflex_port *p, uint64_t min_seq, struct sample *v)
+{
+	uint64_t deadline = arflex_sys_now_ns() + WAIT_TIMEOUT;
+	struct sample s;
+
+	while (arflex_sys_now_ns() < deadline) {
+		if (arflex_state_read(p, &s, sizeof(s), NULL) == 1 && s.seq >= min_seq) {
+			*v = s;
+			return 0;
+		}
+		if (h.pid && arflex_ctl_state(h.ctl) != ARFLEX_STATE_RUNNING)
+			return -ECHILD;
+	}
+	return -ETIMEDOUT;
+}
+
+static int case_ported(const char *exe)
+{
+	struct arflex_param_slot p[3] = {
+		param_f64("kp", 1.0, 0.0, 100.0),
+		param_f64("ki", 15.0, 0.0, 1000.0),
+		param_f64("setpoint", 1.0, -10.0, 10.0),
+	};
+	struct arflex_host_output outs[2] = {
+		{ "velocity", { .method = ARFLEX_PORT_STATE, .type = sample_type, .depth = 1 } },
+		{ "command", { .method = ARFLEX_PORT_STATE, .type = sample_type, .depth = 1 } },
+	};
+	struct arflex_host_opts o = {
+		.runtime = rid, .instance = "pi", .config = config(),
+		.params = p, .nparams = 3, .outputs = outs, .noutputs = 2,
+	};
+	struct arflex_port vel;
+	struct sample v, u;
+	bool vel_open = false;
+	uint64_t applied;
+	int st;
+
+	CHECK(arflex_host_create(&h, &o) == 0, "create");
+	CHECK(arflex_host_spawn(&h, exe, NULL, NULL) == 0, "spawn %s", exe);
+	CHECK(arflex_host_wait_state(&h, ARFLEX_STATE_READY, WAIT_TIMEOUT) == 0, "READY");
+	CHECK(arflex_port_open(&vel, arflex_host_output_name(&h, "velocity"), false, false,
+			       ARFLEX_PORT_STATE, &sample_type) == 0, "open velocity");
+	vel_open = true;
+	CHECK(arflex_host_start(&h, CALL_TIMEOUT) == 0, "START");
+	/* 1500 cycles of 1 ms: the closed loop settles to 1e-6 in ~1000. */
+	CHECK(wait_seq(&vel, 1500, &v) == 0, "no 1500 cycles");
+	CHECK(fabs(v.value - 1.0) < 1e-3, "velocity %.6f after %llu cycles, setpoint 1",
+	      v.value, (unsigned long long)v.seq);
+	CHECK(arflex_state_read(arflex_host_output(&h, "command"), &u, sizeof(u), NULL) >= 0,
+	      "read command");
+	CHECK(fabs(u.value - 0.5) < 1e-2, "command %.6f, expected ~0.5 (setpoint / plant gain)",
+	      u.value);
+	/* A new setpoint through SET_PARAM: applied at a cycle boundary, the loop follows. */
+	CHECK(arflex_host_set_param(&h, "setpoint", arflex_f64_bits(-0.5), &applied,
+				    CALL_TIMEOUT) == 0, "SET_PARAM setpoint");
+	CHECK(arflex_bits_f64(applied) == -0.5, "applied %g", arflex_bits_f64(applied));
+	CHECK(wait_seq(&vel, v.seq + 1500, &v) == 0, "no 1500 more cycles");
+	CHECK(fabs(v.value + 0.5) < 1e-3, "velocity %.6f, setpoint -0.5", v.value);
+	CHECK(arflex_host_shutdown(&h, CALL_TIMEOUT) == 0, "SHUTDOWN");
+	CHECK(arflex_host_wait_exit(&h, WAIT_TIMEOUT) == 0, "exit");
+	st = arflex_host_exit_status(&h);
+	CHECK(WIFEXITED(st) && WEXITSTATUS(st) == 0, "exit status %#x", st);
+out:
+	if (vel_open)
+		arflex_port_close(&vel);
+	return 0;
+}
+
+static int case_template(const char *exe)
+{
+	struct arflex_param_slot p[1] = { param_f64("gain", 3.0, -10.0, 10.0) };
+	struct arflex_host_output outs[1] = {
+		{ "out", { .method = ARFLEX_PORT_STATE, .type = sample_type, .depth = 1 } },
+	};
+	struct arflex_host_opts o = {
+		.runtime = rid, .instance = "tpl", .config = config(),
+		.params = p, .nparams = 1, .outputs = outs, .noutputs = 1,
+	};
+	struct arflex_port_spec spec = { .method = ARFLEX_PORT_STATE, .type = sample_type,
+					 .depth = 1 };
+	struct arflex_port out;
+	bool out_open = false;
+	char name[ARFLEX_OBJ_NAME_SIZE];
+	int st;
+
+	CHECK(arflex_ctl_obj_name(name, sizeof(name), rid, "src", "out.value") == 0, "name");
+	CHECK(arflex_port_create(&provider, name, &spec) == 0, "provider segment");
+	provider_ok = true;
+	CHECK(arflex_host_create(&h, &o) == 0, "create");
+	CHECK(arflex_host_spawn(&h, exe, NULL, NULL) == 0, "spawn %s", exe);
+	CHECK(arflex_host_wait_state(&h, ARFLEX_STATE_READY, WAIT_TIMEOUT) == 0, "READY");
+	CHECK(arflex_port_open(&out, arflex_host_output_name(&h, "out"), false, false,
+			       ARFLEX_PORT_STATE, &sample_type) == 0, "open out");
+	out_open = true;
+	CHECK(arflex_host_bind(&h, "in", name, CALL_TIMEOUT) == 0, "BIND in");
+	CHECK(arflex_host_start(&h, CALL_TIMEOUT) == 0, "START");
+	for (uint64_t i = 1; i <= 20; i++) {
+		struct sample in = { i, (int64_t)arflex_sys_now_ns(), 0.25 * (double)i }, got;
+
+		CHECK(arflex_state_write(&provider, &in, sizeof(in)) == 0, "write in");
+		CHECK(wait_seq(&out, i, &got) == 0, "no output for input %llu",
+		      (unsigned long long)i);
+		CHECK(got.seq == i && got.value == 3.0 * in.value, "out seq %llu value %g for in "
+		      "%g", (unsigned long long)got.seq, got.value, in.value);
+	}
+	CHECK(arflex_host_shutdown(&h, CALL_TIMEOUT) == 0, "SHUTDOWN");
+	CHECK(arflex_host_wait_exit(&h, WAIT_TIMEOUT) == 0, "exit");
+	st = arflex_host_exit_status(&h);
+	CHECK(WIFEXITED(st) && WEXITSTATUS(st) == 0, "exit status %#x", st);
+out:
+	if (out_open)
+		arflex_port_close(&out);
+	return 0;
+}
+
+static bool leaked(const char *inst)
+{
+	char prefix[64];
+	bool any = false;
+	DIR *d = opendir("/dev/shm");
+
+	snprintf(prefix, sizeof(prefix), "arflex.%s.", rid);
+	if (d) {
+		struct dirent *e;
+
+		while ((e = readdir(d))) {
+			if (strncmp(e->d_name, prefix, strlen(prefix)) == 0) {
+				fprintf(stderr, "leak: /dev/shm/%s\n", e->d_name);
+				any = true;
+			}
+		}
+		closedir(d);
+	}
+	/* /dev/mqueue may not be mounted: check the queues by name. */
+	for (unsigned j = 0; j < 2; j++) {
+		char name[ARFLEX_OBJ_NAME_SIZE];
+		mqd_t q;
+
+		arflex_ctl_obj_name(name, sizeof(name), rid, inst, j ? "rsp" : "cmd");
+		q = mq_open(name, O_RDONLY);
+		if (q != (mqd_t)-1) {
+			fprintf(stderr, "leak: queue %s\n", name);
+			mq_close(q);
+			any = true;
+		}
+	}
+	if (waitpid(-1, NULL, WNOHANG) != -1 || errno != ECHILD) {
+		fprintf(stderr, "leak: a child process is left\n");
+		any = true;
+	}
+	return any;
+}
+
+int main(int argc, char **argv)
+{
+	bool ported;
+
+	if (argc != 3 || (strcmp(argv[1], "ported") && strcmp(argv[1], "template"))) {
+		fprintf(stderr, "usage: %s ported|template <component executable>\n", argv[0]);
+		return 2;
+	}
+	ported = strcmp(argv[1], "ported") == 0;
+	snprintf(rid, sizeof(rid), "t-tpl-%ld", (long)getpid());
+	if (ported)
+		case_ported(argv[2]);
+	else
+		case_template(argv[2]);
+	if (failures)
+		fprintf(stderr, "state %u\n", h.ctl ? arflex_ctl_state(h.ctl) : 99u);
+	arflex_host_destroy(&h);
+	if (provider_ok)
+		arflex_port_destroy(&provider);
+	if (leaked(ported ? "pi" : "tpl")) {
+		fprintf(stderr, "FAIL: objects or children leaked\n");
+		failures++;
+	}
+	if (failures) {
+		fprintf(stderr, "rt.template.%s: %d failure(s)\n", argv[1], failures);
+		return 1;
+	}
+	printf("rt.template.%s: ok\n", argv[1]);
+	return 0;
+}
