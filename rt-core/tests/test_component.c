@@ -55,6 +55,9 @@ static void setup_ids(const char *tag)
 	make_env(NULL);
 }
 
+static int probe_prio; /* priority and CPU mask for the next probe_host */
+static uint64_t probe_cpus;
+
 static int probe_host(struct arflex_host *h, const char *inst, uint64_t hb_timeout,
 		      uint32_t cfg_flags, bool with_out)
 {
@@ -67,7 +70,8 @@ static int probe_host(struct arflex_host *h, const char *inst, uint64_t hb_timeo
 	struct arflex_host_opts o = {
 		.runtime = rid, .instance = inst,
 		.config = { .period_ns = 1000000, .hb_timeout_ns = hb_timeout,
-			    .cfg_flags = cfg_flags | ARFLEX_CFG_NO_MLOCK | ARFLEX_CFG_NO_DMA_LATENCY },
+			    .cfg_flags = cfg_flags | ARFLEX_CFG_NO_MLOCK | ARFLEX_CFG_NO_DMA_LATENCY,
+			    .priority = probe_prio, .cpu_mask = probe_cpus },
 		.params = p, .nparams = 2, .outputs = &out, .noutputs = with_out ? 1 : 0,
 	};
 
@@ -475,6 +479,33 @@ static void restart_reuses_objects_and_waits_for_reset(void **state)
 	th_assert_clean(rid);
 }
 
+/* SCHED_FIFO and affinity are either in force (flags) or refused with a counted warning. */
+static void scheduling_applied_or_warned(void **state)
+{
+	struct arflex_host h;
+	uint32_t f;
+
+	(void)state;
+	setup_ids("sched");
+	probe_prio = 10;
+	probe_cpus = 1;
+	assert_int_equal(probe_host(&h, "probe", 0, 0, true), 0);
+	probe_prio = 0;
+	probe_cpus = 0;
+	spawn_ready(&h);
+	assert_int_equal(arflex_host_start(&h, T_CALL), 0);
+	assert_true(wait_out(&h, updates_above, 5, false));
+	f = arflex_ctl_flags(h.ctl);
+	assert_true((f & ARFLEX_FLAG_SCHED_FIFO) || h.ctl->warnings[ARFLEX_WARN_SCHED] == 1);
+	assert_true((f & ARFLEX_FLAG_AFFINITY) || h.ctl->warnings[ARFLEX_WARN_AFFINITY] == 1);
+	assert_false(f & ARFLEX_FLAG_MLOCKALL); /* disabled by cfg_flags */
+	assert_int_equal(h.ctl->warnings[ARFLEX_WARN_MLOCK], 0);
+	shutdown_ok(&h);
+	arflex_host_destroy(&h);
+	unlink(logpath);
+	th_assert_clean(rid);
+}
+
 static void bad_command_line(void **state)
 {
 	struct arflex_host h;
@@ -505,6 +536,7 @@ int main(void)
 		cmocka_unit_test(sigterm_stops_cleanly),
 		cmocka_unit_test(killed_mid_cycle_leaves_nothing),
 		cmocka_unit_test(restart_reuses_objects_and_waits_for_reset),
+		cmocka_unit_test(scheduling_applied_or_warned),
 		cmocka_unit_test(bad_command_line),
 	};
 
