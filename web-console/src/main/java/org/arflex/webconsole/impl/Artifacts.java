@@ -1,0 +1,189 @@
+package org.arflex.webconsole.impl;
+
+import java.io.IOException;
+import java.io.InputStream;
+import java.io.OutputStream;
+import java.net.URI;
+import java.net.URISyntaxException;
+import java.net.http.HttpClient;
+import java.net.http.HttpRequest;
+import java.net.http.HttpResponse;
+import java.nio.file.Files;
+import java.nio.file.Path;
+import java.nio.file.StandardCopyOption;
+import java.security.DigestOutputStream;
+import java.security.MessageDigest;
+import java.security.NoSuchAlgorithmException;
+import java.time.Duration;
+import java.util.HexFormat;
+import java.util.Locale;
+import java.util.jar.JarFile;
+import java.util.regex.Pattern;
+
+/**
+ * Bringing a component bundle in: from a URL under the DRCR's update rules (https or file only,
+ * SHA-256 pinned and checked before anything is installed) or from an upload, into a private
+ * staging directory. Every refusal names what is wrong.
+ */
+final class Artifacts {
+    /** Largest bundle accepted. */
+    static final long MAX_BYTES = 64L << 20;
+    private static final Pattern SHA256 = Pattern.compile("[0-9a-f]{64}");
+
+    private Artifacts() {
+    }
+
+    /** A bundle copied into staging, with its digest and symbolic name. */
+    record Staged(Path file, String sha256, String symbolicName, String version, String origin) {
+    }
+
+    /** Checks a URL and pinned hash against the rules; returns the URI. */
+    static URI checkUrl(String url, String sha256) throws HttpError {
+        if (url == null || url.isBlank()) {
+            throw new HttpError(400, "url: missing");
+        }
+        URI u;
+        try {
+            u = new URI(url.trim());
+        } catch (URISyntaxException e) {
+            throw new HttpError(400, "url: not a URL (" + e.getReason() + ")");
+        }
+        String scheme = u.getScheme() == null ? "" : u.getScheme().toLowerCase(Locale.ROOT);
+        if (!scheme.equals("https") && !scheme.equals("file")) {
+            throw new HttpError(400, "url: scheme '" + scheme + "' refused; only https or file are allowed");
+        }
+        if (scheme.equals("https") && (u.getHost() == null || u.getUserInfo() != null)) {
+            throw new HttpError(400, "url: an https URL needs a host and no user info");
+        }
+        checkSha(sha256);
+        return u;
+    }
+
+    /** Checks the pinned hash syntax. */
+    static String checkSha(String sha256) throws HttpError {
+        if (sha256 == null || sha256.isBlank()) {
+            throw new HttpError(400, "sha256: missing; a URL install needs the pinned SHA-256 of the jar");
+        }
+        String s = sha256.trim().toLowerCase(Locale.ROOT);
+        if (!SHA256.matcher(s).matches()) {
+            throw new HttpError(400, "sha256: '" + sha256 + "' is not 64 hexadecimal digits");
+        }
+        return s;
+    }
+
+    /** Downloads the URL into staging and checks the pinned hash; the file is removed on any failure. */
+    static Staged fetch(URI u, String pinned, Path stagingDir) throws HttpError, IOException {
+        String expected = checkSha(pinned);
+        Path tmp = Files.createTempFile(Files.createDirectories(stagingDir), "fetch-", ".jar");
+        boolean ok = false;
+        try {
+            try (InputStream in = open(u)) {
+                String actual = copyBounded(in, tmp);
+                if (!actual.equals(expected)) {
+                    throw new HttpError(400, "sha256: the jar at " + u + " has SHA-256 " + actual
+                            + ", not the pinned " + expected + "; nothing installed");
+                }
+            }
+            Staged s = inspect(tmp, expected, u.toString());
+            ok = true;
+            return s;
+        } finally {
+            if (!ok) {
+                Files.deleteIfExists(tmp);
+            }
+        }
+    }
+
+    /** Copies an uploaded body into staging; the digest is computed here. */
+    static Staged upload(InputStream body, String name, Path stagingDir) throws HttpError, IOException {
+        Path tmp = Files.createTempFile(Files.createDirectories(stagingDir), "upload-", ".jar");
+        boolean ok = false;
+        try {
+            String sha = copyBounded(body, tmp);
+            Staged s = inspect(tmp, sha, "upload " + (name == null ? "(unnamed)" : name));
+            ok = true;
+            return s;
+        } finally {
+            if (!ok) {
+                Files.deleteIfExists(tmp);
+            }
+        }
+    }
+
+    /** Moves a staged jar to its final place, named by its digest. */
+    static Path keep(Staged s, Path dir) throws IOException {
+        Path target = Files.createDirectories(dir).resolve(s.sha256() + ".jar");
+        return Files.move(s.file(), target, StandardCopyOption.REPLACE_EXISTING);
+    }
+
+    private static InputStream open(URI u) throws HttpError, IOException {
+        if (u.getScheme().equalsIgnoreCase("file")) {
+            Path p;
+            try {
+                p = Path.of(u);
+            } catch (IllegalArgumentException e) {
+                throw new HttpError(400, "url: " + e.getMessage());
+            }
+            if (!Files.isRegularFile(p)) {
+                throw new HttpError(400, "url: no such file " + p);
+            }
+            return Files.newInputStream(p);
+        }
+        HttpClient client = HttpClient.newBuilder().connectTimeout(Duration.ofSeconds(10))
+                .followRedirects(HttpClient.Redirect.NORMAL).build();
+        try {
+            HttpResponse<InputStream> r = client.send(HttpRequest.newBuilder(u).timeout(Duration.ofSeconds(60)).GET()
+                    .build(), HttpResponse.BodyHandlers.ofInputStream());
+            if (r.statusCode() != 200) {
+                r.body().close();
+                throw new HttpError(502, "url: " + u + " answered HTTP " + r.statusCode());
+            }
+            if (!r.uri().getScheme().equalsIgnoreCase("https")) {
+                r.body().close();
+                throw new HttpError(400, "url: redirected to a non-https URL " + r.uri());
+            }
+            return r.body();
+        } catch (InterruptedException e) {
+            Thread.currentThread().interrupt();
+            throw new IOException("interrupted while downloading " + u, e);
+        }
+    }
+
+    private static String copyBounded(InputStream in, Path to) throws IOException, HttpError {
+        MessageDigest md;
+        try {
+            md = MessageDigest.getInstance("SHA-256");
+        } catch (NoSuchAlgorithmException e) {
+            throw new IllegalStateException(e);
+        }
+        long total = 0;
+        try (OutputStream out = new DigestOutputStream(Files.newOutputStream(to), md)) {
+            byte[] buf = new byte[65536];
+            for (int n; (n = in.read(buf)) > 0;) {
+                total += n;
+                if (total > MAX_BYTES) {
+                    throw new HttpError(413, "jar larger than " + (MAX_BYTES >> 20) + " MiB refused");
+                }
+                out.write(buf, 0, n);
+            }
+        }
+        if (total == 0) {
+            throw new HttpError(400, "empty file: no jar received");
+        }
+        return HexFormat.of().formatHex(md.digest());
+    }
+
+    private static Staged inspect(Path jar, String sha, String origin) throws HttpError {
+        try (JarFile jf = new JarFile(jar.toFile())) {
+            var mf = jf.getManifest();
+            String bsn = mf == null ? null : mf.getMainAttributes().getValue("Bundle-SymbolicName");
+            if (bsn == null) {
+                throw new HttpError(400, origin + ": not an OSGi bundle (no Bundle-SymbolicName in the manifest)");
+            }
+            String version = mf.getMainAttributes().getValue("Bundle-Version");
+            return new Staged(jar, sha, bsn.split(";")[0].trim(), version == null ? "0.0.0" : version, origin);
+        } catch (IOException e) {
+            throw new HttpError(400, origin + ": not a jar (" + e.getMessage() + ")");
+        }
+    }
+}

@@ -1,0 +1,394 @@
+package org.arflex.webconsole.impl;
+
+import com.fasterxml.jackson.databind.ObjectMapper;
+import java.io.IOException;
+import java.io.InputStream;
+import java.nio.charset.StandardCharsets;
+import java.nio.file.Files;
+import java.nio.file.Path;
+import java.nio.file.StandardCopyOption;
+import java.security.SecureRandom;
+import java.util.ArrayList;
+import java.util.HexFormat;
+import java.util.LinkedHashMap;
+import java.util.List;
+import java.util.Map;
+import java.util.Optional;
+import java.util.concurrent.ConcurrentHashMap;
+import java.util.regex.Pattern;
+import java.util.stream.Stream;
+import org.arflex.contract.ContractParser;
+import org.arflex.contract.Problem;
+import org.arflex.drcr.ComponentManagement;
+import org.arflex.drcr.DrcrService;
+import org.arflex.drcr.ResourceManager;
+import org.arflex.drcr.UpdateService;
+import org.arflex.drcr.dto.CellDTO;
+import org.arflex.drcr.dto.ContractDTO;
+import org.arflex.drcr.dto.InstanceDTO;
+import org.arflex.drcr.dto.ParamDTO;
+import org.arflex.drcr.dto.StatsDTO;
+import org.osgi.framework.Bundle;
+import org.osgi.framework.BundleContext;
+import org.osgi.framework.BundleException;
+import org.osgi.service.component.annotations.Activate;
+import org.osgi.service.component.annotations.Component;
+import org.osgi.service.component.annotations.Deactivate;
+import org.osgi.service.component.annotations.Reference;
+import org.osgi.service.component.annotations.ReferenceCardinality;
+import org.osgi.service.component.annotations.ReferencePolicy;
+
+/**
+ * Everything the console pages do, behind the HTTP layer: reads the cell through the DRCR's
+ * DTO services only, changes it through ComponentManagement, the bundle life cycle and the
+ * UpdateService. The DRCR services are optional and dynamic: the console keeps working (and
+ * says so) while the DRCR is absent or restarting.
+ */
+@Component(service = Backend.class, immediate = true)
+public class Backend {
+    private static final Pattern NAME = Pattern.compile("[A-Za-z0-9][A-Za-z0-9._-]{0,63}");
+    private static final int MAX_STAGED = 8;
+
+    @Reference(cardinality = ReferenceCardinality.OPTIONAL, policy = ReferencePolicy.DYNAMIC)
+    volatile DrcrService drcr;
+    @Reference(cardinality = ReferenceCardinality.OPTIONAL, policy = ReferencePolicy.DYNAMIC)
+    volatile ResourceManager resources;
+    @Reference(cardinality = ReferenceCardinality.OPTIONAL, policy = ReferencePolicy.DYNAMIC)
+    volatile UpdateService updates;
+    @Reference(cardinality = ReferenceCardinality.MULTIPLE, policy = ReferencePolicy.DYNAMIC)
+    volatile List<ComponentManagement> components;
+
+    private static final com.fasterxml.jackson.core.type.TypeReference<Map<String, Object>> MAP =
+            new com.fasterxml.jackson.core.type.TypeReference<>() { };
+    final ObjectMapper json = new ObjectMapper();
+    private final ContractParser parser = ContractParser.create();
+    private final Map<String, Artifacts.Staged> staged = new ConcurrentHashMap<>();
+    private final SecureRandom random = new SecureRandom();
+    private BundleContext context;
+    private Path dataDir;
+    private Path contractsDir;
+    Sampler sampler;
+
+    @Activate
+    void activate(BundleContext bc) throws IOException {
+        this.context = bc;
+        this.dataDir = bc.getDataFile("").toPath();
+        String configured = bc.getProperty("arflex.contracts.dir");
+        String home = System.getenv("ARFLEX_HOME");
+        this.contractsDir = configured != null ? Path.of(configured)
+                : home != null ? Path.of(home, "contracts") : dataDir.resolve("contracts");
+        this.sampler = new Sampler(this::sample);
+        cleanStaging();
+    }
+
+    @Deactivate
+    void deactivate() throws IOException {
+        sampler.close();
+        cleanStaging();
+    }
+
+    private void cleanStaging() throws IOException {
+        staged.clear();
+        Path dir = dataDir.resolve("staging");
+        if (Files.isDirectory(dir)) {
+            try (Stream<Path> s = Files.list(dir)) {
+                for (Path p : s.toList()) {
+                    Files.deleteIfExists(p);
+                }
+            }
+        }
+    }
+
+    // ---- reading -------------------------------------------------------------------------
+
+    DrcrService drcr() throws HttpError {
+        DrcrService d = drcr;
+        if (d == null) {
+            throw new HttpError(503, "the DRCR is not running (no DrcrService registered)");
+        }
+        return d;
+    }
+
+    /** The cell, or an object saying the DRCR is absent. */
+    Map<String, Object> cell() {
+        Map<String, Object> m = new LinkedHashMap<>();
+        DrcrService d = drcr;
+        m.put("drcr", d != null);
+        if (d != null) {
+            CellDTO c = d.cell();
+            m.put("cell", c);
+            ResourceManager rm = resources;
+            if (rm != null) {
+                m.put("resources", rm.resources());
+            }
+        }
+        return m;
+    }
+
+    /** Contract and instance of one component. */
+    Map<String, Object> component(String name) throws HttpError {
+        checkName(name);
+        DrcrService d = drcr();
+        Optional<ContractDTO> c = d.contract(name);
+        Optional<InstanceDTO> i = d.instance(name);
+        if (c.isEmpty() && i.isEmpty()) {
+            throw new HttpError(404, "no component named '" + name + "' in the cell");
+        }
+        Map<String, Object> m = new LinkedHashMap<>();
+        m.put("contract", c.orElse(null));
+        m.put("instance", i.orElse(null));
+        m.put("managed", management(name).isPresent());
+        return m;
+    }
+
+    Optional<ComponentManagement> management(String name) {
+        List<ComponentManagement> list = components;
+        if (list == null) {
+            return Optional.empty();
+        }
+        return list.stream().filter(cm -> name.equals(safeName(cm))).findFirst();
+    }
+
+    private static String safeName(ComponentManagement cm) {
+        try {
+            return cm.name();
+        } catch (RuntimeException e) {
+            return null;
+        }
+    }
+
+    /** One live sample of a component for the stream (null when it is gone). */
+    Map<String, Object> sample(String name) {
+        Optional<ComponentManagement> cm = management(name);
+        if (cm.isEmpty()) {
+            return null;
+        }
+        Map<String, Object> m = new LinkedHashMap<>();
+        m.put("t", System.currentTimeMillis());
+        ComponentManagement c = cm.get();
+        m.put("state", c.state());
+        StatsDTO s = c.stats();
+        if (s != null) {
+            // Every field of the DTO, whatever the DRCR's version carries.
+            m.putAll(json.convertValue(s, MAP));
+        }
+        InstanceDTO i = c.instance();
+        Map<String, Object> params = new LinkedHashMap<>();
+        if (i != null && i.params != null) {
+            for (ParamDTO p : i.params) {
+                params.put(p.name, p.value);
+            }
+        }
+        m.put("params", params);
+        return m;
+    }
+
+    // ---- changing ------------------------------------------------------------------------
+
+    /** Sets a parameter and returns the value the RT half applied. */
+    Map<String, Object> setParam(String name, String param, String value) throws HttpError {
+        checkName(name);
+        if (param == null || param.isBlank()) {
+            throw new HttpError(400, "param: missing");
+        }
+        if (value == null) {
+            throw new HttpError(400, "value: missing");
+        }
+        ComponentManagement cm = management(name).orElseThrow(
+                () -> new HttpError(404, "component '" + name + "' has no management service (not installed?)"));
+        try {
+            String applied = cm.set(param, value.trim());
+            return Map.of("component", name, "param", param, "applied", applied);
+        } catch (IllegalArgumentException e) {
+            throw new HttpError(400, e.getMessage());
+        } catch (IllegalStateException e) {
+            throw new HttpError(409, e.getMessage());
+        }
+    }
+
+    /** start, stop (the component's bundle) or reset (operator reset of the instance). */
+    Map<String, Object> command(String name, String cmd) throws HttpError {
+        checkName(name);
+        try {
+            switch (cmd == null ? "" : cmd) {
+                case "reset" -> management(name).orElseThrow(() -> new HttpError(404,
+                        "component '" + name + "' has no management service")).reset();
+                case "start" -> bundleOf(name).start();
+                case "stop" -> bundleOf(name).stop();
+                default -> throw new HttpError(400, "cmd: '" + cmd + "' is not start, stop or reset");
+            }
+        } catch (BundleException | IllegalStateException e) {
+            throw new HttpError(409, cmd + " " + name + ": " + e.getMessage());
+        }
+        return Map.of("component", name, "done", cmd);
+    }
+
+    private Bundle bundleOf(String name) throws HttpError {
+        ContractDTO c = drcr().contract(name).orElseThrow(() -> new HttpError(404, "no contract named '" + name + "'"));
+        Bundle b = context.getBundle(c.bundleId);
+        if (b == null) {
+            throw new HttpError(404, "the bundle " + c.bundleId + " of '" + name + "' is gone");
+        }
+        return b;
+    }
+
+    /** Stages a bundle from a URL with a pinned hash and returns its plan. */
+    Map<String, Object> stageUrl(String url, String sha256) throws HttpError, IOException {
+        var u = Artifacts.checkUrl(url, sha256);
+        return planStaged(Artifacts.fetch(u, sha256, dataDir.resolve("staging")));
+    }
+
+    /** Stages an uploaded bundle and returns its plan. */
+    Map<String, Object> stageUpload(InputStream body, String fileName) throws HttpError, IOException {
+        return planStaged(Artifacts.upload(body, fileName, dataDir.resolve("staging")));
+    }
+
+    private Map<String, Object> planStaged(Artifacts.Staged s) throws HttpError, IOException {
+        if (staged.size() >= MAX_STAGED) {
+            Files.deleteIfExists(s.file());
+            throw new HttpError(429, "too many staged bundles waiting for confirmation; install or discard one");
+        }
+        String plan;
+        try {
+            plan = drcr().planInstall(s.file().toUri().toString());
+        } catch (HttpError e) {
+            Files.deleteIfExists(s.file());
+            throw e;
+        } catch (RuntimeException e) {
+            plan = "the DRCR could not plan this install: " + e.getMessage();
+        }
+        byte[] id = new byte[16];
+        random.nextBytes(id);
+        String key = HexFormat.of().formatHex(id);
+        staged.put(key, s);
+        Map<String, Object> m = new LinkedHashMap<>();
+        m.put("id", key);
+        m.put("origin", s.origin());
+        m.put("sha256", s.sha256());
+        m.put("symbolicName", s.symbolicName());
+        m.put("version", s.version());
+        m.put("plan", plan);
+        return m;
+    }
+
+    /** Installs (or updates, when a bundle with that symbolic name exists) a staged bundle. */
+    Map<String, Object> installStaged(String id) throws HttpError, IOException {
+        Artifacts.Staged s = id == null ? null : staged.remove(id);
+        if (s == null) {
+            throw new HttpError(404, "id: no staged bundle with this id (expired or already installed)");
+        }
+        Path kept = Artifacts.keep(s, dataDir.resolve("installed"));
+        String location = kept.toUri().toString();
+        try (InputStream in = Files.newInputStream(kept)) {
+            Bundle existing = null;
+            for (Bundle b : context.getBundles()) {
+                if (s.symbolicName().equals(b.getSymbolicName())) {
+                    existing = b;
+                }
+            }
+            Bundle b;
+            String action;
+            if (existing != null) {
+                existing.update(in);
+                b = existing;
+                action = "updated";
+            } else {
+                b = context.installBundle(location, in);
+                action = "installed";
+            }
+            b.start();
+            return Map.of("bundleId", b.getBundleId(), "symbolicName", s.symbolicName(), "action", action,
+                    "sha256", s.sha256());
+        } catch (BundleException e) {
+            throw new HttpError(409, "install of " + s.symbolicName() + " failed: " + e.getMessage());
+        }
+    }
+
+    /** Drops a staged bundle without installing it. */
+    Map<String, Object> discard(String id) throws IOException {
+        Artifacts.Staged s = id == null ? null : staged.remove(id);
+        if (s != null) {
+            Files.deleteIfExists(s.file());
+        }
+        return Map.of("discarded", s != null);
+    }
+
+    Map<String, Object> planUninstall(String name) throws HttpError {
+        checkName(name);
+        return Map.of("component", name, "plan", drcr().planUninstall(name));
+    }
+
+    Map<String, Object> uninstall(String name) throws HttpError {
+        Bundle b = bundleOf(name);
+        long id = b.getBundleId();
+        try {
+            b.uninstall();
+        } catch (BundleException e) {
+            throw new HttpError(409, "uninstall of " + name + " failed: " + e.getMessage());
+        }
+        return Map.of("component", name, "bundleId", id, "action", "uninstalled");
+    }
+
+    Map<String, Object> update(String name) throws HttpError {
+        checkName(name);
+        UpdateService u = updates;
+        if (u == null) {
+            throw new HttpError(503, "no UpdateService registered (DRCR not running)");
+        }
+        try {
+            return Map.of("component", name, "report", u.update(name));
+        } catch (IllegalStateException | IllegalArgumentException e) {
+            throw new HttpError(409, "update of " + name + " refused: " + e.getMessage());
+        }
+    }
+
+    // ---- contracts -----------------------------------------------------------------------
+
+    List<Problem> validate(String xml, String source) {
+        return parser.validate(xml, source);
+    }
+
+    Map<String, Object> saveContract(String name, String xml) throws HttpError, IOException {
+        checkName(name);
+        List<Problem> problems = validate(xml, name + ".xml");
+        if (!problems.isEmpty()) {
+            Map<String, Object> m = new LinkedHashMap<>();
+            m.put("saved", false);
+            m.put("problems", problems);
+            return m;
+        }
+        Path dir = Files.createDirectories(contractsDir);
+        Path tmp = Files.createTempFile(dir, name, ".tmp");
+        Files.writeString(tmp, xml, StandardCharsets.UTF_8);
+        Path target = dir.resolve(name + ".xml");
+        Files.move(tmp, target, StandardCopyOption.REPLACE_EXISTING, StandardCopyOption.ATOMIC_MOVE);
+        return Map.of("saved", true, "path", target.toString(), "problems", List.of());
+    }
+
+    List<String> savedContracts() throws IOException {
+        if (!Files.isDirectory(contractsDir)) {
+            return List.of();
+        }
+        List<String> names = new ArrayList<>();
+        try (Stream<Path> s = Files.list(contractsDir)) {
+            s.map(p -> p.getFileName().toString()).filter(f -> f.endsWith(".xml")).sorted()
+                    .forEach(f -> names.add(f.substring(0, f.length() - 4)));
+        }
+        return names;
+    }
+
+    String loadContract(String name) throws HttpError, IOException {
+        checkName(name);
+        Path p = contractsDir.resolve(name + ".xml");
+        if (!Files.isRegularFile(p)) {
+            throw new HttpError(404, "no saved contract named '" + name + "'");
+        }
+        return Files.readString(p, StandardCharsets.UTF_8);
+    }
+
+    static void checkName(String name) throws HttpError {
+        if (name == null || !NAME.matcher(name).matches()) {
+            throw new HttpError(400, "name: '" + name + "' is not a component name (letters, digits, . _ -; up to 64)");
+        }
+    }
+}

@@ -1,0 +1,12 @@
+package org.arflex.webconsole.impl;
+
+/** A request the console refuses, with the HTTP status and a message naming what is wrong. */
+final class HttpError extends Exception {
+    private static final long serialVersionUID = 1L;
+    final int status;
+
+    HttpError(int status, String message) {
+        super(message);
+        this.status = status;
+    }
+}

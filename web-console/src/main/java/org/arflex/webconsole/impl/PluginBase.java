@@ -1,0 +1,261 @@
+package org.arflex.webconsole.impl;
+
+import jakarta.servlet.ServletException;
+import jakarta.servlet.http.HttpServletRequest;
+import jakarta.servlet.http.HttpServletResponse;
+import java.io.IOException;
+import java.io.InputStream;
+import java.io.OutputStream;
+import java.io.PrintWriter;
+import java.nio.charset.StandardCharsets;
+import java.util.LinkedHashMap;
+import java.util.Map;
+import java.util.concurrent.atomic.AtomicInteger;
+import org.apache.felix.webconsole.servlet.AbstractServlet;
+import org.apache.felix.webconsole.servlet.ServletConstants;
+import org.owasp.encoder.Encode;
+
+/**
+ * Common base of the console pages. Under {@code /system/console/<label>}:
+ * <ul>
+ * <li>{@code GET} with no further path: the page (the Web Console draws its frame around
+ * {@link #renderContent}); the page script then reads the JSON endpoints;
+ * <li>{@code GET /res/...}: static files of this bundle (our scripts and the vendored
+ * libraries);
+ * <li>{@code GET /api/...}: JSON; {@code GET /api/stream}: server-sent events;
+ * <li>{@code POST /api/...}: state changes, each checked by {@link Csrf} first.
+ * </ul>
+ * The page HTML holds no data: scripts fill it through {@code textContent}, and the few
+ * server-written values are encoded for their context with the OWASP encoder.
+ */
+abstract class PluginBase extends AbstractServlet {
+    private static final long serialVersionUID = 1L;
+    /** Most live streams open at once (each holds one HTTP thread). */
+    static final int MAX_STREAMS = 8;
+    /** A stream ends after this long; EventSource reconnects by itself. */
+    static final long STREAM_MS = 5 * 60_000L;
+    private static final AtomicInteger STREAMS = new AtomicInteger();
+
+    abstract Backend backend();
+
+    /** The page name, also the name of its script ({@code res/arflex/<page>.js}). */
+    abstract String page();
+
+    /** The label under the console root. */
+    abstract String label();
+
+    /** Vendored scripts the page needs, under {@code res/vendor/}. */
+    String[] vendorScripts() {
+        return new String[0];
+    }
+
+    String[] vendorStyles() {
+        return new String[0];
+    }
+
+    private String route(HttpServletRequest req) {
+        String p = req.getPathInfo();
+        if (p == null) {
+            return "";
+        }
+        String prefix = "/" + label();
+        return p.startsWith(prefix) ? p.substring(prefix.length()) : p;
+    }
+
+    @Override
+    protected void doGet(HttpServletRequest req, HttpServletResponse resp) throws ServletException, IOException {
+        String r = route(req);
+        if (r.startsWith("/res/")) {
+            if (getResource(req.getPathInfo()) == null) {
+                resp.sendError(404, "no resource " + r);
+            } else {
+                spoolResource(req, resp);
+            }
+            return;
+        }
+        if (r.equals("/api/stream")) {
+            stream(req, resp);
+            return;
+        }
+        if (r.startsWith("/api/")) {
+            handle(req, resp, () -> get(r.substring(5), req));
+            return;
+        }
+        // Anything else: leave the response untouched, the Web Console renders the page.
+    }
+
+    @Override
+    protected void doPost(HttpServletRequest req, HttpServletResponse resp) throws IOException {
+        String r = route(req);
+        String why = Csrf.refusal(req);
+        if (why != null) {
+            send(resp, 403, Map.of("error", why));
+            return;
+        }
+        if (!r.startsWith("/api/")) {
+            send(resp, 404, Map.of("error", "no endpoint " + r));
+            return;
+        }
+        handle(req, resp, () -> post(r.substring(5), req));
+    }
+
+    private interface Action {
+        Object run() throws HttpError, IOException;
+    }
+
+    private void handle(HttpServletRequest req, HttpServletResponse resp, Action a) throws IOException {
+        try {
+            send(resp, 200, a.run());
+        } catch (HttpError e) {
+            send(resp, e.status, Map.of("error", e.getMessage()));
+        } catch (RuntimeException e) {
+            send(resp, 500, Map.of("error", e.getClass().getSimpleName() + ": " + e.getMessage()));
+        }
+    }
+
+    private void send(HttpServletResponse resp, int status, Object body) throws IOException {
+        setNoCache(resp);
+        resp.setStatus(status);
+        resp.setContentType("application/json");
+        resp.setCharacterEncoding("UTF-8");
+        resp.setHeader("X-Content-Type-Options", "nosniff");
+        byte[] b = backend().json.writeValueAsBytes(body);
+        resp.setContentLength(b.length);
+        try (OutputStream out = resp.getOutputStream()) {
+            out.write(b);
+        }
+    }
+
+    /** The JSON read endpoints (shared by all pages). */
+    private Object get(String what, HttpServletRequest req) throws HttpError, IOException {
+        Backend b = backend();
+        String name = req.getParameter("name");
+        return switch (what) {
+            case "cell" -> b.cell();
+            case "component" -> b.component(name);
+            case "histogram" -> {
+                Backend.checkName(name);
+                Map<String, Object> m = new LinkedHashMap<>();
+                m.put("component", name);
+                m.put("bucketsUs", Sampler.BUCKETS);
+                m.put("counts", b.sampler.histogram(name));
+                yield m;
+            }
+            case "contracts" -> Map.of("saved", b.savedContracts());
+            case "contract" -> Map.of("name", name, "xml", b.loadContract(name));
+            case "plan-uninstall" -> b.planUninstall(name);
+            default -> throw new HttpError(404, "no endpoint /api/" + what);
+        };
+    }
+
+    /** The state-changing endpoints (CSRF already checked). */
+    private Object post(String what, HttpServletRequest req) throws HttpError, IOException {
+        Backend b = backend();
+        String name = req.getParameter("name");
+        return switch (what) {
+            case "param" -> b.setParam(name, req.getParameter("param"), req.getParameter("value"));
+            case "command" -> b.command(name, req.getParameter("cmd"));
+            case "stage-url" -> b.stageUrl(req.getParameter("url"), req.getParameter("sha256"));
+            case "stage-upload" -> {
+                try (InputStream in = req.getInputStream()) {
+                    yield b.stageUpload(in, req.getParameter("file"));
+                }
+            }
+            case "install" -> b.installStaged(req.getParameter("id"));
+            case "discard" -> b.discard(req.getParameter("id"));
+            case "uninstall" -> b.uninstall(name);
+            case "update" -> b.update(name);
+            case "validate" -> Map.of("problems", b.validate(body(req), "editor.xml"));
+            case "save" -> b.saveContract(name, body(req));
+            default -> throw new HttpError(404, "no endpoint /api/" + what);
+        };
+    }
+
+    private static String body(HttpServletRequest req) throws IOException, HttpError {
+        try (InputStream in = req.getInputStream()) {
+            byte[] b = in.readNBytes((1 << 20) + 1);
+            if (b.length > 1 << 20) {
+                throw new HttpError(413, "contract larger than 1 MiB refused");
+            }
+            return new String(b, StandardCharsets.UTF_8);
+        }
+    }
+
+    /** Server-sent events: one frame per sampler period for the named component. */
+    private void stream(HttpServletRequest req, HttpServletResponse resp) throws IOException {
+        String name = req.getParameter("name");
+        try {
+            Backend.checkName(name);
+        } catch (HttpError e) {
+            send(resp, 400, Map.of("error", e.getMessage()));
+            return;
+        }
+        if (STREAMS.incrementAndGet() > MAX_STREAMS) {
+            STREAMS.decrementAndGet();
+            send(resp, 503, Map.of("error", "too many live streams open (" + MAX_STREAMS + ")"));
+            return;
+        }
+        Sampler s = backend().sampler;
+        try {
+            s.subscribe(name);
+        } catch (IllegalStateException e) {
+            STREAMS.decrementAndGet();
+            send(resp, 503, Map.of("error", e.getMessage()));
+            return;
+        }
+        try {
+            setNoCache(resp);
+            resp.setStatus(200);
+            resp.setContentType("text/event-stream");
+            resp.setCharacterEncoding("UTF-8");
+            OutputStream out = resp.getOutputStream();
+            out.write("retry: 2000\n\n".getBytes(StandardCharsets.UTF_8));
+            out.flush();
+            long seq = 0;
+            long end = System.currentTimeMillis() + STREAM_MS;
+            while (System.currentTimeMillis() < end) {
+                Sampler.Frame f = s.awaitAfter(seq, 1000);
+                String line;
+                if (f == null) {
+                    line = ": idle\n\n";
+                } else {
+                    seq = f.seq();
+                    Object sample = f.byComponent().get(name);
+                    line = "data: " + backend().json.writeValueAsString(
+                            sample == null ? Map.of("gone", true) : sample) + "\n\n";
+                }
+                out.write(line.getBytes(StandardCharsets.UTF_8));
+                out.flush();
+            }
+        } catch (IOException e) {
+            // The browser went away: end quietly.
+        } catch (InterruptedException e) {
+            Thread.currentThread().interrupt();
+        } finally {
+            s.unsubscribe(name);
+            STREAMS.decrementAndGet();
+        }
+    }
+
+    @Override
+    public void renderContent(HttpServletRequest req, HttpServletResponse resp) throws IOException {
+        String appRoot = String.valueOf(req.getAttribute(ServletConstants.ATTR_APP_ROOT));
+        String root = appRoot + "/" + label();
+        String token = Csrf.token(req);
+        PrintWriter w = resp.getWriter();
+        w.println("<link rel='stylesheet' href='" + Encode.forHtmlAttribute(root + "/res/arflex/arflex.css") + "'>");
+        for (String css : vendorStyles()) {
+            w.println("<link rel='stylesheet' href='" + Encode.forHtmlAttribute(root + "/res/vendor/" + css) + "'>");
+        }
+        w.println("<div id='arflex-app' class='arflex' data-page='" + Encode.forHtmlAttribute(page())
+                + "' data-root='" + Encode.forHtmlAttribute(root)
+                + "' data-app-root='" + Encode.forHtmlAttribute(appRoot)
+                + "' data-csrf='" + Encode.forHtmlAttribute(token) + "'>");
+        w.println("<noscript>This page needs JavaScript.</noscript></div>");
+        for (String js : vendorScripts()) {
+            w.println("<script src='" + Encode.forHtmlAttribute(root + "/res/vendor/" + js) + "'></script>");
+        }
+        w.println("<script src='" + Encode.forHtmlAttribute(root + "/res/arflex/arflex.js") + "'></script>");
+        w.println("<script src='" + Encode.forHtmlAttribute(root + "/res/arflex/" + page() + ".js") + "'></script>");
+    }
+}

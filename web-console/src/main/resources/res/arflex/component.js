@@ -1,0 +1,143 @@
+/* Component page: contract summary, bindings, parameters (editable where the contract allows,
+ * with the value the RT half applied read back), start/stop/reset, live plots (server-sent
+ * events, uPlot) and the execution-time histogram. */
+'use strict';
+(() => {
+  const {app, el, get, post, fmtNs, fmtBytes, stateBadge, pageUrl, message} = Arflex;
+  const name = new URLSearchParams(window.location.search).get('name');
+  const status = el('div', {id: 'arflex-component-status'});
+
+  async function chooser() {
+    const data = await get('cell');
+    const list = data.drcr ? (data.cell.instances || []) : [];
+    app.replaceChildren(el('h2', {}, 'Components'), status,
+      el('ul', {}, list.map(i => el('li', {}, el('a', {href: pageUrl('arflex-component', {name: i.name})}, i.name), ' ', stateBadge(i.state)))));
+    if (!data.drcr) message(status, 'The DRCR is not running.', 'error');
+  }
+
+  const summary = el('div', {id: 'arflex-summary'});
+  const params = el('div', {id: 'arflex-params'});
+  const plots = el('div', {id: 'arflex-plots'});
+  const histo = el('div', {id: 'arflex-histogram'});
+
+  function kv(rows) {
+    return el('table', {class: 'arflex-table'}, rows.map(([k, v]) => el('tr', {}, el('th', {}, k), el('td', {}, v))));
+  }
+
+  function renderSummary(d) {
+    const c = d.contract || {};
+    const i = d.instance || {};
+    const ports = (c.ports || []).map(p => el('tr', {}, el('td', {}, p.direction), el('td', {}, p.name),
+      el('td', {}, p.type + ' ' + p.typeVersion), el('td', {}, p.method), el('td', {}, p.binding || (p.direction === 'IN' ? 'any' : '')),
+      el('td', {}, p.optional ? 'optional' : '')));
+    const bindings = (i.bindings || []).map(b => el('li', {}, b.provider + '.' + b.output + ' → ' + b.consumer + '.' + b.input));
+    const cmd = (what) => el('button', {type: 'button', id: 'arflex-cmd-' + what, onclick: async () => {
+      try { await post('command', {name, cmd: what}); message(status, what + ': done', 'ok'); load(); }
+      catch (e) { message(status, what + ': ' + e.message, 'error'); }
+    }}, what);
+    summary.replaceChildren(
+      el('div', {}, 'State ', stateBadge(i.state), ' target ', i.targetState || '', ' ',
+        i.failureReason ? el('span', {class: 'arflex-reason'}, '— ' + i.failureReason) : '',
+        ' ', cmd('start'), ' ', cmd('stop'), ' ', cmd('reset')),
+      el('h2', {}, 'Contract'),
+      kv([['Name', c.name + ' ' + (c.version || '')], ['Description', c.description || ''],
+        ['Task', (c.taskType || '') + (c.movesHardware ? ' (moves hardware)' : '')],
+        ['Timing', 'period ' + fmtNs(c.periodNs) + ', deadline ' + fmtNs(c.deadlineNs) + ', wcet ' + fmtNs(c.wcetNs) + ', priority ' + c.priority],
+        ['CPUs', (c.cpus || []).join(',') || 'any'], ['Memory', fmtBytes(c.memoryBytes)], ['Network', fmtBytes(c.networkBps) + '/s'],
+        ['Criticality', String(c.criticality)],
+        ['Fault policy', (c.restart || '') + ', ' + c.intensity + ' restarts in ' + c.windowMs + ' ms, backoff ' + c.backoffMs + ' ms, safe output ' + (c.safeOutput || '')],
+        ['Update', c.updateUrl ? c.updateUrl + ' (sha256 ' + c.updateSha256 + ')' : 'none'],
+        ['Source', c.source || ''], ['Bundle', String(c.bundleId)], ['PID / CPU', (i.pid || '-') + ' / ' + (i.cpu >= 0 ? i.cpu : '-')]]),
+      el('h2', {}, 'Ports'),
+      el('table', {class: 'arflex-table'}, el('tr', {}, ['Dir', 'Port', 'Type', 'Method', 'Binding', ''].map(h => el('th', {}, h))), ports),
+      el('h2', {}, 'Bindings'), bindings.length ? el('ul', {}, bindings) : el('p', {}, 'None.'));
+  }
+
+  function renderParams(d) {
+    const i = d.instance || {};
+    const rows = (i.params || []).map(p => {
+      const applied = el('span', {class: 'arflex-applied', id: 'arflex-applied-' + p.name}, p.value);
+      const input = el('input', {type: 'text', id: 'arflex-param-' + p.name, value: p.value, size: 10, disabled: !p.mutable});
+      const err = el('span', {class: 'arflex-field-error'});
+      const apply = el('button', {type: 'button', id: 'arflex-apply-' + p.name, disabled: !p.mutable, onclick: async () => {
+        err.textContent = ''; input.classList.remove('arflex-invalid');
+        try {
+          const r = await post('param', {name, param: p.name, value: input.value});
+          applied.textContent = r.applied;
+          message(status, p.name + ' applied by the RT half: ' + r.applied, 'ok');
+        } catch (e) {
+          err.textContent = e.message; input.classList.add('arflex-invalid');
+        }
+      }}, 'Apply');
+      const range = (p.min !== null && p.min !== undefined ? p.min : '−∞') + ' … ' + (p.max !== null && p.max !== undefined ? p.max : '+∞');
+      return el('tr', {}, el('td', {}, p.name), el('td', {}, p.type), el('td', {}, range), el('td', {}, p.unit || ''),
+        el('td', {}, p.defaultValue), el('td', {}, applied), el('td', {}, p.mutable ? [input, ' ', apply, err] : 'fixed while Active'));
+    });
+    params.replaceChildren(el('h2', {}, 'Parameters'), rows.length ? el('table', {class: 'arflex-table'},
+      el('tr', {}, ['Name', 'Type', 'Range', 'Unit', 'Default', 'Applied', 'Set'].map(h => el('th', {}, h))), rows) : el('p', {}, 'None.'));
+  }
+
+  // Live plot: a rolling window of the streamed samples.
+  const WINDOW = 300;
+  let plot = null; let series = null; let source = null;
+  function startStream() {
+    if (typeof EventSource === 'undefined' || typeof uPlot === 'undefined') return;
+    const keys = ['maxLatencyNs', 'meanExecNs', 'maxExecNs'];
+    series = {t: [], v: keys.map(() => [])};
+    const box = el('div', {class: 'arflex-plot', id: 'arflex-live-plot'});
+    const counter = el('div', {id: 'arflex-live-count'}, 'waiting for samples…');
+    plots.replaceChildren(el('h2', {}, 'Live statistics (10 Hz)'), counter, box);
+    plot = new uPlot({width: 800, height: 240, series: [{}, ...keys.map((k, n) => ({label: k.replace('Ns', ' (µs)'),
+      stroke: ['#c62828', '#1565c0', '#2e7d32'][n]}))], axes: [{}, {label: 'µs'}]}, [[], ...keys.map(() => [])], box);
+    source = new EventSource(Arflex.root + '/api/stream?' + new URLSearchParams({name}));
+    let n = 0;
+    source.onmessage = ev => {
+      const s = JSON.parse(ev.data);
+      if (s.gone) { counter.textContent = 'component gone'; return; }
+      n++;
+      series.t.push(s.t / 1000);
+      keys.forEach((k, j) => series.v[j].push(typeof s[k] === 'number' ? s[k] / 1000 : null));
+      if (series.t.length > WINDOW) { series.t.shift(); series.v.forEach(a => a.shift()); }
+      plot.setData([series.t, ...series.v]);
+      counter.textContent = n + ' samples; cycles ' + (s.cycles ?? '-') + ', state ' + (s.state || '') +
+        ', params ' + Object.entries(s.params || {}).map(([k, v]) => k + '=' + v).join(' ');
+      for (const [k, v] of Object.entries(s.params || {})) {
+        const a = document.getElementById('arflex-applied-' + k);
+        if (a) a.textContent = v;
+      }
+    };
+  }
+
+  let histPlot = null;
+  async function refreshHistogram() {
+    try {
+      const h = await get('histogram', {name});
+      const xs = h.counts.map((_, b) => b);
+      const box = histo.querySelector('.arflex-plot') || el('div', {class: 'arflex-plot'});
+      if (!histPlot && typeof uPlot !== 'undefined') {
+        histo.replaceChildren(el('h2', {}, 'Execution time histogram (means over 100 ms windows, log2 µs buckets)'), box);
+        histPlot = new uPlot({width: 800, height: 200, scales: {x: {time: false}},
+          series: [{label: 'bucket 2^b µs'}, {label: 'windows', stroke: '#1565c0', fill: 'rgba(21,101,192,.3)',
+            paths: uPlot.paths.bars({size: [0.8, 40]})}]}, [xs, h.counts], box);
+      } else if (histPlot) {
+        histPlot.setData([xs, h.counts]);
+      }
+    } catch (e) { /* shown by the stream status */ }
+  }
+
+  async function load() {
+    try {
+      const d = await get('component', {name});
+      renderSummary(d);
+      renderParams(d);
+    } catch (e) {
+      message(status, 'Cannot read component ' + name + ': ' + e.message, 'error');
+    }
+  }
+
+  if (!name) { chooser(); return; }
+  app.replaceChildren(el('h2', {id: 'arflex-component-name'}, 'Component ', el('code', {}, name)), status, summary, params, plots, histo);
+  load().then(startStream);
+  setInterval(refreshHistogram, 2000);
+  window.addEventListener('beforeunload', () => source && source.close());
+})();
