@@ -17,6 +17,17 @@ PACKAGES=(
   python3                                # benchmark reports
 )
 
+# POSIX message queues are listed in /dev/mqueue only when that filesystem is mounted (some
+# containers do not mount it). Tests check there that nothing leaked, so mount it.
+if [ ! -d /dev/mqueue ] || ! grep -q " /dev/mqueue mqueue " /proc/mounts; then
+  if [ "$(id -u)" -eq 0 ]; then
+    mkdir -p /dev/mqueue && mount -t mqueue none /dev/mqueue \
+      || echo "arflex setup: warning: could not mount /dev/mqueue; queue leak checks are weaker" >&2
+  else
+    echo "arflex setup: warning: /dev/mqueue is not mounted (needs root); queue leak checks are weaker" >&2
+  fi
+fi
+
 missing=()
 for p in "${PACKAGES[@]}"; do
   if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
