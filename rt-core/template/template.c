@@ -29,17 +29,16 @@
 #include <stdlib.h>
 
 #include "arflex/component.h"
+#include "arflex_types/sample.h"
 
-/* The C layout of each port type you use (or the generated header from
- * contracts/include/arflex_types/ once it has the type). Fixed-width fields only. */
-struct sample {
-	uint64_t seq;
-	int64_t t_ns;
-	double value;
-};
-_Static_assert(sizeof(struct sample) == 24, "arflex.Sample is 24 bytes");
+/* The C layout of each port type comes from the header generated from its definition
+ * (contracts/types/<type>.xml -> contracts/include/arflex_types/, CMake target arflex_types).
+ * rt-core checks every segment against this descriptor (name, version, size). */
 static const struct arflex_port_type sample_type = {
-	.name = "arflex.Sample", .major = 1, .minor = 0, .elem_size = sizeof(struct sample),
+	.name = ARFLEX_TYPE_SAMPLE_NAME,
+	.major = ARFLEX_TYPE_SAMPLE_VERSION_MAJOR,
+	.minor = ARFLEX_TYPE_SAMPLE_VERSION_MINOR,
+	.elem_size = ARFLEX_TYPE_SAMPLE_SIZE,
 };
 
 /*
@@ -53,7 +52,7 @@ struct template {
 	/* parameter slot indexes, looked up once in configure */
 	int p_gain;
 	/* working state */
-	struct sample last;
+	struct arflex_sample last;
 	/* counters instead of printf in the loop; report them from cleanup */
 	uint64_t no_input_cycles;
 };
@@ -103,7 +102,7 @@ static int template_start(struct arflex_component *c, void *user)
 	struct template *t = user;
 
 	(void)c;
-	t->last = (struct sample){ 0, 0, 0.0 };
+	t->last = (struct arflex_sample){ 0, 0, 0.0 };
 	return 0;
 }
 
@@ -121,7 +120,7 @@ static int template_start(struct arflex_component *c, void *user)
 static int template_update(struct arflex_component *c, void *user, uint64_t release_ns)
 {
 	struct template *t = user;
-	struct sample s;
+	struct arflex_sample s;
 	int ret = arflex_input_state_read(t->in, &s, sizeof(s), NULL);
 
 	(void)release_ns;
@@ -159,7 +158,7 @@ static int template_safe(struct arflex_component *c, void *user, enum arflex_saf
 			 bool first)
 {
 	struct template *t = user;
-	struct sample z = { t->last.seq, (int64_t)arflex_sys_now_ns(), 0.0 };
+	struct arflex_sample z = { t->last.seq, (int64_t)arflex_sys_now_ns(), 0.0 };
 
 	(void)c;
 	(void)first;

@@ -24,17 +24,13 @@
 #include <unistd.h>
 
 #include "arflex/host.h"
+#include "arflex_types/sample.h"
 
 #define SEC UINT64_C(1000000000)
 #define MS UINT64_C(1000000)
 #define CALL_TIMEOUT (2 * SEC)
 #define WAIT_TIMEOUT (15 * SEC)
 
-struct sample {
-	uint64_t seq;
-	int64_t t_ns;
-	double value;
-};
 static const struct arflex_port_type sample_type = { "arflex.Sample", 1, 0, 24 };
 
 static char rid[ARFLEX_ID_MAX + 1];
@@ -80,10 +76,10 @@ static struct arflex_ctl_config config(void)
 }
 
 /* Waits until the port's value has seq >= @min_seq; returns it in *@v. */
-static int wait_seq(struct arflex_port *p, uint64_t min_seq, struct sample *v)
+static int wait_seq(struct arflex_port *p, uint64_t min_seq, struct arflex_sample *v)
 {
 	uint64_t deadline = arflex_sys_now_ns() + WAIT_TIMEOUT;
-	struct sample s;
+	struct arflex_sample s;
 
 	while (arflex_sys_now_ns() < deadline) {
 		if (arflex_state_read(p, &s, sizeof(s), NULL) == 1 && s.seq >= min_seq) {
@@ -112,7 +108,7 @@ static int case_ported(const char *exe)
 		.params = p, .nparams = 3, .outputs = outs, .noutputs = 2,
 	};
 	struct arflex_port vel;
-	struct sample v, u;
+	struct arflex_sample v, u;
 	bool vel_open = false;
 	uint64_t applied;
 	int st;
@@ -177,7 +173,7 @@ static int case_template(const char *exe)
 	CHECK(arflex_host_bind(&h, "in", name, CALL_TIMEOUT) == 0, "BIND in");
 	CHECK(arflex_host_start(&h, CALL_TIMEOUT) == 0, "START");
 	for (uint64_t i = 1; i <= 20; i++) {
-		struct sample in = { i, (int64_t)arflex_sys_now_ns(), 0.25 * (double)i }, got;
+		struct arflex_sample in = { i, (int64_t)arflex_sys_now_ns(), 0.25 * (double)i }, got;
 
 		CHECK(arflex_state_write(&provider, &in, sizeof(in)) == 0, "write in");
 		CHECK(wait_seq(&out, i, &got) == 0, "no output for input %llu",

@@ -59,7 +59,7 @@ static int counter_configure(struct arflex_component *c, void *user)
 
 static int counter_publish(struct counter *k, uint64_t release_ns, double value)
 {
-	struct sample_value s = {
+	struct arflex_sample s = {
 		.seq = ++k->seq,
 		.t_ns = (int64_t)release_ns,
 		.value = value,

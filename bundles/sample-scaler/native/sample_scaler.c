@@ -30,7 +30,7 @@ struct scaler {
 	struct arflex_port *y;
 	enum arflex_port_method y_method;
 	int p_gain;
-	struct sample_value last_in; /* last input value seen */
+	struct arflex_sample last_in; /* last input value seen */
 	bool was_bound;              /* input was bound in the previous cycle */
 };
 
@@ -65,7 +65,7 @@ static int scaler_configure(struct arflex_component *c, void *user)
 	return 0;
 }
 
-static int scaler_emit(struct scaler *k, const struct sample_value *s)
+static int scaler_emit(struct scaler *k, const struct arflex_sample *s)
 {
 	int ret;
 
@@ -77,7 +77,7 @@ static int scaler_emit(struct scaler *k, const struct sample_value *s)
 
 static int scaler_emit_zero(struct scaler *k)
 {
-	struct sample_value z = {
+	struct arflex_sample z = {
 		.seq = k->last_in.seq,
 		.t_ns = (int64_t)arflex_sys_now_ns(),
 		.value = 0.0,
@@ -98,7 +98,7 @@ static int scaler_start(struct arflex_component *c, void *user)
 static int scaler_update(struct arflex_component *c, void *user, uint64_t release_ns)
 {
 	struct scaler *k = user;
-	struct sample_value in, out;
+	struct arflex_sample in, out;
 	int ret;
 
 	(void)release_ns;

@@ -116,7 +116,7 @@ static int make_scaler(double gain)
 /* A reader of one output port of a host, with its own handle (own last_seq). */
 struct reader {
 	struct arflex_port port;
-	struct sample_value v;
+	struct arflex_sample v;
 	uint64_t n; /* new values seen */
 };
 
@@ -143,16 +143,16 @@ static int reader_poll(struct reader *r)
 
 /* Ring of recently seen counter samples, to look an input value up by its seq. */
 #define HIST 8192
-static struct sample_value xhist[HIST];
+static struct arflex_sample xhist[HIST];
 
-static void xhist_put(const struct sample_value *s)
+static void xhist_put(const struct arflex_sample *s)
 {
 	xhist[s->seq % HIST] = *s;
 }
 
-static const struct sample_value *xhist_get(uint64_t seq)
+static const struct arflex_sample *xhist_get(uint64_t seq)
 {
-	const struct sample_value *s = &xhist[seq % HIST];
+	const struct arflex_sample *s = &xhist[seq % HIST];
 
 	return s->seq == seq ? s : NULL;
 }
@@ -298,7 +298,7 @@ static int match_outputs(struct reader *x, struct reader *y, unsigned count, dou
 
 	*n_old = *n_new = 0;
 	while (matched < count && arflex_sys_now_ns() < deadline) {
-		const struct sample_value *in;
+		const struct arflex_sample *in;
 		bool is_new, is_old;
 
 		if (reader_poll(x) == 1)

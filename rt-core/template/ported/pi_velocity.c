@@ -20,18 +20,17 @@
 #include <stdlib.h>
 
 #include "arflex/component.h"
+#include "arflex_types/sample.h"
 
 #define U_MAX 5.0          /* actuator limit */
 #define PLANT_GAIN 2.0
 #define PLANT_TAU 0.05     /* s */
 
-/* arflex.Sample 1.0: u64 seq, i64 t_ns, f64 value (contracts/types/arflex.Sample.xml) */
-struct sample {
-	uint64_t seq;
-	int64_t t_ns;
-	double value;
+/* arflex.Sample 1.0 (struct arflex_sample: u64 seq, i64 t_ns, f64 value) */
+static const struct arflex_port_type sample_type = {
+	ARFLEX_TYPE_SAMPLE_NAME, ARFLEX_TYPE_SAMPLE_VERSION_MAJOR, ARFLEX_TYPE_SAMPLE_VERSION_MINOR,
+	ARFLEX_TYPE_SAMPLE_SIZE,
 };
-static const struct arflex_port_type sample_type = { "arflex.Sample", 1, 0, 24 };
 
 struct pi {
 	/* tuning and command: parameter slots in the control block */
@@ -72,8 +71,8 @@ static void control_step(struct pi *s, double kp, double ki, double setpoint)
 
 static void publish(struct pi *s, uint64_t release_ns)
 {
-	struct sample v = { (uint64_t)s->cycle + 1, (int64_t)release_ns, s->velocity };
-	struct sample c = { (uint64_t)s->cycle + 1, (int64_t)release_ns, s->u };
+	struct arflex_sample v = { (uint64_t)s->cycle + 1, (int64_t)release_ns, s->velocity };
+	struct arflex_sample c = { (uint64_t)s->cycle + 1, (int64_t)release_ns, s->u };
 
 	arflex_state_write(s->velocity_out, &v, sizeof(v));
 	arflex_state_write(s->command_out, &c, sizeof(c));
