@@ -3,7 +3,7 @@
  * API, wired together as the DRCR would wire them (counter.count -> scaler.x).
  *
  *   test_samples <case> <sample-counter exe> <sample-scaler exe>
- *   cases: counter, scale, set_param, unbind
+ *   cases: counter, scale, set_param, unbind, safe
  *
  * Every case creates its objects under its own runtime id, and ends by checking that no
  * /dev/shm/arflex.<rid>.* or /dev/mqueue/arflex.<rid>.* object and no child process is left.
@@ -62,12 +62,18 @@ static struct arflex_param_slot param_f64(const char *name, double def, double l
 	return s;
 }
 
+/* Heartbeat timeout of both instances (0: watchdog off); the safe case sets it. While
+ * keep_hb is true, every poll writes both runtime heartbeats. */
+static uint64_t hb_timeout_ns;
+static bool keep_hb;
+
 static struct arflex_ctl_config test_config(uint32_t safe_mode)
 {
 	struct arflex_ctl_config c;
 
 	memset(&c, 0, sizeof(c));
 	c.period_ns = 1 * MS;
+	c.hb_timeout_ns = hb_timeout_ns;
 	c.priority = 0; /* tests share the machine: SCHED_OTHER */
 	c.safe_mode = safe_mode;
 	c.cfg_flags = ARFLEX_CFG_NO_MLOCK | ARFLEX_CFG_NO_DMA_LATENCY;
@@ -134,7 +140,13 @@ static int reader_open(struct reader *r, struct arflex_host *h, const char *port
 /* 1 if a new value was read into r->v. */
 static int reader_poll(struct reader *r)
 {
-	int ret = arflex_state_read(&r->port, &r->v, sizeof(r->v), NULL);
+	int ret;
+
+	if (keep_hb) {
+		arflex_host_heartbeat(&counter_h);
+		arflex_host_heartbeat(&scaler_h);
+	}
+	ret = arflex_state_read(&r->port, &r->v, sizeof(r->v), NULL);
 
 	if (ret == 1)
 		r->n++;
@@ -476,6 +488,73 @@ out:
 	return 0;
 }
 
+static bool safe_active(struct arflex_host *h)
+{
+	return arflex_ctl_flags(h->ctl) & ARFLEX_FLAG_SAFE_ACTIVE;
+}
+
+/* rt.sample.safe: when the runtime heartbeat stops, the counter holds (count stops changing)
+ * and the scaler drives y to zero every cycle (their contracts' safe modes); when it comes
+ * back both leave safe mode by themselves (they do not move hardware) and scaling resumes. */
+static int case_safe(void)
+{
+	struct reader x, y;
+	unsigned n_old, n_new;
+	uint64_t deadline, zeros;
+	int nopen = 0;
+
+	hb_timeout_ns = 150 * MS;
+	keep_hb = true;
+	CHECK(make_counter() == 0, "counter create/spawn");
+	CHECK(make_scaler(2.5) == 0, "scaler create/spawn");
+	CHECK(reader_open(&x, &counter_h, "count") == 0, "open count");
+	nopen++;
+	CHECK(reader_open(&y, &scaler_h, "y") == 0, "open y");
+	nopen++;
+	CHECK(start_pair(true) == 0, "start");
+	CHECK(match_outputs(&x, &y, 50, 2.5, 2.5, UINT64_MAX, &n_old, &n_new) == 0, "live");
+	CHECK(!safe_active(&counter_h) && !safe_active(&scaler_h), "safe mode while heartbeating");
+	/* The runtime goes silent. */
+	keep_hb = false;
+	deadline = arflex_sys_now_ns() + WAIT_TIMEOUT;
+	while (!(safe_active(&counter_h) && safe_active(&scaler_h)) &&
+	       arflex_sys_now_ns() < deadline)
+		reader_poll(&y);
+	CHECK(safe_active(&counter_h) && safe_active(&scaler_h), "no safe mode without heartbeat");
+	reader_poll(&x); /* the counter's last value before safe mode */
+	/* 50 new y values, all zero; meanwhile no new count value (hold). */
+	zeros = 0;
+	deadline = arflex_sys_now_ns() + WAIT_TIMEOUT;
+	while (zeros < 50 && arflex_sys_now_ns() < deadline) {
+		CHECK(reader_poll(&x) == 0, "count changed in safe mode (hold): seq %llu",
+		      (unsigned long long)x.v.seq);
+		if (reader_poll(&y) == 1) {
+			CHECK(y.v.value == 0.0, "y = %g in safe mode (zero)", y.v.value);
+			zeros++;
+		}
+	}
+	CHECK(zeros == 50, "only %llu zero outputs in safe mode", (unsigned long long)zeros);
+	CHECK(scaler_h.ctl->warnings[ARFLEX_WARN_SAFE] >= 1, "safe warning not counted");
+	/* The runtime is back: safe mode ends by itself, scaling resumes. */
+	keep_hb = true;
+	deadline = arflex_sys_now_ns() + WAIT_TIMEOUT;
+	while ((safe_active(&counter_h) || safe_active(&scaler_h)) &&
+	       arflex_sys_now_ns() < deadline)
+		reader_poll(&y);
+	CHECK(!safe_active(&counter_h) && !safe_active(&scaler_h), "safe mode did not end");
+	CHECK(match_outputs(&x, &y, 50, 2.5, 2.5, UINT64_MAX, &n_old, &n_new) == 0, "resumed");
+	CHECK(arflex_host_shutdown(&scaler_h, CALL_TIMEOUT) == 0, "SHUTDOWN scaler");
+	CHECK(arflex_host_shutdown(&counter_h, CALL_TIMEOUT) == 0, "SHUTDOWN counter");
+out:
+	if (failures)
+		dump();
+	if (nopen > 1)
+		arflex_port_close(&y.port);
+	if (nopen > 0)
+		arflex_port_close(&x.port);
+	return 0;
+}
+
 int main(int argc, char **argv)
 {
 	static const struct {
@@ -486,11 +565,12 @@ int main(int argc, char **argv)
 		{ "scale", case_scale },
 		{ "set_param", case_set_param },
 		{ "unbind", case_unbind },
+		{ "safe", case_safe },
 	};
 	int (*fn)(void) = NULL;
 
 	if (argc != 4) {
-		fprintf(stderr, "usage: %s counter|scale|set_param|unbind <sample-counter> "
+		fprintf(stderr, "usage: %s counter|scale|set_param|unbind|safe <sample-counter> "
 			"<sample-scaler>\n", argv[0]);
 		return 2;
 	}
