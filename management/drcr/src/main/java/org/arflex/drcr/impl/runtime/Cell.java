@@ -392,6 +392,13 @@ public final class Cell {
                 log.accept("arflex: " + inst.name + ": " + e.getMessage());
             }
         }
+        if (!inst.bound.isEmpty()) {
+            // Let the RT thread see the lost inputs and run its safe behaviour before STOP.
+            long periods = 3 * inst.contract.timing().periodNs() / 1_000_000L;
+            if (!half.awaitCycles(2, Math.max(100, periods))) {
+                log.accept("arflex: " + inst.name + ": no RT cycle after UNBIND; stopping anyway");
+            }
+        }
         inst.bound.clear();
         half.shutdown(cfg.shutdownMs());
         inst.cpu = -1;

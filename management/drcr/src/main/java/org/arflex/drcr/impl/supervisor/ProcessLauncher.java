@@ -218,6 +218,29 @@ public final class ProcessLauncher implements RtLauncher {
         }
 
         @Override
+        public boolean awaitCycles(int n, long timeoutMs) {
+            long deadline = System.nanoTime() + timeoutMs * 1_000_000L;
+            long first = -1;
+            while (System.nanoTime() - deadline < 0 && process.isAlive()) {
+                synchronized (this) {
+                    if (cleaned || ctl.state() != ControlBlock.STATE_RUNNING) {
+                        return false;
+                    }
+                    ControlBlock.Stats s = ctl.stats(0);
+                    if (s != null) {
+                        if (first < 0) {
+                            first = s.cycles();
+                        } else if (s.cycles() - first >= n) {
+                            return true;
+                        }
+                    }
+                }
+                LockSupport.parkNanos(200_000);
+            }
+            return false;
+        }
+
+        @Override
         public void start() throws IOException {
             call(Mailbox.Cmd.START);
         }

@@ -23,6 +23,14 @@ public interface RtHalf {
     /** UNBIND input {@code port}. */
     void unbind(String port) throws IOException;
 
+    /**
+     * Waits until the RT loop completed {@code n} more cycles (so a change such as an UNBIND
+     * reached the RT thread and its safe behaviour ran), at most {@code timeoutMs}.
+     *
+     * @return false on timeout or when the half is not running
+     */
+    boolean awaitCycles(int n, long timeoutMs);
+
     /** START the RT loop. */
     void start() throws IOException;
 

@@ -57,6 +57,12 @@ final class FakeLauncher implements RtLauncher {
         }
 
         @Override
+        public boolean awaitCycles(int n, long timeoutMs) {
+            events.add(inst + " AWAIT " + n);
+            return started;
+        }
+
+        @Override
         public void start() {
             started = true;
             events.add(inst + " START");
