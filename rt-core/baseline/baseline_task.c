@@ -301,7 +301,7 @@ static void print_table(const struct opts *o, const struct result *r, struct sum
 {
 	const struct arflex_metric *m = &r->lat;
 
-	char cpu[16];
+	char cpu[32];
 
 	if (o->cpu >= 0)
 		snprintf(cpu, sizeof(cpu), "%d%s", o->cpu, r->pinned ? "" : " (refused)");
