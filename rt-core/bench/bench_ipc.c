@@ -606,7 +606,7 @@ int main(int argc, char **argv)
 	struct shared *sh = MAP_FAILED;
 	uint64_t *samples = MAP_FAILED; /* shared: the child writes the one-way samples */
 	uint64_t *mq_samples[2] = { NULL, NULL };
-	size_t samples_len;
+	size_t samples_len = 0;
 	struct arflex_port port;
 	bool port_ok = false, mb_ok = false;
 	struct arflex_mailbox mb;
