@@ -91,6 +91,14 @@ public final class Admission {
     private static final class Entry {
         final Schedulability.Task task;
         long r; // a lower bound of the response time (exact after final analysis); -1 unknown
+        /**
+         * Processor demand in a window of length D: {@code C + sum ceil(D/Tj) Cj} over the other
+         * tasks of higher or equal priority on the CPU. When it is at most D the response time is
+         * at most D (the iteration cannot pass a point where demand fits), so exact analysis is
+         * only needed for tasks whose demand exceeds their deadline. Kept up to date in O(1) per
+         * task added.
+         */
+        long demand;
 
         Entry(Schedulability.Task task) {
             this.task = task;
@@ -99,7 +107,11 @@ public final class Admission {
     }
 
     /** The outcome of testing one task on one CPU. */
-    private record Fit(boolean ok, String reason, Map<Entry, Long> newR) {
+    private record Fit(boolean ok, String reason, Map<Entry, Long> newR, Map<Entry, Long> newDemand) {
+    }
+
+    private static long ceilDiv(long a, long b) {
+        return (a + b - 1) / b;
     }
 
     private static final class Cpu {
@@ -145,8 +157,23 @@ public final class Admission {
             util += t.utilisation();
             prioByPeriod.put(t.periodNs(), oldPrio == null ? new int[] {t.priority(), t.priority()}
                     : new int[] {Math.min(oldPrio[0], t.priority()), Math.max(oldPrio[1], t.priority())});
+            long d = t.wcetNs();
+            List<Entry> delayed = new ArrayList<>();
+            for (Entry x : tasks) {
+                if (x.task.priority() >= t.priority()) {
+                    d += ceilDiv(t.deadlineNs(), x.task.periodNs()) * x.task.wcetNs();
+                }
+                if (x.task.priority() <= t.priority()) {
+                    x.demand += ceilDiv(x.task.deadlineNs(), t.periodNs()) * t.wcetNs();
+                    delayed.add(x);
+                }
+            }
+            e.demand = d;
             tasks.add(e);
             return () -> {
+                for (Entry x : delayed) {
+                    x.demand -= ceilDiv(x.task.deadlineNs(), t.periodNs()) * t.wcetNs();
+                }
                 tasks.remove(e);
                 rmOk = oldRm;
                 hyper = oldHyper;
@@ -174,26 +201,40 @@ public final class Admission {
             double u = util + t.utilisation();
             if (u > cap + 1e-9) {
                 return new Fit(false, "cpu " + id + ": utilisation " + Text.util(u) + " with '" + t.name()
-                        + "' exceeds cap " + Text.util(cap), Map.of());
+                        + "' exceeds cap " + Text.util(cap), Map.of(), Map.of());
             }
             if (rmOkWith(t) && hyper * (t.utilisation() + 1) <= 2 + 1e-12) {
-                return new Fit(true, null, Map.of());
+                return new Fit(true, null, Map.of(), Map.of());
             }
-            List<Schedulability.Task> all = taskList(t);
+            List<Schedulability.Task> all = null;
             Map<Entry, Long> newR = new HashMap<>();
+            Map<Entry, Long> newDemand = new HashMap<>();
             // The new task first, then the tasks it can delay (lower or equal priority), most
             // urgent first, so the first miss reported is the most telling one.
             Entry fresh = new Entry(t);
+            long d0 = t.wcetNs();
+            for (Entry e : tasks) {
+                if (e.task.priority() >= t.priority()) {
+                    d0 += ceilDiv(t.deadlineNs(), e.task.periodNs()) * e.task.wcetNs();
+                }
+            }
+            newDemand.put(fresh, d0);
             List<Entry> affected = new ArrayList<>();
-            affected.add(fresh);
             for (Entry e : tasks) {
                 if (e.task.priority() <= t.priority()) {
                     affected.add(e);
+                    newDemand.put(e, e.demand + ceilDiv(e.task.deadlineNs(), t.periodNs()) * t.wcetNs());
                 }
             }
-            affected.subList(1, affected.size()).sort(Comparator.comparingInt((Entry e) -> -e.task.priority())
-                    .thenComparing(e -> e.task.name()));
+            affected.sort(Comparator.comparingInt((Entry e) -> -e.task.priority()).thenComparing(e -> e.task.name()));
+            affected.add(0, fresh);
             for (Entry e : affected) {
+                if (newDemand.get(e) <= e.task.deadlineNs()) {
+                    continue; // demand within the deadline: R <= D without iterating
+                }
+                if (all == null) {
+                    all = taskList(t);
+                }
                 long start = Math.max(e.r, e.task.wcetNs());
                 long r = Schedulability.responseTime(e.task, all, start);
                 if (r < 0) {
@@ -202,11 +243,11 @@ public final class Admission {
                     String who = e == fresh ? rt + " of '" + t.name() + "'"
                             : "adding '" + t.name() + "' gives " + rt + " of '" + e.task.name() + "', which";
                     return new Fit(false, "cpu " + id + ": " + who + " exceeds deadline "
-                            + Text.duration(e.task.deadlineNs()) + " (U=" + Text.util(u) + ")", Map.of());
+                            + Text.duration(e.task.deadlineNs()) + " (U=" + Text.util(u) + ")", Map.of(), Map.of());
                 }
                 newR.put(e, r);
             }
-            return new Fit(true, null, newR);
+            return new Fit(true, null, newR, newDemand);
         }
 
         String testName() {

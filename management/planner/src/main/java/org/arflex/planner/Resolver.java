@@ -71,6 +71,8 @@ public final class Resolver {
         final String filterError;
         final TreeSet<Out> candidates = new TreeSet<>();
         Wire wire;
+        /** The index set this input is registered in, if any. */
+        Set<In> home;
 
         In(String consumer, PortSpec spec) {
             this.consumer = consumer;
@@ -128,7 +130,14 @@ public final class Resolver {
     }
 
     private final Map<String, Node> nodes = new HashMap<>();
+    /** Inputs without a rule, or with a filter that has no equality to index, by port type. */
     private final Map<String, Set<In>> inputsByType = new HashMap<>();
+    /** Outputs by port type, then by each {@code lower-case-key=value} attribute of their component. */
+    private final Map<String, Map<String, Set<Out>>> outputsByHint = new HashMap<>();
+    /** Inputs with an explicit rule, by the provider component they name. */
+    private final Map<String, Set<In>> explicitByProvider = new HashMap<>();
+    /** Inputs with a filter that requires {@code key=value}, by port type, then by that equality. */
+    private final Map<String, Map<String, Set<In>>> filterByHint = new HashMap<>();
     private final Map<String, Set<Out>> outputsByType = new HashMap<>();
     /** provider name -> inputs that have one of its outputs as a candidate. */
     private final Map<String, Set<In>> candidateOf = new HashMap<>();
@@ -234,7 +243,9 @@ public final class Resolver {
     private void detach(String name, Change ch) {
         Node node = nodes.remove(name);
         for (In in : node.inputs) {
-            inputsByType.get(in.spec.type()).remove(in);
+            if (in.home != null) {
+                in.home.remove(in);
+            }
             for (Out o : in.candidates) {
                 Set<In> s = candidateOf.get(o.component());
                 if (s != null) {
@@ -246,7 +257,19 @@ public final class Resolver {
             }
         }
         for (PortSpec p : node.contract.outputs()) {
-            outputsByType.get(p.type()).remove(new Out(name, p));
+            Out out = new Out(name, p);
+            outputsByType.get(p.type()).remove(out);
+            Map<String, Set<Out>> byHint = outputsByHint.get(p.type());
+            for (Map.Entry<String, String> a : node.contract.attributes().entrySet()) {
+                Set<Out> set = byHint.get(hintOf(a));
+                if (set == null) {
+                    continue; // two keys differing only in case, with the same value
+                }
+                set.remove(out);
+                if (set.isEmpty()) {
+                    byHint.remove(hintOf(a));
+                }
+            }
         }
         Set<In> fed = candidateOf.remove(name);
         if (fed != null) {
@@ -268,20 +291,22 @@ public final class Resolver {
         for (PortSpec p : c.outputs()) {
             Out out = new Out(c.name(), p);
             outputsByType.computeIfAbsent(p.type(), k -> new HashSet<>()).add(out);
-            Set<In> ins = inputsByType.get(p.type());
-            if (ins != null) {
-                for (In in : ins) {
-                    if (matches(in, c, p)) {
-                        in.candidates.add(out);
-                        candidateOf.computeIfAbsent(c.name(), k -> new HashSet<>()).add(in);
-                        rewire(in, ch);
-                        ch.dirty.add(in.consumer);
-                    }
+            Map<String, Set<Out>> byHint = outputsByHint.computeIfAbsent(p.type(), k -> new HashMap<>());
+            for (Map.Entry<String, String> a : c.attributes().entrySet()) {
+                byHint.computeIfAbsent(hintOf(a), k -> new HashSet<>()).add(out);
+            }
+            // Only the inputs that could accept this output are looked at.
+            offer(inputsByType.get(p.type()), c, p, out, ch);
+            offer(explicitByProvider.get(c.name()), c, p, out, ch);
+            Map<String, Set<In>> hinted = filterByHint.get(p.type());
+            if (hinted != null) {
+                for (Map.Entry<String, String> a : c.attributes().entrySet()) {
+                    offer(hinted.get(hintOf(a)), c, p, out, ch);
                 }
             }
         }
         for (In in : node.inputs) {
-            inputsByType.computeIfAbsent(in.spec.type(), k -> new HashSet<>()).add(in);
+            index(in);
             if (in.explicit()) {
                 Node p = nodes.get(in.explicitComponent());
                 if (p != null) {
@@ -292,7 +317,13 @@ public final class Resolver {
                     });
                 }
             } else {
-                Set<Out> outs = outputsByType.get(in.spec.type());
+                Set<Out> outs;
+                if (in.filter != null && in.filter.equalityHint().isPresent()) {
+                    Map<String, Set<Out>> byHint = outputsByHint.get(in.spec.type());
+                    outs = byHint == null ? null : byHint.get(in.filter.equalityHint().get());
+                } else {
+                    outs = outputsByType.get(in.spec.type());
+                }
                 if (outs != null) {
                     for (Out o : outs) {
                         if (!o.component().equals(c.name()) && matches(in, nodes.get(o.component()).contract, o.spec())) {
@@ -305,6 +336,40 @@ public final class Resolver {
         }
         ch.dirty.add(c.name());
         return node;
+    }
+
+    private static String hintOf(Map.Entry<String, String> attribute) {
+        return attribute.getKey().toLowerCase(java.util.Locale.ROOT) + "=" + attribute.getValue();
+    }
+
+    private void offer(Set<In> ins, Contract c, PortSpec p, Out out, Change ch) {
+        if (ins == null) {
+            return;
+        }
+        for (In in : ins) {
+            if (matches(in, c, p)) {
+                in.candidates.add(out);
+                candidateOf.computeIfAbsent(c.name(), k -> new HashSet<>()).add(in);
+                rewire(in, ch);
+                ch.dirty.add(in.consumer);
+            }
+        }
+    }
+
+    private void index(In in) {
+        if (in.filterError != null) {
+            in.home = null; // matches nothing; nothing to index
+        } else if (in.explicit()) {
+            in.home = explicitByProvider.computeIfAbsent(in.explicitComponent(), k -> new HashSet<>());
+        } else if (in.filter != null && in.filter.equalityHint().isPresent()) {
+            in.home = filterByHint.computeIfAbsent(in.spec.type(), k -> new HashMap<>())
+                    .computeIfAbsent(in.filter.equalityHint().get(), k -> new HashSet<>());
+        } else {
+            in.home = inputsByType.computeIfAbsent(in.spec.type(), k -> new HashSet<>());
+        }
+        if (in.home != null) {
+            in.home.add(in);
+        }
     }
 
     private void addCandidate(In in, Out o) {

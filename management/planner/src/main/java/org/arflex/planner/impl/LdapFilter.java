@@ -39,7 +39,9 @@ public final class LdapFilter {
         if (p.pos != p.s.length()) {
             throw p.error("unexpected text after the filter");
         }
-        return new LdapFilter(n, text);
+        LdapFilter f = new LdapFilter(n, text);
+        f.hint = p.hint;
+        return f;
     }
 
     /** True when the attributes match. */
@@ -69,24 +71,58 @@ public final class LdapFilter {
         return null;
     }
 
-    private static int compare(String actual, String wanted) {
-        try {
-            return Double.compare(Double.parseDouble(actual.trim()), Double.parseDouble(wanted.trim()));
-        } catch (NumberFormatException e) {
-            return actual.compareTo(wanted);
+    /** True when the text is a plain decimal number (checked before parsing: no exceptions on the hot path). */
+    static boolean numeric(String s) {
+        String t = s.trim();
+        if (t.isEmpty() || t.length() > 40) {
+            return false;
         }
+        boolean digit = false;
+        for (int i = 0; i < t.length(); i++) {
+            char c = t.charAt(i);
+            if (c >= '0' && c <= '9') {
+                digit = true;
+            } else if (!(c == '.' || c == 'e' || c == 'E' || ((c == '-' || c == '+') && (i == 0
+                    || t.charAt(i - 1) == 'e' || t.charAt(i - 1) == 'E')))) {
+                return false;
+            }
+        }
+        if (!digit) {
+            return false;
+        }
+        try {
+            Double.parseDouble(t);
+            return true;
+        } catch (NumberFormatException e) {
+            return false;
+        }
+    }
+
+    private static int compare(String actual, String wanted) {
+        if (numeric(actual) && numeric(wanted)) {
+            return Double.compare(Double.parseDouble(actual.trim()), Double.parseDouble(wanted.trim()));
+        }
+        return actual.compareTo(wanted);
     }
 
     private static boolean equalValue(String actual, String wanted) {
         if (actual.equals(wanted)) {
             return true;
         }
-        try {
-            return Double.parseDouble(actual.trim()) == Double.parseDouble(wanted.trim());
-        } catch (NumberFormatException e) {
-            return false;
-        }
+        return numeric(actual) && numeric(wanted)
+                && Double.parseDouble(actual.trim()) == Double.parseDouble(wanted.trim());
     }
+
+    /**
+     * An equality every matching attribute set must satisfy, as {@code lower-case-key=value},
+     * for indexing: the filter itself or an operand of a top-level {@code &} of the form
+     * {@code (key=value)} with a non-numeric value and no wildcard. Empty when there is none.
+     */
+    public java.util.Optional<String> equalityHint() {
+        return java.util.Optional.ofNullable(hint);
+    }
+
+    private String hint;
 
     private static String squash(String s) {
         return s.replaceAll("\\s+", "").toLowerCase(Locale.ROOT);
@@ -96,6 +132,9 @@ public final class LdapFilter {
         private static final int MAX_DEPTH = 32;
         final String s;
         int pos;
+        /** First equality found at depth 0 or directly under a top-level '&'. */
+        String hint;
+        private int andDepth = -1;
 
         Parser(String s) {
             this.s = s;
@@ -116,6 +155,9 @@ public final class LdapFilter {
             char c = s.charAt(pos);
             Node n;
             if (c == '&' || c == '|') {
+                if (c == '&' && depth == 0) {
+                    andDepth = 1;
+                }
                 pos++;
                 List<Node> parts = new ArrayList<>();
                 while (pos < s.length() && s.charAt(pos) == '(') {
@@ -144,7 +186,7 @@ public final class LdapFilter {
                 Node inner = filter(depth + 1);
                 n = a -> !inner.eval(a);
             } else {
-                n = item();
+                n = item(depth == 0 || depth == andDepth);
             }
             expect(')');
             return n;
@@ -157,7 +199,7 @@ public final class LdapFilter {
             pos++;
         }
 
-        Node item() {
+        Node item(boolean necessary) {
             int start = pos;
             while (pos < s.length() && "=<>~()".indexOf(s.charAt(pos)) < 0) {
                 pos++;
@@ -199,6 +241,9 @@ public final class LdapFilter {
             List<String> pieces = value(true);
             if (pieces.size() == 1) {
                 String v = pieces.get(0);
+                if (necessary && hint == null && !numeric(v)) {
+                    hint = attr.toLowerCase(Locale.ROOT) + "=" + v;
+                }
                 return a -> {
                     String x = lookup(a, attr);
                     return x != null && equalValue(x, v);

@@ -1,0 +1,331 @@
+package org.arflex.planner.bench;
+
+import java.io.IOException;
+import java.nio.file.Files;
+import java.nio.file.Path;
+import java.util.ArrayList;
+import java.util.Arrays;
+import java.util.LinkedHashMap;
+import java.util.List;
+import java.util.Locale;
+import java.util.Map;
+import java.util.Optional;
+import java.util.Random;
+import org.arflex.contract.Binding;
+import org.arflex.contract.Contract;
+import org.arflex.contract.FaultPolicy;
+import org.arflex.contract.PortSpec;
+import org.arflex.contract.Resources;
+import org.arflex.contract.Timing;
+import org.arflex.contract.TypeVersion;
+import org.arflex.planner.Admission;
+import org.arflex.planner.AdmissionResult;
+import org.arflex.planner.Capacities;
+import org.arflex.planner.Change;
+import org.arflex.planner.Planner;
+import org.arflex.planner.ResolveDelta;
+import org.arflex.planner.Resolver;
+
+/**
+ * Benchmark of the planner on synthetic cells of 100, 1,000 and 10,000 components (not a test).
+ *
+ * <p>Graph: chains of 20 components (each link reads the previous one) and, every tenth
+ * component, a fan-in aggregator reading 4 to 8 earlier components; 12 shared port types
+ * (versions 1.0 to 1.2, state/stream/frame), inputs bound explicitly (60%), by a filter on an
+ * {@code id} attribute (30%) or by a unique port type without rule (10%), 5% optional. Timing:
+ * 30% periodic, 10% sporadic, 60% service; periods 1 to 100 ms with rate-monotonic priorities,
+ * 2% constrained deadlines (which force response-time analysis on their CPU); 16 CPUs.
+ *
+ * <p>Measures: full resolve (one batch), full admission, full plan ({@link Planner#apply} of
+ * the install of everything) and incremental resolver changes (add a leaf consumer, remove it,
+ * replace a middle component by a new version, remove a middle component and put it back),
+ * plus an incremental {@link Planner#plan} of one install. Prints a table and writes JSON.
+ *
+ * <p>Run: {@code mvn -q -o -pl management/planner exec:java -Dexec.classpathScope=test
+ * -Dexec.mainClass=org.arflex.planner.bench.PlannerBench [-Dexec.args=out.json]}.
+ */
+public final class PlannerBench {
+
+    private static final String[] TYPES = {"arflex.JointState", "arflex.Pose", "arflex.Image", "arflex.Sample",
+        "arflex.Wrench", "arflex.Trajectory", "arflex.Twist", "arflex.Correction", "arflex.Status",
+        "arflex.PointCloud", "arflex.Io", "arflex.Gripper"};
+    private static final long MS = 1_000_000L;
+    private static final long[] PERIODS = {1 * MS, 2 * MS, 5 * MS, 10 * MS, 20 * MS, 50 * MS, 100 * MS};
+
+    private PlannerBench() {
+    }
+
+    static PortSpec.Method methodOf(int type) {
+        return type == 2 ? PortSpec.Method.FRAME : type == 9 ? PortSpec.Method.STREAM : PortSpec.Method.STATE;
+    }
+
+    static Contract component(int i, int n, Random rnd, String version) {
+        String name = "c" + i;
+        List<PortSpec> ports = new ArrayList<>();
+        int type = i % TYPES.length;
+        ports.add(new PortSpec("out", PortSpec.Direction.OUT, TYPES[type], new TypeVersion(1, 2), methodOf(type), 4,
+                PortSpec.Overflow.DROP_OLDEST, Optional.empty(), false));
+        ports.add(new PortSpec("u", PortSpec.Direction.OUT, "bench.U" + i, new TypeVersion(1, 0), PortSpec.Method.STATE,
+                1, PortSpec.Overflow.DROP_OLDEST, Optional.empty(), false));
+        List<Integer> providers = new ArrayList<>();
+        if (i % 20 != 0) {
+            providers.add(i - 1);
+        }
+        if (i % 10 == 9 && i > 20) {
+            int k = 4 + rnd.nextInt(5);
+            for (int j = 0; j < k; j++) {
+                int p = rnd.nextInt(i - 1);
+                if (!providers.contains(p)) {
+                    providers.add(p);
+                }
+            }
+        }
+        int idx = 0;
+        for (int p : providers) {
+            int r = rnd.nextInt(10);
+            int ptype = p % TYPES.length;
+            Optional<Binding> b;
+            String portType = TYPES[ptype];
+            PortSpec.Method m = methodOf(ptype);
+            TypeVersion v = new TypeVersion(1, rnd.nextInt(3));
+            if (r < 6) {
+                b = Optional.of(Binding.explicit("c" + p, "out"));
+            } else if (r < 9) {
+                b = Optional.of(Binding.filter("(id=c" + p + ")"));
+            } else {
+                b = Optional.empty();
+                portType = "bench.U" + p;
+                m = PortSpec.Method.STATE;
+                v = new TypeVersion(1, 0);
+            }
+            ports.add(new PortSpec("in" + idx++, PortSpec.Direction.IN, portType, v, m, 4, PortSpec.Overflow.DROP_OLDEST,
+                    b, rnd.nextInt(20) == 0));
+        }
+        int kind = rnd.nextInt(10);
+        Contract.TaskType tt = kind < 3 ? Contract.TaskType.PERIODIC
+                : kind < 4 ? Contract.TaskType.SPORADIC : Contract.TaskType.SERVICE;
+        int pi = rnd.nextInt(PERIODS.length);
+        long period = PERIODS[pi];
+        long deadline = rnd.nextInt(50) == 0 ? period / 2 : period;
+        // About 0.15% of a CPU each: 10,000 components put ~0.3 on each of 16 CPUs.
+        long wcet = Math.max(1000, period * (5 + rnd.nextInt(20)) / 10_000);
+        int prio = 90 - pi * 10;
+        Timing timing = new Timing(period, deadline, wcet, prio, List.of());
+        return new Contract(name, version, "", name + "-rt", tt, false, Map.of("id", name), ports, List.of(), timing,
+                new Resources(1L << 20, 1000), 1 + rnd.nextInt(5),
+                new FaultPolicy(FaultPolicy.Restart.PERMANENT, 3, 10_000, 100, FaultPolicy.SafeOutput.HOLD, 500),
+                Optional.empty(), "bench");
+    }
+
+    static List<Contract> graph(int n, long seed) {
+        Random rnd = new Random(seed);
+        List<Contract> cs = new ArrayList<>(n);
+        for (int i = 0; i < n; i++) {
+            cs.add(component(i, n, rnd, "1.0.0"));
+        }
+        return cs;
+    }
+
+    static Capacities caps(int n) {
+        return Capacities.of(16, 0.9, (long) n * 4 << 20, (long) n * 10_000);
+    }
+
+    record Stats(double meanUs, double p50Us, double p99Us, double maxUs) {
+        static Stats of(long[] ns) {
+            long[] s = ns.clone();
+            Arrays.sort(s);
+            double sum = 0;
+            for (long v : s) {
+                sum += v;
+            }
+            return new Stats(sum / s.length / 1e3, s[s.length / 2] / 1e3, s[(int) Math.min(s.length - 1,
+                    Math.ceil(s.length * 0.99) - 1)] / 1e3, s[s.length - 1] / 1e3);
+        }
+    }
+
+    public static void main(String[] args) throws IOException {
+        Path out = Path.of(args.length > 0 ? args[0] : "target/planner-bench.json");
+        int[] sizes = {100, 1_000, 10_000};
+        Map<String, Object> json = new LinkedHashMap<>();
+        json.put("java", System.getProperty("java.version"));
+        json.put("cpus", Runtime.getRuntime().availableProcessors());
+        List<Map<String, Object>> rows = new ArrayList<>();
+        // Warm-up: the whole procedure on the middle size, twice.
+        for (int w = 0; w < 2; w++) {
+            run(1_000, 3, 100, false);
+        }
+        System.out.printf(Locale.ROOT, "%-7s %-28s %10s %10s %10s %10s%n", "n", "operation", "mean", "p50", "p99", "max");
+        for (int n : sizes) {
+            int fullReps = n >= 10_000 ? 5 : 10;
+            rows.addAll(run(n, fullReps, 300, true));
+        }
+        json.put("results", rows);
+        Files.createDirectories(out.toAbsolutePath().getParent());
+        Files.writeString(out, toJson(json));
+        System.out.println("wrote " + out.toAbsolutePath());
+    }
+
+    static List<Map<String, Object>> run(int n, int fullReps, int incReps, boolean print) {
+        List<Contract> cs = graph(n, 7);
+        Capacities caps = caps(n);
+        List<Map<String, Object>> rows = new ArrayList<>();
+        long[] resolve = new long[fullReps];
+        long[] admit = new long[fullReps];
+        long[] plan = new long[fullReps];
+        Resolver r = null;
+        AdmissionResult adm = null;
+        for (int k = 0; k < fullReps; k++) {
+            long t0 = System.nanoTime();
+            r = new Resolver();
+            r.apply(cs, List.of());
+            long t1 = System.nanoTime();
+            adm = Admission.admit(r, caps, Map.of());
+            long t2 = System.nanoTime();
+            resolve[k] = t1 - t0;
+            admit[k] = t2 - t1;
+            long t3 = System.nanoTime();
+            Planner p = new Planner(caps);
+            p.apply(Change.install(cs.toArray(new Contract[0])));
+            plan[k] = System.nanoTime() - t3;
+        }
+        long[] full = new long[fullReps];
+        for (int k = 0; k < fullReps; k++) {
+            full[k] = resolve[k] + admit[k];
+        }
+        int satisfied = r.satisfied().size();
+        int admitted = adm.admitted().size();
+        rows.add(row(n, "full resolve", Stats.of(resolve), Map.of("satisfied", satisfied, "wires", r.wires().size())));
+        rows.add(row(n, "full admission", Stats.of(admit), Map.of("admitted", admitted,
+                "rtaCpus", adm.cpus().stream().filter(c -> c.test().startsWith("response")).count())));
+        rows.add(row(n, "full resolve+admit", Stats.of(full), Map.of()));
+        rows.add(row(n, "full plan (Planner.apply)", Stats.of(plan), Map.of()));
+
+        // Incremental resolver changes on the resolved cell.
+        Random rnd = new Random(11);
+        long[] add = new long[incReps];
+        long[] remove = new long[incReps];
+        long[] replace = new long[incReps];
+        long[] removeMid = new long[incReps];
+        long[] putBack = new long[incReps];
+        long touchedAdd = 0;
+        long touchedReplace = 0;
+        long touchedRemoveMid = 0;
+        for (int k = 0; k < incReps; k++) {
+            int target = rnd.nextInt(n);
+            Contract leaf = leaf("leaf" + k, target);
+            long t0 = System.nanoTime();
+            ResolveDelta d = r.put(leaf);
+            long t1 = System.nanoTime();
+            r.remove(leaf.name());
+            long t2 = System.nanoTime();
+            add[k] = t1 - t0;
+            remove[k] = t2 - t1;
+            touchedAdd += d.touched();
+            int mid = rnd.nextInt(n);
+            Contract old = r.contract("c" + mid).get();
+            Contract bumped = new Contract(old.name(), "1.0." + (k + 1), old.description(), old.executable(),
+                    old.taskType(), old.movesHardware(), old.attributes(), old.ports(), old.properties(), old.timing(),
+                    old.resources(), old.criticality(), old.fault(), old.update(), old.source());
+            long t3 = System.nanoTime();
+            d = r.put(bumped);
+            long t4 = System.nanoTime();
+            replace[k] = t4 - t3;
+            touchedReplace += d.touched();
+            long t5 = System.nanoTime();
+            d = r.remove(bumped.name());
+            long t6 = System.nanoTime();
+            r.put(old);
+            long t7 = System.nanoTime();
+            removeMid[k] = t6 - t5;
+            putBack[k] = t7 - t6;
+            touchedRemoveMid += d.touched();
+        }
+        rows.add(row(n, "add one (leaf)", Stats.of(add), Map.of("meanTouched", touchedAdd / (double) incReps)));
+        rows.add(row(n, "remove one (leaf)", Stats.of(remove), Map.of()));
+        rows.add(row(n, "replace one (middle)", Stats.of(replace),
+                Map.of("meanTouched", touchedReplace / (double) incReps)));
+        rows.add(row(n, "remove one (middle)", Stats.of(removeMid),
+                Map.of("meanTouched", touchedRemoveMid / (double) incReps)));
+        rows.add(row(n, "put it back (middle)", Stats.of(putBack), Map.of()));
+
+        // A whole incremental plan (dry run of one install): resolver change + admission of all.
+        Planner p = new Planner(caps);
+        p.apply(Change.install(cs.toArray(new Contract[0])));
+        int planReps = n >= 10_000 ? 20 : 100;
+        long[] planOne = new long[planReps];
+        for (int k = 0; k < planReps; k++) {
+            Contract leaf = leaf("leaf" + k, rnd.nextInt(n));
+            long t0 = System.nanoTime();
+            p.plan(Change.install(leaf));
+            planOne[k] = System.nanoTime() - t0;
+        }
+        rows.add(row(n, "plan one install (dry run)", Stats.of(planOne), Map.of()));
+        if (print) {
+            for (Map<String, Object> row : rows) {
+                System.out.printf(Locale.ROOT, "%-7d %-28s %10s %10s %10s %10s%n", n, row.get("operation"),
+                        fmt((double) row.get("meanUs")), fmt((double) row.get("p50Us")), fmt((double) row.get("p99Us")),
+                        fmt((double) row.get("maxUs")));
+            }
+        }
+        return rows;
+    }
+
+    static Contract leaf(String name, int target) {
+        int ptype = target % TYPES.length;
+        PortSpec in = new PortSpec("in", PortSpec.Direction.IN, TYPES[ptype], new TypeVersion(1, 0), methodOf(ptype), 4,
+                PortSpec.Overflow.DROP_OLDEST, Optional.of(Binding.explicit("c" + target, "out")), false);
+        return new Contract(name, "1.0.0", "", name + "-rt", Contract.TaskType.PERIODIC, false, Map.of("id", name),
+                List.of(in), List.of(), new Timing(10 * MS, 10 * MS, 10_000, 50, List.of()), new Resources(1L << 20, 0), 1,
+                new FaultPolicy(FaultPolicy.Restart.PERMANENT, 3, 10_000, 100, FaultPolicy.SafeOutput.HOLD, 500),
+                Optional.empty(), "bench");
+    }
+
+    static String fmt(double us) {
+        return us >= 1000 ? String.format(Locale.ROOT, "%.1f ms", us / 1000) : String.format(Locale.ROOT, "%.1f us", us);
+    }
+
+    static Map<String, Object> row(int n, String op, Stats s, Map<String, Object> extra) {
+        Map<String, Object> m = new LinkedHashMap<>();
+        m.put("n", n);
+        m.put("operation", op);
+        m.put("meanUs", s.meanUs());
+        m.put("p50Us", s.p50Us());
+        m.put("p99Us", s.p99Us());
+        m.put("maxUs", s.maxUs());
+        m.putAll(new java.util.TreeMap<>(extra));
+        return m;
+    }
+
+    static String toJson(Object o) {
+        StringBuilder sb = new StringBuilder();
+        write(sb, o, "");
+        return sb.append('\n').toString();
+    }
+
+    private static void write(StringBuilder sb, Object o, String indent) {
+        if (o instanceof Map<?, ?> m) {
+            sb.append("{\n");
+            int i = 0;
+            for (Map.Entry<?, ?> e : m.entrySet()) {
+                sb.append(indent).append("  \"").append(e.getKey()).append("\": ");
+                write(sb, e.getValue(), indent + "  ");
+                sb.append(++i < m.size() ? ",\n" : "\n");
+            }
+            sb.append(indent).append('}');
+        } else if (o instanceof List<?> l) {
+            sb.append("[\n");
+            for (int i = 0; i < l.size(); i++) {
+                sb.append(indent).append("  ");
+                write(sb, l.get(i), indent + "  ");
+                sb.append(i + 1 < l.size() ? ",\n" : "\n");
+            }
+            sb.append(indent).append(']');
+        } else if (o instanceof String s) {
+            sb.append('"').append(s.replace("\\", "\\\\").replace("\"", "\\\"")).append('"');
+        } else if (o instanceof Double d) {
+            sb.append(String.format(Locale.ROOT, "%.3f", d));
+        } else {
+            sb.append(o);
+        }
+    }
+}
