@@ -297,7 +297,8 @@ static int64_t pct_sorted(const int64_t *v, uint64_t n, double p)
 }
 
 static void print_table(const struct opts *o, const struct result *r, struct summary ls,
-			struct summary ds, const int64_t *dev_sorted, uint64_t ndev)
+			struct summary ds, const int64_t *lat_sorted, const int64_t *dev_sorted,
+			uint64_t ndev)
 {
 	const struct arflex_metric *m = &r->lat;
 
@@ -317,14 +318,18 @@ static void print_table(const struct opts *o, const struct result *r, struct sum
 	       " %10" PRIu64 "\n", "wake-up latency", m->min_ns, ls.mean, m->max_ns, ls.avedev,
 	       arflex_metric_percentile(m, 50.0), arflex_metric_percentile(m, 99.0),
 	       arflex_metric_percentile(m, 99.9));
+	printf("%-26s %10" PRIu64 " %10.0f %10" PRIu64 " %10.0f %10" PRId64 " %10" PRId64
+	       " %10" PRId64 "\n", "  same, exact percentiles", m->min_ns, ls.mean, m->max_ns,
+	       ls.avedev, pct_sorted(lat_sorted, m->count, 50.0),
+	       pct_sorted(lat_sorted, m->count, 99.0), pct_sorted(lat_sorted, m->count, 99.9));
 	printf("%-26s %10" PRId64 " %10.0f %10" PRId64 " %10.0f %10" PRId64 " %10" PRId64
 	       " %10" PRId64 "\n", "period deviation (signed)", ds.min, ds.mean, ds.max,
 	       ds.avedev, pct_sorted(dev_sorted, ndev, 50.0), pct_sorted(dev_sorted, ndev, 99.0),
 	       pct_sorted(dev_sorted, ndev, 99.9));
 	printf("overruns %" PRIu64 ", missed periods %" PRIu64 ", sleep errors %" PRIu64 "\n",
 	       r->overruns, r->missed_periods, r->sleep_errors);
-	printf("(latency percentiles: upper edge of 100 ns histogram bins, as rt-core; avedev "
-	       "exact)\n");
+	printf("(first row: percentiles from rt-core's histogram, upper edge of 100 ns bins, the\n"
+	       " max for samples >= 200 us; second row: exact percentiles; avedev exact)\n");
 }
 
 static int write_json(const char *path, const struct opts *o, const struct result *r,
@@ -424,7 +429,7 @@ int main(int argc, char **argv)
 	qsort(r.lat_ns, o.loops, sizeof(int64_t), cmp_i64);
 	qsort(r.dev_ns, o.loops - 1, sizeof(int64_t), cmp_i64);
 	if (!o.quiet)
-		print_table(&o, &r, ls, ds, r.dev_ns, o.loops - 1);
+		print_table(&o, &r, ls, ds, r.lat_ns, r.dev_ns, o.loops - 1);
 	ret = 0;
 	if (o.json && write_json(o.json, &o, &r, ls, ds, r.lat_ns, r.dev_ns, o.loops) < 0)
 		ret = 1;
