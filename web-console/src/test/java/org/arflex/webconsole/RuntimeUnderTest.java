@@ -1,0 +1,198 @@
+package org.arflex.webconsole;
+
+import java.io.IOException;
+import java.io.OutputStream;
+import java.net.ServerSocket;
+import java.net.URI;
+import java.net.http.HttpClient;
+import java.net.http.HttpRequest;
+import java.net.http.HttpResponse;
+import java.nio.charset.StandardCharsets;
+import java.nio.file.Files;
+import java.nio.file.Path;
+import java.nio.file.StandardCopyOption;
+import java.security.SecureRandom;
+import java.time.Duration;
+import java.util.Base64;
+import java.util.Comparator;
+import java.util.List;
+import java.util.concurrent.TimeUnit;
+import java.util.function.BooleanSupplier;
+import java.util.stream.Stream;
+
+/**
+ * The assembled ARFLEX runtime started as a child process through scripts/run-cell.sh, with a
+ * fresh ARFLEX_HOME, a random console password and a free HTTP port, from a private copy of
+ * management/runtime/target/arflex-runtime with this module's bundle added to console/.
+ */
+final class RuntimeUnderTest implements AutoCloseable {
+    static final String USER = "arflex";
+    final String password;
+    final int port;
+    final Path work;
+    final Path runtimeDir;
+    final Path home;
+    final Path log;
+    private final Process process;
+    private final OutputStream stdin;
+    private final HttpClient http = HttpClient.newBuilder().connectTimeout(Duration.ofSeconds(5)).build();
+
+    RuntimeUnderTest(Path work) throws IOException {
+        Path assembled = Path.of(System.getProperty("arflex.runtime.dir",
+                "../management/runtime/target/arflex-runtime")).toAbsolutePath().normalize();
+        Path jar = Path.of(System.getProperty("arflex.webconsole.jar", "target/org.arflex.webconsole.jar"));
+        Path root = Path.of(System.getProperty("arflex.root", "..")).toAbsolutePath().normalize();
+        if (!Files.isRegularFile(assembled.resolve("bin/felix.jar"))) {
+            throw new IllegalStateException("no assembled runtime at " + assembled
+                    + " (build it: mvn -Darflex.native.skip=true -DskipTests -pl management/runtime package)");
+        }
+        if (!Files.isRegularFile(jar)) {
+            throw new IllegalStateException("no web console bundle at " + jar + " (run the package phase first)");
+        }
+        this.work = work;
+        deleteTree(work);
+        this.runtimeDir = work.resolve("runtime");
+        this.home = work.resolve("home");
+        this.log = work.resolve("runtime.log");
+        copyTree(assembled, runtimeDir);
+        deleteTree(runtimeDir.resolve("felix-cache"));
+        deleteTree(runtimeDir.resolve("cell"));
+        Files.copy(jar, runtimeDir.resolve("console/org.arflex.webconsole.jar"));
+        this.port = freePort();
+        Path conf = runtimeDir.resolve("conf/config.properties");
+        String props = Files.readString(conf).replaceAll("(?m)^org\\.osgi\\.service\\.http\\.port=.*$",
+                "org.osgi.service.http.port=" + port);
+        Files.writeString(conf, props);
+        byte[] pw = new byte[18];
+        new SecureRandom().nextBytes(pw);
+        this.password = Base64.getUrlEncoder().withoutPadding().encodeToString(pw);
+
+        ProcessBuilder pb = new ProcessBuilder("bash", root.resolve("scripts/run-cell.sh").toString(),
+                runtimeDir.toString());
+        pb.environment().put("ARFLEX_HOME", home.toString());
+        pb.environment().put("ARFLEX_CONSOLE_USER", USER);
+        pb.environment().put("ARFLEX_CONSOLE_PASSWORD", password);
+        pb.redirectErrorStream(true).redirectOutput(log.toFile());
+        pb.directory(runtimeDir.toFile());
+        this.process = pb.start();
+        this.stdin = process.getOutputStream();
+    }
+
+    /** Waits until the console answers and the DRCR is registered. */
+    void awaitUp(Duration timeout) {
+        awaitCondition("the console at port " + port + " and the DRCR up", timeout, () -> {
+            if (!process.isAlive()) {
+                throw new IllegalStateException("the runtime exited early; log:\n" + tail());
+            }
+            HttpResponse<String> r = get("/system/console/arflex-cell/api/cell", true);
+            return r != null && r.statusCode() == 200 && r.body().contains("\"drcr\":true");
+        });
+    }
+
+    String base() {
+        return "http://127.0.0.1:" + port;
+    }
+
+    String basicAuth() {
+        return "Basic " + Base64.getEncoder().encodeToString((USER + ":" + password).getBytes(StandardCharsets.UTF_8));
+    }
+
+    /** GET with or without the console credentials; null when the server does not answer. */
+    HttpResponse<String> get(String path, boolean auth) {
+        return send(HttpRequest.newBuilder(URI.create(base() + path)).GET(), auth);
+    }
+
+    HttpResponse<String> send(HttpRequest.Builder b, boolean auth) {
+        if (auth) {
+            b.header("Authorization", basicAuth());
+        }
+        try {
+            return http.send(b.timeout(Duration.ofSeconds(10)).build(), HttpResponse.BodyHandlers.ofString());
+        } catch (IOException e) {
+            return null;
+        } catch (InterruptedException e) {
+            Thread.currentThread().interrupt();
+            throw new IllegalStateException(e);
+        }
+    }
+
+    /** Sends a Gogo command line to the runtime's shell. */
+    void gogo(String line) throws IOException {
+        stdin.write((line + "\n").getBytes(StandardCharsets.UTF_8));
+        stdin.flush();
+    }
+
+    String tail() {
+        try {
+            List<String> lines = Files.readAllLines(log);
+            return String.join("\n", lines.subList(Math.max(0, lines.size() - 60), lines.size()));
+        } catch (IOException e) {
+            return "(no log: " + e.getMessage() + ")";
+        }
+    }
+
+    /** Stops the framework through Gogo; kills what is left after the deadline. */
+    @Override
+    public void close() throws IOException {
+        try {
+            gogo("stop 0");
+            stdin.close();
+        } catch (IOException e) {
+            // already gone
+        }
+        try {
+            if (!process.waitFor(60, TimeUnit.SECONDS)) {
+                process.descendants().forEach(ProcessHandle::destroyForcibly);
+                process.destroyForcibly();
+                process.waitFor(10, TimeUnit.SECONDS);
+            }
+        } catch (InterruptedException e) {
+            Thread.currentThread().interrupt();
+        }
+    }
+
+    static void awaitCondition(String what, Duration timeout, BooleanSupplier condition) {
+        long deadline = System.nanoTime() + timeout.toNanos();
+        while (!condition.getAsBoolean()) {
+            if (System.nanoTime() > deadline) {
+                throw new AssertionError("timed out after " + timeout.toSeconds() + " s waiting for " + what);
+            }
+            try {
+                Thread.sleep(100);
+            } catch (InterruptedException e) {
+                Thread.currentThread().interrupt();
+                throw new AssertionError("interrupted waiting for " + what);
+            }
+        }
+    }
+
+    private static int freePort() throws IOException {
+        try (ServerSocket s = new ServerSocket(0)) {
+            return s.getLocalPort();
+        }
+    }
+
+    private static void copyTree(Path from, Path to) throws IOException {
+        try (Stream<Path> s = Files.walk(from)) {
+            for (Path p : s.toList()) {
+                Path t = to.resolve(from.relativize(p).toString());
+                if (Files.isDirectory(p)) {
+                    Files.createDirectories(t);
+                } else {
+                    Files.copy(p, t, StandardCopyOption.COPY_ATTRIBUTES);
+                }
+            }
+        }
+    }
+
+    static void deleteTree(Path p) throws IOException {
+        if (!Files.exists(p)) {
+            return;
+        }
+        try (Stream<Path> s = Files.walk(p)) {
+            for (Path q : s.sorted(Comparator.reverseOrder()).toList()) {
+                Files.delete(q);
+            }
+        }
+    }
+}

@@ -1,0 +1,368 @@
+package org.arflex.webconsole;
+
+import static org.junit.jupiter.api.Assertions.assertEquals;
+import static org.junit.jupiter.api.Assertions.assertFalse;
+import static org.junit.jupiter.api.Assertions.assertNotNull;
+import static org.junit.jupiter.api.Assertions.assertTrue;
+
+import com.sun.net.httpserver.HttpServer;
+import java.io.IOException;
+import java.net.InetSocketAddress;
+import java.net.URI;
+import java.net.http.HttpRequest;
+import java.net.http.HttpResponse;
+import java.nio.charset.StandardCharsets;
+import java.nio.file.Files;
+import java.nio.file.Path;
+import java.security.MessageDigest;
+import java.time.Duration;
+import java.util.HexFormat;
+import java.util.List;
+import java.util.Map;
+import java.util.regex.Matcher;
+import java.util.regex.Pattern;
+import java.util.stream.Stream;
+import org.junit.jupiter.api.AfterAll;
+import org.junit.jupiter.api.BeforeAll;
+import org.junit.jupiter.api.MethodOrderer;
+import org.junit.jupiter.api.Order;
+import org.junit.jupiter.api.Test;
+import org.junit.jupiter.api.TestMethodOrder;
+import org.openqa.selenium.By;
+import org.openqa.selenium.OutputType;
+import org.openqa.selenium.WebElement;
+import org.openqa.selenium.chrome.ChromeDriver;
+import org.openqa.selenium.chrome.ChromeDriverService;
+import org.openqa.selenium.chrome.ChromeOptions;
+import org.openqa.selenium.support.ui.ExpectedConditions;
+import org.openqa.selenium.support.ui.WebDriverWait;
+
+/**
+ * The console in Debian's headless Chromium against the real runtime (child process): login,
+ * refusals, CSRF, the contract editor, install/parameter/uninstall of the sample components
+ * through the pages. Screenshots of each page go to target/screenshots/. The tests run in order
+ * on one runtime, as an engineer would use it.
+ */
+@TestMethodOrder(MethodOrderer.OrderAnnotation.class)
+class WebConsoleIT {
+    private static final Duration WAIT = Duration.ofSeconds(30);
+    private static RuntimeUnderTest rt;
+    private static ChromeDriver browser;
+    private static Path screenshots;
+    private static Path profile;
+    private static String runtimeId;
+
+    @BeforeAll
+    static void start() throws IOException {
+        Path work = Path.of(System.getProperty("arflex.it.work", "target/it")).toAbsolutePath();
+        screenshots = Path.of(System.getProperty("arflex.screenshots", "target/screenshots")).toAbsolutePath();
+        Files.createDirectories(screenshots);
+        rt = new RuntimeUnderTest(work);
+        rt.awaitUp(Duration.ofSeconds(90));
+        runtimeId = jsonString(rt.get("/system/console/arflex-cell/api/cell", true).body(), "runtimeId");
+
+        profile = Files.createTempDirectory("arflex-chrome-");
+        ChromeOptions o = new ChromeOptions();
+        o.setBinary("/usr/bin/chromium");
+        o.addArguments("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+                "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-dev-shm-usage",
+                "--window-size=1400,1000", "--user-data-dir=" + profile);
+        ChromeDriverService service = new ChromeDriverService.Builder()
+                .usingDriverExecutable(Path.of("/usr/bin/chromedriver").toFile()).usingAnyFreePort().build();
+        browser = new ChromeDriver(service, o);
+    }
+
+    @AfterAll
+    static void stop() throws IOException {
+        try {
+            if (browser != null) {
+                browser.quit();
+            }
+        } finally {
+            if (rt != null) {
+                rt.close();
+            }
+            if (profile != null) {
+                RuntimeUnderTest.deleteTree(profile);
+            }
+        }
+        // Nothing leaks: no child process, no shared memory or queue of this runtime.
+        RuntimeUnderTest.awaitCondition("child processes to end", Duration.ofSeconds(20),
+                () -> ProcessHandle.current().descendants().noneMatch(ProcessHandle::isAlive));
+        if (runtimeId != null) {
+            String prefix = "arflex." + runtimeId + ".";
+            for (String dir : List.of("/dev/shm", "/dev/mqueue")) {
+                Path d = Path.of(dir);
+                if (Files.isDirectory(d)) {
+                    try (Stream<Path> s = Files.list(d)) {
+                        List<Path> left = s.filter(p -> p.getFileName().toString().startsWith(prefix)).toList();
+                        assertTrue(left.isEmpty(), "left over in " + dir + ": " + left);
+                    }
+                }
+            }
+        }
+    }
+
+    /** Logs the browser in: the Web Console uses HTTP Basic authentication. */
+    private static void login() {
+        browser.executeCdpCommand("Network.enable", Map.of());
+        browser.executeCdpCommand("Network.setExtraHTTPHeaders", Map.of("headers", Map.of("Authorization", rt.basicAuth())));
+    }
+
+    private static void open(String labelAndQuery) {
+        browser.get(rt.base() + "/system/console/" + labelAndQuery);
+    }
+
+    private static WebElement await(By by) {
+        return new WebDriverWait(browser, WAIT).until(ExpectedConditions.visibilityOfElementLocated(by));
+    }
+
+    private static void awaitText(By by, String text) {
+        new WebDriverWait(browser, WAIT).until(ExpectedConditions.textToBePresentInElementLocated(by, text));
+    }
+
+    private static void shot(String name) throws IOException {
+        Files.write(screenshots.resolve(name + ".png"), browser.getScreenshotAs(OutputType.BYTES));
+    }
+
+    private static String cell() {
+        return rt.get("/system/console/arflex-cell/api/cell", true).body();
+    }
+
+    private static String instanceState(String name) {
+        Matcher m = Pattern.compile("\"name\":\"" + Pattern.quote(name) + "\",\"state\":\"([A-Z]+)\"").matcher(cell());
+        return m.find() ? m.group(1) : null;
+    }
+
+    private static String jsonString(String json, String key) {
+        Matcher m = Pattern.compile("\"" + Pattern.quote(key) + "\":\"([^\"]*)\"").matcher(json);
+        return m.find() ? m.group(1) : null;
+    }
+
+    private static Path sample(String which) {
+        Path p = Path.of(System.getProperty("arflex.sample." + which, "")).toAbsolutePath().normalize();
+        assertTrue(Files.isRegularFile(p), "sample bundle " + which + " not built: " + p);
+        return p;
+    }
+
+    @Test
+    @Order(1)
+    void refusedWithoutOrWithWrongCredentials() throws IOException {
+        HttpResponse<String> none = rt.get("/system/console/arflex-cell", false);
+        assertEquals(401, none.statusCode());
+        assertTrue(none.headers().firstValue("WWW-Authenticate").orElse("").startsWith("Basic"));
+        HttpResponse<String> wrong = rt.send(HttpRequest.newBuilder(URI.create(rt.base() + "/system/console/arflex-cell/api/cell"))
+                .header("Authorization", "Basic " + java.util.Base64.getEncoder().encodeToString("arflex:admin".getBytes(StandardCharsets.UTF_8))), false);
+        assertEquals(401, wrong.statusCode());
+        HttpResponse<String> admin = rt.send(HttpRequest.newBuilder(URI.create(rt.base() + "/system/console/bundles"))
+                .header("Authorization", "Basic " + java.util.Base64.getEncoder().encodeToString("admin:admin".getBytes(StandardCharsets.UTF_8))), false);
+        assertEquals(401, admin.statusCode(), "the Web Console default login must not work");
+        // The browser without credentials gets no page either.
+        open("arflex-cell");
+        assertFalse(browser.getPageSource().contains("arflex-app"));
+        shot("00-refused");
+    }
+
+    @Test
+    @Order(2)
+    void loginAndSeeTheCell() throws IOException {
+        login();
+        open("arflex-cell");
+        await(By.id("arflex-instances"));
+        awaitText(By.id("arflex-cell-status"), "Runtime");
+        assertTrue(browser.findElement(By.id("arflex-resources")).getText().contains("CPU"));
+        shot("01-cell-empty");
+    }
+
+    @Test
+    @Order(3)
+    void forgedCrossSitePostsAreRefused() throws IOException {
+        // Without a token, with a wrong token: refused with 403 before anything happens.
+        HttpResponse<String> noToken = rt.send(HttpRequest.newBuilder(URI.create(rt.base()
+                + "/system/console/arflex-deploy/api/uninstall?name=sample-counter"))
+                .header("Origin", rt.base()).POST(HttpRequest.BodyPublishers.noBody()), true);
+        assertEquals(403, noToken.statusCode());
+        assertTrue(noToken.body().contains("CSRF"), noToken.body());
+        HttpResponse<String> wrongToken = rt.send(HttpRequest.newBuilder(URI.create(rt.base()
+                + "/system/console/arflex-deploy/api/uninstall?name=sample-counter"))
+                .header("Origin", rt.base()).header("X-Arflex-Csrf", "forged").POST(HttpRequest.BodyPublishers.noBody()), true);
+        assertEquals(403, wrongToken.statusCode());
+
+        // A page on another origin submits forms at the console while the browser holds the
+        // credentials: ours and the Web Console's own (stop the system bundle).
+        HttpServer evil = HttpServer.create(new InetSocketAddress("127.0.0.1", 0), 0);
+        String target = rt.base() + "/system/console";
+        String page = "<html><body><form id='f1' method='POST' action='" + target
+                + "/arflex-contract/api/save?name=forged'><input name='_csrf' value='guess'></form>"
+                + "<form id='f2' method='POST' action='" + target + "/bundles/0'>"
+                + "<input name='action' value='stop'></form>"
+                + "<p id='which'></p><script>var w=location.hash.substring(1);document.getElementById(w).submit();</script></body></html>";
+        evil.createContext("/evil", ex -> {
+            byte[] b = page.getBytes(StandardCharsets.UTF_8);
+            ex.getResponseHeaders().add("Content-Type", "text/html");
+            ex.sendResponseHeaders(200, b.length);
+            ex.getResponseBody().write(b);
+            ex.close();
+        });
+        evil.start();
+        try {
+            String evilBase = "http://localhost:" + evil.getAddress().getPort() + "/evil";
+            browser.get(evilBase + "#f1");
+            new WebDriverWait(browser, WAIT).until(d -> d.getCurrentUrl().contains("/api/save"));
+            assertTrue(browser.getPageSource().contains("cross-"), browser.getPageSource());
+            shot("02-forged-post-refused");
+            assertFalse(Files.exists(rt.home.resolve("contracts/forged.xml")));
+            browser.get(evilBase + "#f2");
+            new WebDriverWait(browser, WAIT).until(d -> d.getCurrentUrl().contains("/bundles/0"));
+            assertTrue(browser.getPageSource().contains("403"), browser.getPageSource());
+        } finally {
+            evil.stop(0);
+        }
+        assertEquals(200, rt.get("/system/console/arflex-cell/api/cell", true).statusCode(), "the runtime still runs");
+    }
+
+    @Test
+    @Order(4)
+    void contractEditorShowsTheErrorAtTheFieldThenSaves() throws IOException {
+        open("arflex-contract");
+        await(By.id("arflex-new")).click();
+        WebElement name = await(By.id("arflex-f-name"));
+        name.clear();
+        name.sendKeys("demo-filter");
+        await(By.id("arflex-add-port")).click();
+        await(By.id("arflex-add-prop")).click();
+        WebElement period = await(By.id("arflex-f-timing-period"));
+        period.clear();
+        period.sendKeys("fast");
+        assertTrue(browser.findElement(By.id("arflex-xml")).getAttribute("value").contains("period=\"fast\""));
+        await(By.id("arflex-validate")).click();
+        new WebDriverWait(browser, WAIT).until(d -> d.findElement(By.id("arflex-f-timing-period")).getAttribute("class").contains("arflex-invalid"));
+        WebElement err = browser.findElement(By.xpath("//input[@id='arflex-f-timing-period']/following-sibling::span[@class='arflex-field-error']"));
+        assertTrue(err.getText().contains("fast"), "error shown at the period field: " + err.getText());
+        shot("03-contract-error-at-field");
+        // Saving an invalid contract is refused with the same problems.
+        await(By.id("arflex-save")).click();
+        awaitText(By.id("arflex-contract-status"), "problem");
+        assertFalse(Files.exists(rt.home.resolve("contracts/demo-filter.xml")));
+
+        period = browser.findElement(By.id("arflex-f-timing-period"));
+        period.clear();
+        period.sendKeys("5ms");
+        browser.findElement(By.id("arflex-validate")).click();
+        awaitText(By.id("arflex-contract-status"), "Valid");
+        browser.findElement(By.id("arflex-save")).click();
+        awaitText(By.id("arflex-contract-status"), "Saved to");
+        shot("04-contract-saved");
+        Path saved = rt.home.resolve("contracts/demo-filter.xml");
+        assertTrue(Files.isRegularFile(saved));
+        assertTrue(Files.readString(saved).contains("period=\"5ms\""));
+    }
+
+    @Test
+    @Order(5)
+    void installTheCounterByUploadWithThePlanShown() throws IOException {
+        Path counter = sample("counter");
+        open("arflex-deploy");
+        await(By.id("arflex-upload-file")).sendKeys(counter.toString());
+        browser.findElement(By.id("arflex-upload")).click();
+        WebElement plan = await(By.id("arflex-plan-text"));
+        assertFalse(plan.getText().isBlank(), "a plan is shown before confirming");
+        assertEquals(sha256(counter), browser.findElement(By.id("arflex-staged-sha")).getText());
+        assertEquals(null, instanceState("sample-counter"), "nothing installed before confirming");
+        shot("05-deploy-plan-upload");
+        browser.findElement(By.id("arflex-confirm")).click();
+        awaitText(By.id("arflex-deploy-status"), "installed");
+        RuntimeUnderTest.awaitCondition("sample-counter Active", WAIT, () -> "ACTIVE".equals(instanceState("sample-counter")));
+    }
+
+    @Test
+    @Order(6)
+    void installTheScalerFromAFileUrlWithItsPinnedHash() throws IOException {
+        Path scaler = sample("scaler");
+        open("arflex-deploy");
+        // A wrong pin is refused and nothing is installed.
+        await(By.id("arflex-url")).sendKeys(scaler.toUri().toString());
+        browser.findElement(By.id("arflex-sha256")).sendKeys("0".repeat(64));
+        browser.findElement(By.id("arflex-fetch")).click();
+        awaitText(By.id("arflex-deploy-status"), "not the pinned");
+        // http is refused.
+        browser.findElement(By.id("arflex-url")).clear();
+        browser.findElement(By.id("arflex-url")).sendKeys("http://127.0.0.1/x.jar");
+        browser.findElement(By.id("arflex-fetch")).click();
+        awaitText(By.id("arflex-deploy-status"), "only https or file");
+        // The right pin gives the plan, then the install.
+        browser.findElement(By.id("arflex-url")).clear();
+        browser.findElement(By.id("arflex-url")).sendKeys(scaler.toUri().toString());
+        browser.findElement(By.id("arflex-sha256")).clear();
+        browser.findElement(By.id("arflex-sha256")).sendKeys(sha256(scaler));
+        browser.findElement(By.id("arflex-fetch")).click();
+        assertFalse(await(By.id("arflex-plan-text")).getText().isBlank());
+        shot("06-deploy-plan-url");
+        browser.findElement(By.id("arflex-confirm")).click();
+        awaitText(By.id("arflex-deploy-status"), "installed");
+        RuntimeUnderTest.awaitCondition("sample-scaler Active", WAIT, () -> "ACTIVE".equals(instanceState("sample-scaler")));
+        open("arflex-cell");
+        awaitText(By.id("arflex-instances"), "sample-scaler");
+        new WebDriverWait(browser, WAIT).until(d -> d.findElements(By.cssSelector("tr[data-component='sample-scaler'] .arflex-state-active")).size() == 1);
+        shot("07-cell-two-components");
+    }
+
+    @Test
+    @Order(7)
+    void changeAParameterAndSeeItAppliedByTheRtHalf() throws IOException {
+        open("arflex-component?name=sample-scaler");
+        WebElement gain = await(By.id("arflex-param-gain"));
+        // Out of range: refused at the field.
+        gain.clear();
+        gain.sendKeys("99");
+        browser.findElement(By.id("arflex-apply-gain")).click();
+        new WebDriverWait(browser, WAIT).until(d -> d.findElement(By.id("arflex-param-gain")).getAttribute("class").contains("arflex-invalid"));
+        gain = browser.findElement(By.id("arflex-param-gain"));
+        gain.clear();
+        gain.sendKeys("4.25");
+        browser.findElement(By.id("arflex-apply-gain")).click();
+        awaitText(By.id("arflex-component-status"), "applied by the RT half");
+        awaitText(By.id("arflex-applied-gain"), "4.25");
+        // The live stream shows samples (server-sent events).
+        awaitText(By.id("arflex-live-count"), "samples");
+        awaitText(By.id("arflex-live-count"), "gain=4.25");
+        shot("08-component-param-applied");
+        String comp = rt.get("/system/console/arflex-component/api/component?name=sample-scaler", true).body();
+        assertTrue(Pattern.compile("\"name\":\"gain\",\"type\":\"[A-Z]+\",\"value\":\"4\\.25\"").matcher(comp).find(), comp);
+    }
+
+    @Test
+    @Order(8)
+    void graphShowsComponentsAndLinks() throws IOException {
+        open("arflex-graph");
+        WebElement g = await(By.id("arflex-graph"));
+        new WebDriverWait(browser, WAIT).until(d -> "2".equals(g.getAttribute("data-nodes")));
+        assertEquals("1", g.getAttribute("data-edges"));
+        shot("09-graph");
+    }
+
+    @Test
+    @Order(9)
+    void uninstallWithThePlanShown() throws IOException {
+        open("arflex-deploy");
+        await(By.id("arflex-uninstall-sample-scaler")).click();
+        assertFalse(await(By.id("arflex-plan-text")).getText().isBlank());
+        assertNotNull(instanceState("sample-scaler"), "still installed until confirmed");
+        shot("10-uninstall-plan");
+        browser.findElement(By.id("arflex-confirm")).click();
+        awaitText(By.id("arflex-deploy-status"), "uninstalled");
+        RuntimeUnderTest.awaitCondition("sample-scaler gone", WAIT, () -> instanceState("sample-scaler") == null);
+        assertEquals("ACTIVE", instanceState("sample-counter"), "the other component is not disturbed");
+        open("arflex-cell");
+        awaitText(By.id("arflex-instances"), "sample-counter");
+        shot("11-cell-after-uninstall");
+    }
+
+    private static String sha256(Path p) throws IOException {
+        try {
+            return HexFormat.of().formatHex(MessageDigest.getInstance("SHA-256").digest(Files.readAllBytes(p)));
+        } catch (java.security.NoSuchAlgorithmException e) {
+            throw new IllegalStateException(e);
+        }
+    }
+}
