@@ -58,7 +58,21 @@ std::unique_ptr<Renderer> Renderer::Create(const mjModel* model, int width, int 
   return r;
 }
 
+bool Renderer::MakeCurrent() {
+  if (!osmesa_) return false;
+  return OSMesaMakeCurrent(static_cast<OSMesaContext>(osmesa_), osmesa_buffer_.data(),
+                           GL_UNSIGNED_BYTE, 64, 64);
+}
+
+void Renderer::ReleaseCurrent() {
+  if (osmesa_ && OSMesaGetCurrentContext() == static_cast<OSMesaContext>(osmesa_)) {
+    OSMesaMakeCurrent(nullptr, nullptr, 0, 0, 0);
+  }
+}
+
 Renderer::~Renderer() {
+  // MuJoCo frees GL objects: the context must be current on this thread.
+  if (osmesa_) MakeCurrent();
   if (have_context_) mjr_freeContext(&context_);
   if (have_scene_) mjv_freeScene(&scene_);
   if (data_) mj_deleteData(data_);

@@ -48,6 +48,13 @@ class Renderer {
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
+  // Makes the OSMesa context current on the calling thread / releases it from the calling
+  // thread. A Renderer created on one thread (e.g. an RT half's configure hook) can be handed
+  // to another (its RT thread): ReleaseCurrent() on the first, MakeCurrent() on the second.
+  // The destructor makes the context current on the destroying thread itself.
+  bool MakeCurrent();
+  void ReleaseCurrent();
+
   int width() const { return width_; }
   int height() const { return height_; }
   int camera_count() const { return model_->ncam; }

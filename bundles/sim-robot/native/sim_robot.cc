@@ -1,0 +1,356 @@
+// sim-robot: the RT half of the simulated robot (simulator/README.md, "As components").
+//
+// One period = steps_per_period physics steps of the TRUE arm (1 ms each), lock-step with the
+// RT loop: the arm's own joint position servo follows the joint reference read from
+// `joint_ref` (arflex.JointRef); a correction is added upstream, never here. Outputs:
+// `joint_state` (arflex.JointState: motor angles, velocities, measured drive torques) and
+// `wrench` (arflex.Wrench: wrist F/T in the flange frame). Evaluation runs also get the
+// ground truth in `truth` (eval.GroundTruth, not a contract port; see ground_truth.h).
+//
+// Scripted disturbances come from parameters (see the contract, sim-robot.xml). The safe hook
+// holds the arm where it is (the servo's reference becomes the measured pose).
+//
+// Everything is allocated in configure; update/safe only step the Cell (no allocation, no
+// printing, no blocking).
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <unistd.h>
+
+#include <arflex/component.h>
+#include <arflex_types/joint_ref.h>
+#include <arflex_types/joint_state.h>
+#include <arflex_types/wrench.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "arflex_sim/cell.h"
+#include "arflex_sim/ground_truth.h"
+#include "arflex_sim/params.h"
+
+namespace {
+
+using arflex::sim::Cell;
+using arflex::sim::CellConfig;
+using arflex::sim::HandGuideSpec;
+using arflex::sim::JointVector;
+using arflex::sim::kNumJoints;
+using arflex::sim::PushSpec;
+using arflex::sim::Vec3;
+
+// Home pose: the arm in front of the cameras, tool tags visible (simulator/README.md).
+constexpr JointVector kHome = {0.0, 0.5, 0.3, 0.0, 0.8, 0.0};
+
+const arflex_port_type kJointRefType = {ARFLEX_TYPE_JOINT_REF_NAME,
+                                        ARFLEX_TYPE_JOINT_REF_VERSION_MAJOR,
+                                        ARFLEX_TYPE_JOINT_REF_VERSION_MINOR,
+                                        ARFLEX_TYPE_JOINT_REF_SIZE};
+const arflex_port_type kJointStateType = {ARFLEX_TYPE_JOINT_STATE_NAME,
+                                          ARFLEX_TYPE_JOINT_STATE_VERSION_MAJOR,
+                                          ARFLEX_TYPE_JOINT_STATE_VERSION_MINOR,
+                                          ARFLEX_TYPE_JOINT_STATE_SIZE};
+const arflex_port_type kWrenchType = {ARFLEX_TYPE_WRENCH_NAME, ARFLEX_TYPE_WRENCH_VERSION_MAJOR,
+                                      ARFLEX_TYPE_WRENCH_VERSION_MINOR, ARFLEX_TYPE_WRENCH_SIZE};
+const arflex_port_type kTruthType = {ARFLEX_SIM_TRUTH_TYPE_NAME, ARFLEX_SIM_TRUTH_VERSION_MAJOR,
+                                     ARFLEX_SIM_TRUTH_VERSION_MINOR, ARFLEX_SIM_TRUTH_SIZE};
+
+// Parameter names (the contract's properties). A parameter missing from the control block
+// takes the default given here, so the RT half also runs under a host that sets only some.
+enum Param {
+  kStepsPerPeriod, kSeed, kPayloadKg, kPayloadKnown,
+  kPushForce, kPushDirX, kPushDirY, kPushDirZ, kPushDurationMs,
+  kObstacleEnable, kObstacleX, kObstacleY, kObstacleZ,
+  kGuideForce, kGuideDx, kGuideDy, kGuideDz, kGuideDurationMs,
+  kParamCount
+};
+struct ParamInfo {
+  const char* name;
+  double def;  // default when absent (bool: 0/1, int: integral)
+  char kind;   // 'd' double, 'i' int, 'b' bool
+};
+const ParamInfo kParams[kParamCount] = {
+    {"steps_per_period", 1, 'i'}, {"seed", 1, 'i'},
+    {"payload_kg", 0, 'd'},       {"payload_known", 1, 'b'},
+    {"push_force_n", 0, 'd'},     {"push_dir_x", 0, 'd'},
+    {"push_dir_y", 1, 'd'},       {"push_dir_z", 0, 'd'},
+    {"push_duration_ms", 200, 'd'},
+    {"obstacle_enable", 0, 'b'},  {"obstacle_x", 1.8, 'd'},
+    {"obstacle_y", 0.0, 'd'},     {"obstacle_z", 1.0, 'd'},
+    {"guide_force_n", 0, 'd'},    {"guide_dx", 0.0, 'd'},
+    {"guide_dy", 0.2, 'd'},       {"guide_dz", 0.0, 'd'},
+    {"guide_duration_ms", 2000, 'd'},
+};
+
+struct Robot {
+  std::unique_ptr<Cell> cell;
+  arflex_port* joint_state = nullptr;
+  arflex_port* wrench = nullptr;
+  arflex_port* truth = nullptr;  // only in evaluation runs
+  arflex_input* joint_ref = nullptr;
+  int idx[kParamCount];
+  // Change detection of the disturbance parameters (applied at the cycle they change).
+  double push_sig[5];
+  double obstacle_sig[4];
+  double guide_sig[5];
+  double payload_sig[2];
+  bool first_cycle = true;
+  std::vector<PushSpec> push_buf;  // one element, allocated in configure
+  uint64_t cycles = 0;
+  uint64_t seq = 0;
+  bool safe = false;
+  JointVector q_ref = kHome;
+};
+
+Robot g_robot;
+
+double P(const arflex_component* c, const Robot& r, Param p) {
+  const int i = r.idx[p];
+  if (i < 0) return kParams[p].def;
+  switch (kParams[p].kind) {
+    case 'i': return static_cast<double>(arflex_param_i64(c, i));
+    case 'b': return arflex_param_bool(c, i) ? 1.0 : 0.0;
+    default: return arflex_param_f64(c, i);
+  }
+}
+
+bool Changed(double* sig, const double* now, int n) {
+  bool changed = false;
+  for (int k = 0; k < n; ++k) {
+    if (sig[k] != now[k]) changed = true;
+    sig[k] = now[k];
+  }
+  return changed;
+}
+
+// Applies parameters that changed since the last cycle (all of them on the first cycle).
+void ApplyParams(const arflex_component* c, Robot& r) {
+  Cell& cell = *r.cell;
+  const bool all = r.first_cycle;
+  r.first_cycle = false;
+
+  const double payload[2] = {P(c, r, kPayloadKg), P(c, r, kPayloadKnown)};
+  if (Changed(r.payload_sig, payload, 2) || all) cell.SetPayload(payload[0], payload[1] != 0.0);
+
+  const double obstacle[4] = {P(c, r, kObstacleEnable), P(c, r, kObstacleX),
+                              P(c, r, kObstacleY), P(c, r, kObstacleZ)};
+  if (Changed(r.obstacle_sig, obstacle, 4) || all) {
+    cell.SetObstacle(obstacle[0] != 0.0, {obstacle[1], obstacle[2], obstacle[3]});
+  }
+
+  // A push starts at the period in which its parameters change (force > 0); setting the
+  // force to 0 ends it. The force is applied at the TCP along push_dir (normalised).
+  const double push[5] = {P(c, r, kPushForce), P(c, r, kPushDirX), P(c, r, kPushDirY),
+                          P(c, r, kPushDirZ), P(c, r, kPushDurationMs)};
+  if (Changed(r.push_sig, push, 5) || all) {
+    PushSpec& p = r.push_buf[0];
+    const double n = std::sqrt(push[1] * push[1] + push[2] * push[2] + push[3] * push[3]);
+    p.start = cell.time();
+    p.duration = (push[0] > 0.0 && n > 0.0) ? push[4] * 1e-3 : 0.0;
+    for (int k = 0; k < 3; ++k) p.force[k] = n > 0.0 ? push[0] * push[1 + k] / n : 0.0;
+    cell.SetPushes(r.push_buf);
+  }
+
+  // A hand guides the TCP from where it is now by (guide_dx, dy, dz) over guide_duration_ms,
+  // pulling with at most guide_force_n; 0 releases the arm.
+  const double guide[5] = {P(c, r, kGuideForce), P(c, r, kGuideDx), P(c, r, kGuideDy),
+                           P(c, r, kGuideDz), P(c, r, kGuideDurationMs)};
+  if (Changed(r.guide_sig, guide, 5) || all) {
+    HandGuideSpec h;
+    h.enabled = guide[0] > 0.0;
+    if (h.enabled) {
+      const Eigen::Vector3d from = cell.TrueTcp().translation();
+      h.start = cell.time();
+      h.duration = guide[4] * 1e-3;
+      h.from = {from.x(), from.y(), from.z()};
+      h.to = {from.x() + guide[1], from.y() + guide[2], from.z() + guide[3]};
+      h.max_force = guide[0];
+    }
+    cell.SetHandGuide(h);
+  }
+}
+
+// Steps the physics for one period and publishes the outputs.
+int StepAndPublish(const arflex_component* c, Robot& r, uint64_t release_ns) {
+  Cell& cell = *r.cell;
+  const double spp = P(c, r, kStepsPerPeriod);
+  cell.Step(spp >= 1.0 ? static_cast<int>(spp) : 1);
+  ++r.cycles;
+  ++r.seq;
+
+  const arflex::sim::JointState js = cell.ReadJointState();
+  arflex_joint_state out;
+  std::memset(&out, 0, sizeof(out));
+  out.t_ns = static_cast<int64_t>(release_ns);
+  out.seq = r.seq;
+  for (int i = 0; i < kNumJoints; ++i) {
+    out.q[i] = js.q[i];
+    out.qd[i] = js.dq[i];
+    out.tau[i] = js.tau[i];
+  }
+  int ret = arflex_state_write(r.joint_state, &out, sizeof(out));
+
+  const arflex::sim::Wrench w = cell.ReadWrench();
+  arflex_wrench wr;
+  std::memset(&wr, 0, sizeof(wr));
+  wr.t_ns = out.t_ns;
+  wr.seq = r.seq;
+  for (int k = 0; k < 3; ++k) {
+    wr.force[k] = w.force[k];
+    wr.torque[k] = w.torque[k];
+  }
+  if (ret == 0) ret = arflex_state_write(r.wrench, &wr, sizeof(wr));
+
+  if (r.truth) {
+    arflex_sim_ground_truth g;
+    std::memset(&g, 0, sizeof(g));
+    g.t_ns = out.t_ns;
+    g.seq = r.seq;
+    g.steps = cell.step_count();
+    g.cycles = r.cycles;
+    g.sim_time = cell.time();
+    const Eigen::Isometry3d tcp = cell.TrueTcp();
+    const Eigen::Quaterniond qt(tcp.linear());
+    for (int k = 0; k < 3; ++k) g.p[k] = tcp.translation()[k];
+    g.quat[0] = qt.w();
+    g.quat[1] = qt.x();
+    g.quat[2] = qt.y();
+    g.quat[3] = qt.z();
+    const JointVector d = cell.ComplianceDeflection();
+    for (int i = 0; i < kNumJoints; ++i) g.deflection[i] = d[i];
+    const Vec3 f = cell.last_external_force();
+    for (int k = 0; k < 3; ++k) g.ext_force[k] = f[k];
+    g.obstacle_contacts = static_cast<uint32_t>(cell.obstacle_contacts());
+    g.safe = r.safe ? 1u : 0u;
+    g.warnings = static_cast<uint32_t>(cell.warning_count());
+    const int t = arflex_state_write(r.truth, &g, sizeof(g));
+    if (ret == 0) ret = t;
+  }
+  return ret;
+}
+
+bool ReferenceValid(const Cell& cell, const double* q) {
+  for (int i = 0; i < kNumJoints; ++i) {
+    const auto& link = cell.config().arm.links[i];
+    if (!std::isfinite(q[i]) || q[i] < link.lower || q[i] > link.upper) return false;
+  }
+  return true;
+}
+
+int Configure(arflex_component* c, void* user) {
+  Robot& r = *static_cast<Robot*>(user);
+  for (int p = 0; p < kParamCount; ++p) r.idx[p] = arflex_component_param(c, kParams[p].name);
+
+  int ret = arflex_component_output(c, "joint_state", ARFLEX_PORT_STATE, &kJointStateType,
+                                    &r.joint_state);
+  if (ret == 0) {
+    ret = arflex_component_output(c, "wrench", ARFLEX_PORT_STATE, &kWrenchType, &r.wrench);
+  }
+  if (ret == 0) {
+    ret = arflex_component_input(c, "joint_ref", ARFLEX_PORT_STATE, &kJointRefType,
+                                 &r.joint_ref);
+  }
+  if (ret < 0) return ret;
+
+  // The ground-truth segment exists only when the manager created it (evaluation run).
+  char name[ARFLEX_OBJ_NAME_SIZE];
+  ret = arflex_ctl_obj_name(name, sizeof(name), arflex_component_runtime(c),
+                            arflex_component_instance(c), "out." ARFLEX_SIM_TRUTH_PORT);
+  if (ret < 0) return ret;
+  const int fd = shm_open(name, O_RDONLY, 0);
+  if (fd >= 0) {
+    close(fd);
+    ret = arflex_component_output(c, ARFLEX_SIM_TRUTH_PORT, ARFLEX_PORT_STATE, &kTruthType,
+                                  &r.truth);
+    if (ret < 0) return ret;
+  }
+
+  const double spp = P(c, r, kStepsPerPeriod);
+  const double seed = P(c, r, kSeed);
+  if (spp < 1.0 || spp > 1000.0) {
+    std::fprintf(stderr, "sim-robot: parameter steps_per_period = %g outside 1..1000\n", spp);
+    return -ERANGE;
+  }
+  if (seed < 0.0) {
+    std::fprintf(stderr, "sim-robot: parameter seed = %g must be >= 0\n", seed);
+    return -ERANGE;
+  }
+  CellConfig config = arflex::sim::DefaultCellConfig();
+  config.error_seed = static_cast<uint64_t>(seed);
+  config.payload_mass = P(c, r, kPayloadKg);
+  config.nominal_payload_mass = P(c, r, kPayloadKnown) != 0.0 ? config.payload_mass : 0.0;
+  config.pushes.assign(1, PushSpec{});
+  std::string error;
+  r.cell = Cell::Create(config, kHome, &error);
+  if (!r.cell) {
+    std::fprintf(stderr, "sim-robot: cannot build the simulated cell: %s\n", error.c_str());
+    return -EINVAL;
+  }
+  r.push_buf.assign(1, PushSpec{});
+  r.q_ref = kHome;
+  r.first_cycle = true;
+  return 0;
+}
+
+int Start(arflex_component* c, void* user) {
+  Robot& r = *static_cast<Robot*>(user);
+  ApplyParams(c, r);
+  return 0;
+}
+
+int Update(arflex_component* c, void* user, uint64_t release_ns) {
+  Robot& r = *static_cast<Robot*>(user);
+  r.safe = false;
+  ApplyParams(c, r);
+  arflex_joint_ref ref;
+  const int got = arflex_input_state_read(r.joint_ref, &ref, sizeof(ref), nullptr);
+  int ret = 0;
+  if (got == 1) {
+    if (ReferenceValid(*r.cell, ref.q)) {
+      for (int i = 0; i < kNumJoints; ++i) r.q_ref[i] = ref.q[i];
+    } else {
+      ret = -ERANGE;  // refused: non-finite or outside the joint limits; keep the last one
+    }
+  }
+  r.cell->SetJointReference(r.q_ref);
+  const int pub = StepAndPublish(c, r, release_ns);
+  return ret < 0 ? ret : pub;
+}
+
+// Hold: the servo's reference becomes the measured pose (no motion); the physics keeps
+// running (the world does not stop) and the sensors keep publishing. Both safe modes hold:
+// "zero" velocity is what holding a position means for a robot.
+int Safe(arflex_component* c, void* user, arflex_safe_mode /*mode*/, bool first) {
+  Robot& r = *static_cast<Robot*>(user);
+  if (first) {
+    const arflex::sim::JointState js = r.cell->ReadJointState();
+    r.q_ref = js.q;
+    r.cell->SetJointReference(r.q_ref);
+    r.cell->SetCorrection(JointVector{});
+  }
+  r.safe = true;
+  return StepAndPublish(c, r, arflex_sys_now_ns());
+}
+
+void Cleanup(arflex_component*, void* user) {
+  Robot& r = *static_cast<Robot*>(user);
+  r.cell.reset();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  arflex_component_ops ops{};
+  ops.name = "sim-robot";
+  ops.user = &g_robot;
+  ops.configure = Configure;
+  ops.start = Start;
+  ops.update = Update;
+  ops.safe = Safe;
+  ops.cleanup = Cleanup;
+  return arflex_component_main(argc, argv, &ops);
+}

@@ -1,0 +1,554 @@
+// sim.comp.*: sim-robot and sim-camera as RT halves under the rt-core host API (what the DRCR
+// does): create the instance's objects, spawn, START, BIND, read the outputs, STOP, SHUTDOWN,
+// destroy, and check that nothing is left. Waits are on conditions with deadlines; nothing
+// asserts timings.
+#include <apriltag/apriltag.h>
+#include <apriltag/tag36h11.h>
+#include <dirent.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <arflex/host.h>
+#include <arflex_types/image_frame.h>
+#include <arflex_types/joint_ref.h>
+#include <arflex_types/joint_state.h>
+#include <arflex_types/wrench.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <functional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "arflex_sim/ground_truth.h"
+
+namespace {
+
+constexpr uint64_t kMs = 1000000ull;
+constexpr uint64_t kSec = 1000 * kMs;
+constexpr uint64_t kCall = 10 * kSec;
+constexpr double kHome[6] = {0.0, 0.5, 0.3, 0.0, 0.8, 0.0};
+constexpr uint32_t kFrameElem =
+    ARFLEX_TYPE_IMAGE_FRAME_SIZE + ARFLEX_TYPE_IMAGE_FRAME_MAX_PAYLOAD;
+
+const arflex_port_type kJointRefType = {ARFLEX_TYPE_JOINT_REF_NAME, 1, 0,
+                                        ARFLEX_TYPE_JOINT_REF_SIZE};
+const arflex_port_type kJointStateType = {ARFLEX_TYPE_JOINT_STATE_NAME, 1, 0,
+                                          ARFLEX_TYPE_JOINT_STATE_SIZE};
+const arflex_port_type kWrenchType = {ARFLEX_TYPE_WRENCH_NAME, 1, 0, ARFLEX_TYPE_WRENCH_SIZE};
+const arflex_port_type kTruthType = {ARFLEX_SIM_TRUTH_TYPE_NAME, 1, 0, ARFLEX_SIM_TRUTH_SIZE};
+const arflex_port_type kFrameType = {ARFLEX_TYPE_IMAGE_FRAME_NAME, 1, 0, kFrameElem};
+
+uint64_t Now() { return arflex_sys_now_ns(); }
+
+void Pause() {
+  const timespec ts = {0, 1000000};  // poll interval of a condition wait
+  nanosleep(&ts, nullptr);
+}
+
+// Waits until `cond` is true or `timeout` passes; returns the last value of `cond`.
+bool WaitFor(const std::function<bool()>& cond, uint64_t timeout = 60 * kSec) {
+  const uint64_t end = Now() + timeout;
+  while (!cond()) {
+    if (Now() > end) return cond();
+    Pause();
+  }
+  return true;
+}
+
+arflex_param_slot ParamF(const char* name, double def, double lo, double hi, bool mut) {
+  arflex_param_slot s;
+  std::memset(&s, 0, sizeof(s));
+  std::snprintf(s.name, sizeof(s.name), "%s", name);
+  s.type = ARFLEX_PARAM_DOUBLE;
+  s.flags = mut ? ARFLEX_PARAM_MUTABLE : 0;
+  s.min_bits = arflex_f64_bits(lo);
+  s.max_bits = arflex_f64_bits(hi);
+  s.default_bits = arflex_f64_bits(def);
+  return s;
+}
+arflex_param_slot ParamI(const char* name, int64_t def, int64_t lo, int64_t hi, bool mut) {
+  arflex_param_slot s;
+  std::memset(&s, 0, sizeof(s));
+  std::snprintf(s.name, sizeof(s.name), "%s", name);
+  s.type = ARFLEX_PARAM_INT64;
+  s.flags = mut ? ARFLEX_PARAM_MUTABLE : 0;
+  s.min_bits = static_cast<uint64_t>(lo);
+  s.max_bits = static_cast<uint64_t>(hi);
+  s.default_bits = static_cast<uint64_t>(def);
+  return s;
+}
+arflex_param_slot ParamB(const char* name, bool def, bool mut) {
+  arflex_param_slot s;
+  std::memset(&s, 0, sizeof(s));
+  std::snprintf(s.name, sizeof(s.name), "%s", name);
+  s.type = ARFLEX_PARAM_BOOL;
+  s.flags = mut ? ARFLEX_PARAM_MUTABLE : 0;
+  s.default_bits = def ? 1 : 0;
+  return s;
+}
+
+arflex_ctl_config Config(uint64_t period_ns, bool moves_hardware) {
+  arflex_ctl_config c;
+  std::memset(&c, 0, sizeof(c));
+  c.period_ns = period_ns;
+  c.priority = 0;  // tests share the machine: SCHED_OTHER
+  c.safe_mode = ARFLEX_SAFE_HOLD;
+  c.cfg_flags = ARFLEX_CFG_NO_MLOCK | ARFLEX_CFG_NO_DMA_LATENCY |
+                (moves_hardware ? static_cast<uint32_t>(ARFLEX_CFG_MOVES_HARDWARE) : 0u);
+  return c;
+}
+
+// The parameters of sim-robot's contract (bundles/sim-robot/.../sim-robot.xml).
+std::vector<arflex_param_slot> RobotParams(int64_t steps_per_period) {
+  return {
+      ParamI("steps_per_period", steps_per_period, 1, 1000, false),
+      ParamI("seed", 1, 0, 1000000, false),
+      ParamF("payload_kg", 0, 0, 300, true),
+      ParamB("payload_known", true, true),
+      ParamF("push_force_n", 0, 0, 5000, true),
+      ParamF("push_dir_x", 0, -1, 1, true),
+      ParamF("push_dir_y", 1, -1, 1, true),
+      ParamF("push_dir_z", 0, -1, 1, true),
+      ParamF("push_duration_ms", 200, 0, 60000, true),
+      ParamB("obstacle_enable", false, true),
+      ParamF("obstacle_x", 1.8, -5, 5, true),
+      ParamF("obstacle_y", 0, -5, 5, true),
+      ParamF("obstacle_z", 1.0, -5, 5, true),
+      ParamF("guide_force_n", 0, 0, 500, true),
+      ParamF("guide_dx", 0, -1, 1, true),
+      ParamF("guide_dy", 0.2, -1, 1, true),
+      ParamF("guide_dz", 0, -1, 1, true),
+      ParamF("guide_duration_ms", 2000, 1, 60000, true),
+  };
+}
+
+class SimComponents : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    static int n = 0;
+    std::snprintf(rid_, sizeof(rid_), "simc-%d-%d", static_cast<int>(getpid()), n++);
+    std::memset(&robot_, 0, sizeof(robot_));
+    std::memset(&camera_, 0, sizeof(camera_));
+    std::memset(&ref_, 0, sizeof(ref_));
+  }
+  void TearDown() override {
+    if (camera_used_) arflex_host_destroy(&camera_);
+    if (robot_used_) arflex_host_destroy(&robot_);
+    if (ref_used_) arflex_port_destroy(&ref_);
+    EXPECT_EQ(Leftovers(), "") << "objects or children left behind";
+  }
+
+  // Every /dev/shm and /dev/mqueue object of this test's runtime id, and child processes.
+  std::string Leftovers() {
+    std::string left;
+    const std::string prefix = std::string("arflex.") + rid_ + ".";
+    for (const char* dir : {"/dev/shm", "/dev/mqueue"}) {
+      DIR* d = opendir(dir);
+      if (!d) continue;
+      while (dirent* e = readdir(d)) {
+        if (std::strncmp(e->d_name, prefix.c_str(), prefix.size()) == 0) {
+          left += std::string(dir) + "/" + e->d_name + " ";
+        }
+      }
+      closedir(d);
+    }
+    if (waitpid(-1, nullptr, WNOHANG) != -1 || errno != ECHILD) left += "child-process ";
+    return left;
+  }
+
+  void CreateRobot(uint64_t period_ns, int64_t steps_per_period, bool truth,
+                   uint64_t hb_timeout_ns = 0) {
+    std::vector<arflex_param_slot> params = RobotParams(steps_per_period);
+    std::vector<struct arflex_host_output> outs = {
+        {"joint_state", {ARFLEX_PORT_STATE, kJointStateType, 1, ARFLEX_OVERFLOW_NONE}},
+        {"wrench", {ARFLEX_PORT_STATE, kWrenchType, 1, ARFLEX_OVERFLOW_NONE}},
+    };
+    if (truth) outs.push_back({"truth", {ARFLEX_PORT_STATE, kTruthType, 1, ARFLEX_OVERFLOW_NONE}});
+    arflex_host_opts o{};
+    o.runtime = rid_;
+    o.instance = "robot";
+    o.config = Config(period_ns, true);
+    o.config.hb_timeout_ns = hb_timeout_ns;
+    o.params = params.data();
+    o.nparams = static_cast<unsigned>(params.size());
+    o.outputs = outs.data();
+    o.noutputs = static_cast<unsigned>(outs.size());
+    robot_used_ = true;
+    ASSERT_EQ(arflex_host_create(&robot_, &o), 0);
+    ASSERT_EQ(arflex_host_spawn(&robot_, SIM_ROBOT_EXE, nullptr, nullptr), 0);
+    ASSERT_EQ(arflex_host_wait_state(&robot_, ARFLEX_STATE_READY, 60 * kSec), 0);
+  }
+
+  void CreateCamera(uint64_t period_ns, int64_t camera, int64_t w, int64_t h, double noise) {
+    std::vector<arflex_param_slot> params = {
+        ParamI("camera", camera, 0, 3, false),   ParamI("width", w, 16, 1280, false),
+        ParamI("height", h, 16, 1024, false),    ParamB("color", false, false),
+        ParamF("noise_sigma", noise, 0, 50, true), ParamF("blur_sigma", 0, 0, 5, true),
+        ParamI("seed", 1, 0, 1000000, false),    ParamF("payload_kg", 0, 0, 300, false),
+    };
+    std::vector<struct arflex_host_output> outs = {
+        {"frames", {ARFLEX_PORT_FRAME, kFrameType, 2, ARFLEX_OVERFLOW_NONE}},
+    };
+    arflex_host_opts o{};
+    o.runtime = rid_;
+    o.instance = "camera";
+    o.config = Config(period_ns, false);
+    o.params = params.data();
+    o.nparams = static_cast<unsigned>(params.size());
+    o.outputs = outs.data();
+    o.noutputs = static_cast<unsigned>(outs.size());
+    camera_used_ = true;
+    ASSERT_EQ(arflex_host_create(&camera_, &o), 0);
+    ASSERT_EQ(arflex_host_spawn(&camera_, SIM_CAMERA_EXE, nullptr, nullptr), 0);
+    ASSERT_EQ(arflex_host_wait_state(&camera_, ARFLEX_STATE_READY, 60 * kSec), 0);
+  }
+
+  // A joint reference provider owned by the test (as an upstream component's output).
+  void CreateReference() {
+    char name[ARFLEX_OBJ_NAME_SIZE];
+    ASSERT_EQ(arflex_ctl_obj_name(name, sizeof(name), rid_, "ref", "out.q"), 0);
+    arflex_port_spec spec{ARFLEX_PORT_STATE, kJointRefType, 1, ARFLEX_OVERFLOW_NONE};
+    ref_used_ = true;
+    ASSERT_EQ(arflex_port_create(&ref_, name, &spec), 0);
+    ref_name_ = name;
+  }
+  void WriteReference(const double q[6]) {
+    static uint64_t seq = 0;
+    arflex_joint_ref r{};
+    r.t_ns = static_cast<int64_t>(Now());
+    r.seq = ++seq;
+    for (int i = 0; i < 6; ++i) r.q[i] = q[i];
+    ASSERT_EQ(arflex_state_write(&ref_, &r, sizeof(r)), 0);
+  }
+
+  // Opens a reader of output `port` of `h`.
+  void OpenReader(arflex_host* h, const char* port, arflex_port_method m,
+                  const arflex_port_type* t, arflex_port* p) {
+    const char* name = arflex_host_output_name(h, port);
+    ASSERT_NE(name, nullptr);
+    ASSERT_EQ(arflex_port_open(p, name, false, false, m, t), 0);
+  }
+
+  // Shuts an instance down cleanly and checks its exit code.
+  void Shutdown(arflex_host* h) {
+    EXPECT_EQ(arflex_host_shutdown(h, kCall), 0);
+    ASSERT_EQ(arflex_host_wait_exit(h, 30 * kSec), 0);
+    const int st = arflex_host_exit_status(h);
+    EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << "wait status " << st;
+  }
+
+  void SetF(arflex_host* h, const char* name, double v) {
+    ASSERT_EQ(arflex_host_set_param(h, name, arflex_f64_bits(v), nullptr, kCall), 0) << name;
+  }
+
+  char rid_[ARFLEX_ID_MAX + 1];
+  arflex_host robot_, camera_;
+  arflex_port ref_;
+  std::string ref_name_;
+  bool robot_used_ = false, camera_used_ = false, ref_used_ = false;
+};
+
+// Reads the newest value of a state port into `out` (any value, new or not): keeps the last
+// value read by this handle in `last` and returns whether there is one.
+template <typename T>
+bool Latest(arflex_port* p, T* last, bool* have) {
+  T v;
+  if (arflex_state_read(p, &v, sizeof(v), nullptr) == 1) {
+    *last = v;
+    *have = true;
+  }
+  return *have;
+}
+
+TEST_F(SimComponents, RobotFollowsJointReference) {
+  CreateRobot(1 * kMs, 1, false);
+  CreateReference();
+  arflex_port js_port, wr_port;
+  OpenReader(&robot_, "joint_state", ARFLEX_PORT_STATE, &kJointStateType, &js_port);
+  OpenReader(&robot_, "wrench", ARFLEX_PORT_STATE, &kWrenchType, &wr_port);
+  ASSERT_EQ(arflex_host_start(&robot_, kCall), 0);
+
+  arflex_joint_state js{};
+  bool have = false;
+  ASSERT_TRUE(WaitFor([&] { return Latest(&js_port, &js, &have); }));
+  for (int i = 0; i < 6; ++i) EXPECT_NEAR(js.q[i], kHome[i], 1e-3) << "joint " << i;
+  // Joint 2 carries the arm's weight: a large measured drive torque.
+  EXPECT_GT(std::fabs(js.tau[1]), 1000.0);
+  arflex_wrench wr{};
+  bool have_wr = false;
+  ASSERT_TRUE(WaitFor([&] { return Latest(&wr_port, &wr, &have_wr); }));
+  const double f = std::sqrt(wr.force[0] * wr.force[0] + wr.force[1] * wr.force[1] +
+                             wr.force[2] * wr.force[2]);
+  EXPECT_NEAR(f, 25.0 * 9.81, 0.05 * 25.0 * 9.81) << "tool weight at the wrist";
+
+  const double target[6] = {0.15, 0.45, 0.35, 0.2, 0.7, 0.3};
+  ASSERT_EQ(arflex_host_bind(&robot_, "joint_ref", ref_name_.c_str(), kCall), 0);
+  WriteReference(target);
+  const bool reached = WaitFor([&] {
+    if (!Latest(&js_port, &js, &have)) return false;
+    for (int i = 0; i < 6; ++i)
+      if (std::fabs(js.q[i] - target[i]) > 1e-4) return false;
+    return true;
+  });
+  for (int i = 0; i < 6; ++i) EXPECT_NEAR(js.q[i], target[i], 1e-4) << "joint " << i;
+  EXPECT_TRUE(reached);
+
+  // A reference outside the joint limits is refused (counted as an update error) and the arm
+  // stays where it is.
+  arflex_stats st;
+  ASSERT_EQ(arflex_ctl_stats_read(robot_.ctl, &st), 0);
+  const uint64_t errors_before = st.update_errors;
+  const double bad[6] = {0.15, 0.45, 0.35, 0.2, 3.0, 0.3};  // j5 limit is 125 deg
+  WriteReference(bad);
+  ASSERT_TRUE(WaitFor([&] {
+    return arflex_ctl_stats_read(robot_.ctl, &st) == 0 && st.update_errors > errors_before;
+  }));
+  const uint64_t seq0 = js.seq;
+  ASSERT_TRUE(WaitFor([&] { return Latest(&js_port, &js, &have) && js.seq > seq0 + 200; }));
+  EXPECT_NEAR(js.q[4], target[4], 1e-4);
+
+  EXPECT_EQ(arflex_host_stop(&robot_, kCall), 0);
+  arflex_port_close(&js_port);
+  arflex_port_close(&wr_port);
+  Shutdown(&robot_);
+}
+
+TEST_F(SimComponents, RobotLockStepPeriodsEqualPhysicsSteps) {
+  // Faster than real time: 3 physics steps of 1 ms every 0.5 ms period.
+  CreateRobot(500000, 3, true);
+  arflex_port truth_port, js_port;
+  OpenReader(&robot_, "truth", ARFLEX_PORT_STATE, &kTruthType, &truth_port);
+  OpenReader(&robot_, "joint_state", ARFLEX_PORT_STATE, &kJointStateType, &js_port);
+  ASSERT_EQ(arflex_host_start(&robot_, kCall), 0);
+  arflex_sim_ground_truth g{};
+  bool have = false;
+  ASSERT_TRUE(WaitFor([&] { return Latest(&truth_port, &g, &have) && g.cycles >= 700; }));
+  ASSERT_EQ(arflex_host_stop(&robot_, kCall), 0);
+
+  arflex_stats st;
+  ASSERT_EQ(arflex_ctl_stats_read(robot_.ctl, &st), 0);
+  Latest(&truth_port, &g, &have);
+  arflex_joint_state js{};
+  bool have_js = false;
+  ASSERT_TRUE(Latest(&js_port, &js, &have_js));
+  EXPECT_GE(st.cycles, 700u);
+  EXPECT_EQ(g.cycles, st.cycles) << "one update per RT cycle";
+  EXPECT_EQ(g.steps, 3 * st.cycles) << "exactly steps_per_period physics steps per period";
+  EXPECT_EQ(js.seq, st.cycles);
+  EXPECT_EQ(js.t_ns, g.t_ns);
+  EXPECT_NEAR(g.sim_time, 0.001 * static_cast<double>(g.steps), 1e-9);
+  EXPECT_EQ(g.safe, 0u);
+  // The true TCP is where the arm is: about 2.4 m in front of the base at the home pose.
+  EXPECT_GT(g.p[0], 1.5);
+  EXPECT_NEAR(g.quat[0] * g.quat[0] + g.quat[1] * g.quat[1] + g.quat[2] * g.quat[2] +
+                  g.quat[3] * g.quat[3], 1.0, 1e-9);
+
+  // A second run continues the count.
+  ASSERT_EQ(arflex_host_start(&robot_, kCall), 0);
+  ASSERT_TRUE(WaitFor([&] { return Latest(&truth_port, &g, &have) && g.cycles >= st.cycles + 100; }));
+  ASSERT_EQ(arflex_host_stop(&robot_, kCall), 0);
+  ASSERT_EQ(arflex_ctl_stats_read(robot_.ctl, &st), 0);
+  Latest(&truth_port, &g, &have);
+  EXPECT_EQ(g.steps, 3 * g.cycles);
+  arflex_port_close(&truth_port);
+  arflex_port_close(&js_port);
+  Shutdown(&robot_);
+}
+
+TEST_F(SimComponents, RobotScriptedPushShowsInWrenchAndTorques) {
+  CreateRobot(1 * kMs, 1, true);
+  arflex_port wr_port, js_port, truth_port;
+  OpenReader(&robot_, "wrench", ARFLEX_PORT_STATE, &kWrenchType, &wr_port);
+  OpenReader(&robot_, "joint_state", ARFLEX_PORT_STATE, &kJointStateType, &js_port);
+  OpenReader(&robot_, "truth", ARFLEX_PORT_STATE, &kTruthType, &truth_port);
+  ASSERT_EQ(arflex_host_start(&robot_, kCall), 0);
+  arflex_wrench wr{};
+  arflex_joint_state js{};
+  arflex_sim_ground_truth g{};
+  bool hw = false, hj = false, hg = false;
+  // Settle, then record the baseline.
+  ASSERT_TRUE(WaitFor([&] { return Latest(&js_port, &js, &hj) && js.seq > 300; }));
+  Latest(&wr_port, &wr, &hw);
+  ASSERT_TRUE(hw);
+  const arflex_wrench wr0 = wr;
+  const arflex_joint_state js0 = js;
+
+  // 400 N sideways (+y) on the tool for 2 s.
+  SetF(&robot_, "push_duration_ms", 2000);
+  SetF(&robot_, "push_force_n", 400);
+  double max_df = 0, max_dtau1 = 0;
+  ASSERT_TRUE(WaitFor([&] {
+    Latest(&wr_port, &wr, &hw);
+    Latest(&js_port, &js, &hj);
+    double df = 0;
+    for (int k = 0; k < 3; ++k) df += (wr.force[k] - wr0.force[k]) * (wr.force[k] - wr0.force[k]);
+    max_df = std::max(max_df, std::sqrt(df));
+    max_dtau1 = std::max(max_dtau1, std::fabs(js.tau[0] - js0.tau[0]));
+    return max_df > 300 && max_dtau1 > 300;
+  }));
+  EXPECT_GT(max_df, 300.0) << "wrist force change";
+  EXPECT_GT(max_dtau1, 300.0) << "joint 1 torque change (400 N at > 2 m lever)";
+  ASSERT_TRUE(Latest(&truth_port, &g, &hg));
+  EXPECT_NEAR(g.ext_force[1], 400.0, 1e-6) << "the push as applied";
+
+  // The push ends and the wrench returns to the tool weight.
+  ASSERT_TRUE(WaitFor([&] {
+    Latest(&wr_port, &wr, &hw);
+    Latest(&truth_port, &g, &hg);
+    double df = 0;
+    for (int k = 0; k < 3; ++k) df += (wr.force[k] - wr0.force[k]) * (wr.force[k] - wr0.force[k]);
+    return g.ext_force[1] == 0.0 && std::sqrt(df) < 10.0;
+  }));
+  EXPECT_EQ(arflex_host_stop(&robot_, kCall), 0);
+  arflex_port_close(&wr_port);
+  arflex_port_close(&js_port);
+  arflex_port_close(&truth_port);
+  Shutdown(&robot_);
+}
+
+TEST_F(SimComponents, RobotSafeHookHoldsPosition) {
+  CreateRobot(1 * kMs, 1, true, 300 * kMs);
+  CreateReference();
+  arflex_port js_port, truth_port;
+  OpenReader(&robot_, "joint_state", ARFLEX_PORT_STATE, &kJointStateType, &js_port);
+  OpenReader(&robot_, "truth", ARFLEX_PORT_STATE, &kTruthType, &truth_port);
+  arflex_host_heartbeat(&robot_);
+  ASSERT_EQ(arflex_host_start(&robot_, kCall), 0);
+  ASSERT_EQ(arflex_host_bind(&robot_, "joint_ref", ref_name_.c_str(), kCall), 0);
+  // A motion is under way when the runtime's heartbeat stops: the arm must stop where it is.
+  const double far[6] = {0.9, 0.5, 0.3, 0.0, 0.8, 0.0};
+  WriteReference(far);
+  arflex_joint_state js{};
+  arflex_sim_ground_truth g{};
+  bool hj = false, hg = false;
+  ASSERT_TRUE(WaitFor([&] {
+    arflex_host_heartbeat(&robot_);
+    return Latest(&js_port, &js, &hj) && js.q[0] > 0.02;
+  }));
+  // No more heartbeats: safe mode within the timeout.
+  ASSERT_TRUE(WaitFor([&] { return Latest(&truth_port, &g, &hg) && g.safe == 1u; }));
+  const uint64_t c0 = g.cycles;
+  ASSERT_TRUE(WaitFor([&] { return Latest(&truth_port, &g, &hg) && g.cycles > c0 + 1500; }));
+  ASSERT_TRUE(WaitFor([&] { return Latest(&js_port, &js, &hj) && js.seq >= g.seq; }));
+  const double q_hold = js.q[0];
+  EXPECT_LT(q_hold, 0.85) << "did not continue to the reference";
+  const uint64_t c1 = g.cycles;
+  ASSERT_TRUE(WaitFor([&] { return Latest(&truth_port, &g, &hg) && g.cycles > c1 + 500; }));
+  ASSERT_TRUE(WaitFor([&] { return Latest(&js_port, &js, &hj) && js.seq >= g.seq; }));
+  EXPECT_NEAR(js.q[0], q_hold, 1e-5) << "held";
+  EXPECT_EQ(g.steps, g.cycles) << "physics keeps stepping in safe mode";
+  // Moves hardware: a fresh heartbeat alone does not end safe mode; the operator's RESET does.
+  arflex_host_heartbeat(&robot_);
+  ASSERT_TRUE(WaitFor([&] {
+    return (arflex_ctl_flags(robot_.ctl) & ARFLEX_FLAG_RESET_REQUIRED) != 0;
+  }));
+  EXPECT_TRUE(Latest(&truth_port, &g, &hg) && g.safe == 1u);
+  EXPECT_EQ(arflex_host_reset(&robot_, kCall), 0);
+  ASSERT_TRUE(WaitFor([&] {
+    arflex_host_heartbeat(&robot_);
+    return Latest(&truth_port, &g, &hg) && g.safe == 0u;
+  }));
+  // After the reset the arm stays held: the old reference is not resumed.
+  const uint64_t c2 = g.cycles;
+  ASSERT_TRUE(WaitFor([&] {
+    arflex_host_heartbeat(&robot_);
+    return Latest(&truth_port, &g, &hg) && g.cycles > c2 + 300;
+  }));
+  ASSERT_TRUE(WaitFor([&] { return Latest(&js_port, &js, &hj) && js.seq >= g.seq; }));
+  EXPECT_NEAR(js.q[0], q_hold, 1e-5);
+  arflex_host_heartbeat(&robot_);
+  EXPECT_EQ(arflex_host_stop(&robot_, kCall), 0);
+  arflex_port_close(&js_port);
+  arflex_port_close(&truth_port);
+  Shutdown(&robot_);
+}
+
+class TagDetector {
+ public:
+  TagDetector() : family_(tag36h11_create()), det_(apriltag_detector_create()) {
+    apriltag_detector_add_family(det_, family_);
+    det_->quad_decimate = 1.0;
+    det_->nthreads = 1;
+  }
+  ~TagDetector() {
+    apriltag_detector_destroy(det_);
+    tag36h11_destroy(family_);
+  }
+  std::set<int> Detect(const uint8_t* gray, int w, int h, int stride) {
+    std::vector<uint8_t> copy(gray, gray + static_cast<size_t>(stride) * h);
+    image_u8_t im = {w, h, stride, copy.data()};
+    zarray_t* dets = apriltag_detector_detect(det_, &im);
+    std::set<int> ids;
+    for (int i = 0; i < zarray_size(dets); ++i) {
+      apriltag_detection_t* d;
+      zarray_get(dets, i, &d);
+      if (d->hamming == 0) ids.insert(d->id);
+    }
+    apriltag_detections_destroy(dets);
+    return ids;
+  }
+
+ private:
+  apriltag_family_t* family_;
+  apriltag_detector_t* det_;
+};
+
+TEST_F(SimComponents, CameraRendersArmFromJointStateAndTagsAreFound) {
+  CreateRobot(1 * kMs, 1, false);
+  CreateCamera(40 * kMs, 0, 800, 600, 1.0);
+  arflex_port frames, js_port;
+  OpenReader(&camera_, "frames", ARFLEX_PORT_FRAME, &kFrameType, &frames);
+  OpenReader(&robot_, "joint_state", ARFLEX_PORT_STATE, &kJointStateType, &js_port);
+  ASSERT_EQ(arflex_host_start(&robot_, kCall), 0);
+  ASSERT_EQ(arflex_host_bind(&camera_, "joint_state",
+                             arflex_host_output_name(&robot_, "joint_state"), kCall), 0);
+  ASSERT_EQ(arflex_host_start(&camera_, kCall), 0);
+
+  // Collect a few frames; each must carry the time of a joint state the robot published.
+  TagDetector detector;
+  int frames_seen = 0;
+  std::set<int> ids;
+  arflex_image_frame hdr{};
+  ASSERT_TRUE(WaitFor([&] {
+    arflex_frame_view v;
+    if (arflex_frame_acquire(&frames, &v) != 1) return false;
+    std::memcpy(&hdr, v.data, sizeof(hdr));
+    if (hdr.width == 800 && hdr.height == 600 && hdr.format == ARFLEX_IMAGE_FRAME_FORMAT_GRAY8 &&
+        v.length == ARFLEX_TYPE_IMAGE_FRAME_SIZE + hdr.bytes) {
+      const uint8_t* px = static_cast<const uint8_t*>(v.data) + ARFLEX_TYPE_IMAGE_FRAME_SIZE;
+      std::set<int> got = detector.Detect(px, 800, 600, static_cast<int>(hdr.stride));
+      if (arflex_frame_valid(&v)) {
+        ++frames_seen;
+        ids = got;
+      }
+    }
+    return frames_seen >= 2;
+  }));
+  EXPECT_EQ(hdr.camera, 0u);
+  EXPECT_EQ(hdr.stride, 800u);
+  EXPECT_EQ(hdr.bytes, 800u * 600u);
+  EXPECT_GT(hdr.t_ns, 0);
+  arflex_joint_state js{};
+  bool hj = false;
+  ASSERT_TRUE(Latest(&js_port, &js, &hj));
+  EXPECT_LE(hdr.t_ns, js.t_ns);
+  EXPECT_EQ((js.t_ns - hdr.t_ns) % 1000000, 0) << "a release time of the robot's 1 ms grid";
+  // Camera 0 at the home pose sees the reference-board tags 0, 1, 3 and the tool tags 10, 11
+  // (the golden set of sim.RenderTest at pose_a).
+  EXPECT_TRUE(ids.count(10)) << "tool tag 10";
+  EXPECT_TRUE(ids.count(11)) << "tool tag 11";
+  EXPECT_TRUE(ids.count(0) && ids.count(1) && ids.count(3)) << "reference board tags";
+
+  EXPECT_EQ(arflex_host_stop(&camera_, kCall), 0);
+  EXPECT_EQ(arflex_host_stop(&robot_, kCall), 0);
+  arflex_port_close(&frames);
+  arflex_port_close(&js_port);
+  Shutdown(&camera_);
+  Shutdown(&robot_);
+}
+
+}  // namespace
