@@ -2,7 +2,9 @@
  * arflex-bench-ipc - IPC costs of rt-core against their raw floors, measured in one run with
  * two processes pinned to different CPUs.
  *
- * Cases (each: warm-up samples discarded, then N samples):
+ * Cases (each: warm-up samples discarded, then N samples; the two cases of a comparison run
+ * interleaved, in R rounds of N/R samples each with alternating order, so that both see the
+ * same machine even when the load from elsewhere drifts):
  *   raw-shm     one-way latency, raw shared memory: the writer stores a CLOCK_MONOTONIC
  *               timestamp and then a sequence word (release); the reader spins on the word
  *               (acquire) and records now - timestamp. The floor of any shm transport.
@@ -56,6 +58,7 @@ static const char *const case_name[C_COUNT] = { "raw-shm", "state-port", "raw-mq
 
 struct opts {
 	uint64_t n_port, n_mq, warmup;
+	unsigned rounds;
 	int cpu_a, cpu_b;
 	int priority;
 	char json[PATH_MAX];
@@ -137,11 +140,12 @@ static void on_signal(int sig)
 static void usage(FILE *f, const char *argv0)
 {
 	fprintf(f,
-		"usage: %s [--samples N] [--mq-samples N] [--warmup N] [--cpus A,B]\n"
+		"usage: %s [--samples N] [--mq-samples N] [--warmup N] [--rounds R] [--cpus A,B]\n"
 		"          [--priority P] [--json FILE]\n"
 		"  --samples N     one-way samples per shm case (default 100000)\n"
 		"  --mq-samples N  round trips per queue case (default 20000)\n"
-		"  --warmup N      discarded samples before each case (default 2000)\n"
+		"  --warmup N      discarded samples of each case before the first round (default 2000)\n"
+		"  --rounds R      the compared cases alternate in R rounds of N/R samples (default 10)\n"
 		"  --cpus A,B      CPU of the writer/requester and of the reader/server (default 0,1)\n"
 		"  --priority P    SCHED_FIFO priority of both processes, 0 = SCHED_OTHER (default 0)\n"
 		"  --json FILE     where to write the results (default: bench-ipc.json in the build\n"
@@ -171,6 +175,7 @@ static int parse_args(int argc, char **argv, struct opts *o)
 		{ "samples", required_argument, NULL, 's' },
 		{ "mq-samples", required_argument, NULL, 'm' },
 		{ "warmup", required_argument, NULL, 'w' },
+		{ "rounds", required_argument, NULL, 'r' },
 		{ "cpus", required_argument, NULL, 'c' },
 		{ "priority", required_argument, NULL, 'p' },
 		{ "json", required_argument, NULL, 'j' },
@@ -184,6 +189,7 @@ static int parse_args(int argc, char **argv, struct opts *o)
 	o->n_port = 100000;
 	o->n_mq = 20000;
 	o->warmup = 2000;
+	o->rounds = 10;
 	o->cpu_a = 0;
 	o->cpu_b = ncpu > 1 ? 1 : 0;
 	o->priority = 0;
@@ -201,6 +207,11 @@ static int parse_args(int argc, char **argv, struct opts *o)
 		case 'w':
 			if (parse_u64("--warmup", optarg, 0, 10000000, &o->warmup))
 				return 2;
+			break;
+		case 'r':
+			if (parse_u64("--rounds", optarg, 1, 1000, &v))
+				return 2;
+			o->rounds = (unsigned)v;
 			break;
 		case 'c': {
 			int a, b, n = 0;
@@ -296,131 +307,159 @@ static int spin_eq(_Atomic uint64_t *w, uint64_t want)
 	}
 }
 
-/* ---- child: reader of the one-way cases, server of the round-trip cases ------------- */
+/* ---- the schedule: rounds of interleaved segments --------------------------------- */
 
-static int child_serve_mq(mqd_t rx, mqd_t tx, uint64_t total)
+/*
+ * Both processes follow the same schedule. Round 0 is the warm-up (o->warmup samples of each
+ * case, discarded); rounds 1..R split the N samples of each case evenly. In each round the
+ * two cases being compared run one after the other, in alternating order, so that both see
+ * the same machine (load from elsewhere drifts over a run; interleaving spreads it evenly).
+ */
+static uint64_t seg_count(const struct opts *o, unsigned round, uint64_t n)
 {
-	char buf[MQ_MSG];
-
-	for (uint64_t i = 0; i < total; i++) {
-		struct timespec dl = arflex_sys_realtime_in(SPIN_TIMEOUT);
-
-		if (mq_timedreceive(rx, buf, sizeof(buf), NULL, &dl) != MQ_MSG)
-			return -errno;
-		if (mq_send(tx, buf, MQ_MSG, 0) != 0)
-			return -errno;
-	}
-	return 0;
+	if (round == 0)
+		return o->warmup;
+	return n / o->rounds + (round == o->rounds ? n % o->rounds : 0);
 }
 
-static int child_serve_mailbox(const char *rid, uint64_t total)
+/* Case run at position @k (0 or 1) of round @round, for the pair (@a, @b). */
+static int seg_case(unsigned round, int k, int a, int b)
+{
+	return (round % 2 == 0) == (k == 0) ? a : b;
+}
+
+/* ---- child: reader of the one-way cases, server of the round-trip cases ------------- */
+
+/* Spins on a state port until a new value arrives; returns its stamp in *@stamp. */
+static int read_port(struct arflex_port *p, uint64_t *stamp)
+{
+	uint64_t deadline = 0;
+
+	for (unsigned k = 0;; k++) {
+		if (arflex_state_read(p, stamp, sizeof(*stamp), NULL) == 1)
+			return 0;
+		if ((k & 4095) == 0) {
+			uint64_t now = arflex_sys_now_ns();
+
+			if (!deadline)
+				deadline = now + SPIN_TIMEOUT;
+			else if (now > deadline)
+				return -ETIMEDOUT;
+		}
+	}
+}
+
+static int child_one_way(const struct opts *o, struct shared *sh, uint64_t *samples,
+			 uint64_t *seg)
+{
+	struct arflex_port p;
+	uint64_t raw_n = 0, ack_n = 0, rec[2] = { 0, 0 };
+	int r = arflex_port_open(&p, port_name, false, false, ARFLEX_PORT_STATE, NULL);
+
+	if (r)
+		return r;
+	for (unsigned round = 0; round <= o->rounds; round++) {
+		for (int k = 0; k < 2; k++) {
+			int c = seg_case(round, k, C_RAW_SHM, C_STATE_PORT);
+			uint64_t n = seg_count(o, round, o->n_port);
+			uint64_t *out = samples + (c == C_RAW_SHM ? 0 : o->n_port);
+
+			atomic_store_explicit(&sh->phase, ++*seg, memory_order_release);
+			for (uint64_t i = 0; i < n; i++) {
+				uint64_t stamp, lat;
+
+				if (c == C_RAW_SHM) {
+					r = spin_eq(&sh->seq, ++raw_n);
+					stamp = atomic_load_explicit(&sh->stamp,
+								     memory_order_relaxed);
+				} else {
+					r = read_port(&p, &stamp);
+				}
+				lat = arflex_sys_now_ns() - stamp;
+				if (r)
+					goto out;
+				if (round > 0)
+					out[rec[c]++] = lat;
+				atomic_store_explicit(&sh->ack, ++ack_n, memory_order_release);
+			}
+		}
+	}
+out:
+	arflex_port_close(&p);
+	return r;
+}
+
+static int child_round_trip(const struct opts *o, struct shared *sh, const char *rid,
+			    mqd_t rx, mqd_t tx, uint64_t *seg)
 {
 	struct arflex_mailbox mb;
 	struct arflex_msg m;
+	char buf[MQ_MSG];
 	int r = arflex_mailbox_attach(&mb, rid, "mbox");
 
 	if (r)
 		return r;
-	for (uint64_t i = 0; i < total && r == 0; i++) {
-		r = arflex_mailbox_recv(&mb, &m, SPIN_TIMEOUT);
-		if (r)
-			break;
-		m.flags |= ARFLEX_MSG_REPLY;
-		m.status = 0;
-		r = arflex_mailbox_send(&mb, &m, SPIN_TIMEOUT);
+	for (unsigned round = 0; round <= o->rounds && r == 0; round++) {
+		for (int k = 0; k < 2 && r == 0; k++) {
+			int c = seg_case(round, k, C_RAW_MQ, C_MAILBOX);
+			uint64_t n = seg_count(o, round, o->n_mq);
+
+			atomic_store_explicit(&sh->phase, ++*seg, memory_order_release);
+			for (uint64_t i = 0; i < n && r == 0; i++) {
+				if (c == C_RAW_MQ) {
+					struct timespec dl = arflex_sys_realtime_in(SPIN_TIMEOUT);
+
+					if (mq_timedreceive(rx, buf, sizeof(buf), NULL, &dl) != MQ_MSG ||
+					    mq_send(tx, buf, MQ_MSG, 0) != 0)
+						r = -errno;
+				} else {
+					r = arflex_mailbox_recv(&mb, &m, SPIN_TIMEOUT);
+					if (r)
+						break;
+					m.flags |= ARFLEX_MSG_REPLY;
+					m.status = 0;
+					r = arflex_mailbox_send(&mb, &m, SPIN_TIMEOUT);
+				}
+			}
+		}
 	}
 	arflex_mailbox_deinit(&mb); /* attached: closes, never unlinks */
 	return r;
 }
 
-/* The state-port reader records its samples into the shared sample area. */
-/* Acks continue from @base (the raw case's last ack): never reset, so the writer cannot miss
- * its last ack of the previous case. */
-static int child_state_port(struct shared *sh, uint64_t base, uint64_t total, uint64_t *out)
-{
-	struct arflex_port p;
-	int r = arflex_port_open(&p, port_name, false, false, ARFLEX_PORT_STATE, NULL);
-
-	if (r)
-		return r;
-	/* Ready only once the port is open: a value written before the open would not count
-	 * as new for this handle. */
-	atomic_store_explicit(&sh->phase, C_STATE_PORT + 1, memory_order_release);
-	for (uint64_t i = 0; i < total; i++) {
-		uint64_t stamp, deadline = 0;
-
-		for (unsigned k = 0;; k++) {
-			if (arflex_state_read(&p, &stamp, sizeof(stamp), NULL) == 1)
-				break;
-			if ((k & 4095) == 0) {
-				uint64_t now = arflex_sys_now_ns();
-
-				if (!deadline) {
-					deadline = now + SPIN_TIMEOUT;
-				} else if (now > deadline) {
-					arflex_port_close(&p);
-					return -ETIMEDOUT;
-				}
-			}
-		}
-		out[i] = arflex_sys_now_ns() - stamp;
-		atomic_store_explicit(&sh->ack, base + i + 1, memory_order_release);
-	}
-	arflex_port_close(&p);
-	return 0;
-}
-
-static int child_raw_shm_rec(struct shared *sh, uint64_t total, uint64_t *out)
-{
-	for (uint64_t i = 0; i < total; i++) {
-		int r = spin_eq(&sh->seq, i + 1);
-
-		if (r)
-			return r;
-		out[i] = arflex_sys_now_ns() - atomic_load_explicit(&sh->stamp,
-								   memory_order_relaxed);
-		atomic_store_explicit(&sh->ack, i + 1, memory_order_release);
-	}
-	return 0;
-}
-
 static void child_main(const struct opts *o, struct shared *sh, uint64_t *samples,
 		       const char *rid, mqd_t mq_a, mqd_t mq_b)
 {
-	uint64_t np = o->n_port + o->warmup, nm = o->n_mq + o->warmup;
+	uint64_t seg = 0;
 	int r;
 
 	prctl(PR_SET_PDEATHSIG, SIGKILL);
 	if (getppid() == 1)
 		_exit(1);
 	setup_cpu(o->cpu_b, o->priority, "reader");
-
-	atomic_store_explicit(&sh->phase, C_RAW_SHM + 1, memory_order_release);
-	r = child_raw_shm_rec(sh, np, samples);
-	if (r)
-		goto fail;
-	r = child_state_port(sh, np, np, samples + np);
-	if (r)
-		goto fail;
-	atomic_store_explicit(&sh->phase, C_RAW_MQ + 1, memory_order_release);
-	r = child_serve_mq(mq_a, mq_b, nm);
-	if (r)
-		goto fail;
-	atomic_store_explicit(&sh->phase, C_MAILBOX + 1, memory_order_release);
-	r = child_serve_mailbox(rid, nm);
-	if (r)
-		goto fail;
-	_exit(0);
-fail:
+	r = child_one_way(o, sh, samples, &seg);
+	if (r == 0)
+		r = child_round_trip(o, sh, rid, mq_a, mq_b, &seg);
+	if (r == 0)
+		_exit(0);
 	atomic_store_explicit(&sh->child_error, r, memory_order_release);
 	_exit(1);
 }
 
 /* ---- parent: writer of the one-way cases, requester of the round trips -------------- */
 
-static int wait_phase(struct shared *sh, int c)
+/* Waits until the peer reached segment @seg (it may be further on if segments were empty). */
+static int wait_phase(struct shared *sh, uint64_t seg, int c)
 {
-	int r = spin_eq(&sh->phase, (uint64_t)c + 1);
+	uint64_t deadline = arflex_sys_now_ns() + SPIN_TIMEOUT;
+	int r = 0;
+
+	while (atomic_load_explicit(&sh->phase, memory_order_acquire) < seg) {
+		if (arflex_sys_now_ns() > deadline) {
+			r = -ETIMEDOUT;
+			break;
+		}
+	}
 
 	if (r)
 		fprintf(stderr, "arflex-bench-ipc: %s: the reader process did not get ready\n",
@@ -428,66 +467,81 @@ static int wait_phase(struct shared *sh, int c)
 	return r;
 }
 
-static int parent_raw_shm(struct shared *sh, uint64_t total)
+/* Runs the one-way schedule as the writer. On failure *@failed is the case. */
+static int parent_one_way(const struct opts *o, struct shared *sh, struct arflex_port *p,
+			  uint64_t *seg, int *failed)
 {
-	for (uint64_t i = 0; i < total; i++) {
-		atomic_store_explicit(&sh->stamp, arflex_sys_now_ns(), memory_order_relaxed);
-		atomic_store_explicit(&sh->seq, i + 1, memory_order_release);
-		if (spin_eq(&sh->ack, i + 1))
-			return -ETIMEDOUT;
+	uint64_t raw_n = 0, ack_n = 0;
+
+	for (unsigned round = 0; round <= o->rounds; round++) {
+		for (int k = 0; k < 2; k++) {
+			int c = seg_case(round, k, C_RAW_SHM, C_STATE_PORT);
+			uint64_t n = seg_count(o, round, o->n_port);
+			int r;
+
+			*failed = c;
+			if ((r = wait_phase(sh, ++*seg, c)))
+				return r;
+			for (uint64_t i = 0; i < n; i++) {
+				uint64_t stamp = arflex_sys_now_ns();
+
+				if (c == C_RAW_SHM) {
+					atomic_store_explicit(&sh->stamp, stamp,
+							      memory_order_relaxed);
+					atomic_store_explicit(&sh->seq, ++raw_n,
+							      memory_order_release);
+				} else if ((r = arflex_state_write(p, &stamp, sizeof(stamp)))) {
+					return r;
+				}
+				if ((r = spin_eq(&sh->ack, ++ack_n)))
+					return r;
+			}
+		}
 	}
 	return 0;
 }
 
-static int parent_state_port(struct shared *sh, struct arflex_port *p, uint64_t base,
-			     uint64_t total)
+/* Runs the round-trip schedule as the requester; @out[0] raw-mq, @out[1] mailbox. */
+static int parent_round_trip(const struct opts *o, struct shared *sh, mqd_t tx, mqd_t rx,
+			     struct arflex_mailbox *mb, uint64_t *out[2], uint64_t *seg,
+			     int *failed)
 {
-	for (uint64_t i = 0; i < total; i++) {
-		uint64_t stamp = arflex_sys_now_ns();
-		int r = arflex_state_write(p, &stamp, sizeof(stamp));
-
-		if (r)
-			return r;
-		if (spin_eq(&sh->ack, base + i + 1))
-			return -ETIMEDOUT;
-	}
-	return 0;
-}
-
-static int parent_raw_mq(mqd_t tx, mqd_t rx, uint64_t warmup, uint64_t n, uint64_t *out)
-{
+	uint64_t rec[2] = { 0, 0 };
+	uint32_t msg_seq = 0;
 	char buf[MQ_MSG];
 
 	memset(buf, 0x5a, sizeof(buf));
-	for (uint64_t i = 0; i < warmup + n; i++) {
-		struct timespec dl = arflex_sys_realtime_in(SPIN_TIMEOUT);
-		uint64_t t0 = arflex_sys_now_ns();
+	for (unsigned round = 0; round <= o->rounds; round++) {
+		for (int k = 0; k < 2; k++) {
+			int c = seg_case(round, k, C_RAW_MQ, C_MAILBOX);
+			uint64_t n = seg_count(o, round, o->n_mq);
+			int r;
 
-		if (mq_send(tx, buf, MQ_MSG, 0) != 0)
-			return -errno;
-		if (mq_timedreceive(rx, buf, sizeof(buf), NULL, &dl) != MQ_MSG)
-			return -errno;
-		if (i >= warmup)
-			out[i - warmup] = arflex_sys_now_ns() - t0;
-	}
-	return 0;
-}
+			*failed = c;
+			if ((r = wait_phase(sh, ++*seg, c)))
+				return r;
+			for (uint64_t i = 0; i < n; i++) {
+				uint64_t t0 = arflex_sys_now_ns(), t1;
 
-static int parent_mailbox(struct arflex_mailbox *mb, uint64_t warmup, uint64_t n,
-			  uint64_t *out)
-{
-	struct arflex_msg req, rsp;
+				if (c == C_RAW_MQ) {
+					struct timespec dl = arflex_sys_realtime_in(SPIN_TIMEOUT);
 
-	for (uint64_t i = 0; i < warmup + n; i++) {
-		uint64_t t0 = arflex_sys_now_ns();
-		int r;
+					if (mq_send(tx, buf, MQ_MSG, 0) != 0 ||
+					    mq_timedreceive(rx, buf, sizeof(buf), NULL, &dl) != MQ_MSG)
+						return -errno;
+				} else {
+					struct arflex_msg req, rsp;
 
-		arflex_msg_init(&req, ARFLEX_CMD_PING, (uint32_t)(i + 1));
-		r = arflex_mailbox_call(mb, &req, &rsp, SPIN_TIMEOUT);
-		if (r)
-			return r;
-		if (i >= warmup)
-			out[i - warmup] = arflex_sys_now_ns() - t0;
+					arflex_msg_init(&req, ARFLEX_CMD_PING, ++msg_seq);
+					if ((r = arflex_mailbox_call(mb, &req, &rsp, SPIN_TIMEOUT)))
+						return r;
+				}
+				t1 = arflex_sys_now_ns();
+				if (round > 0)
+					out[c == C_RAW_MQ ? 0 : 1][rec[c == C_RAW_MQ ? 0 : 1]++] =
+						t1 - t0;
+			}
+		}
 	}
 	return 0;
 }
@@ -579,7 +633,7 @@ static int write_json(const struct opts *o, const struct stat5 *s, double r_port
 		u.release);
 	fprintf(f, "  \"cpus\": [%d, %d],\n  \"priority\": %d,\n  \"warmup\": %" PRIu64 ",\n",
 		o->cpu_a, o->cpu_b, o->priority, o->warmup);
-	fprintf(f, "  \"clock_read_ns\": %.1f,\n", clk);
+	fprintf(f, "  \"rounds\": %u,\n  \"clock_read_ns\": %.1f,\n", o->rounds, clk);
 	fprintf(f, "  \"cases\": {\n");
 	for (int c = 0; c < C_COUNT; c++)
 		fprintf(f, "    \"%s\": {\"kind\": \"%s\", \"samples\": %" PRIu64 ", \"min_ns\": %"
@@ -629,6 +683,7 @@ int main(int argc, char **argv)
 	struct stat5 st[C_COUNT];
 	double r_port, r_mb, clk;
 	int fd = -1, r, status, ret = 1, cur = 0;
+	uint64_t seg = 0;
 	struct sigaction sa;
 
 	r = parse_args(argc, argv, &o);
@@ -657,7 +712,7 @@ int main(int argc, char **argv)
 	arflex_sys_close(fd);
 	fd = -1;
 	/* one-way samples of the child (anonymous shared mapping, inherited by fork) */
-	samples_len = 2 * (o.n_port + o.warmup) * sizeof(uint64_t);
+	samples_len = 2 * o.n_port * sizeof(uint64_t);
 	if ((r = arflex_sys_mmap((void **)&samples, samples_len, PROT_READ | PROT_WRITE,
 				 MAP_SHARED | MAP_ANONYMOUS, -1, 0)))
 		goto out_err;
@@ -709,20 +764,8 @@ int main(int argc, char **argv)
 		child_main(&o, sh, samples, rid, mq_a, mq_b);
 	setup_cpu(o.cpu_a, o.priority, "writer");
 
-	cur = C_RAW_SHM;
-	if ((r = wait_phase(sh, C_RAW_SHM)) || (r = parent_raw_shm(sh, o.n_port + o.warmup)))
-		goto out_case;
-	cur = C_STATE_PORT;
-	if ((r = wait_phase(sh, C_STATE_PORT)) ||
-	    (r = parent_state_port(sh, &port, o.n_port + o.warmup, o.n_port + o.warmup)))
-		goto out_case;
-	cur = C_RAW_MQ;
-	if ((r = wait_phase(sh, C_RAW_MQ)) ||
-	    (r = parent_raw_mq(mq_a, mq_b, o.warmup, o.n_mq, mq_samples[0])))
-		goto out_case;
-	cur = C_MAILBOX;
-	if ((r = wait_phase(sh, C_MAILBOX)) ||
-	    (r = parent_mailbox(&mb, o.warmup, o.n_mq, mq_samples[1])))
+	if ((r = parent_one_way(&o, sh, &port, &seg, &cur)) ||
+	    (r = parent_round_trip(&o, sh, mq_a, mq_b, &mb, mq_samples, &seg, &cur)))
 		goto out_case;
 	if (waitpid(child_pid, &status, 0) == child_pid)
 		child_pid = 0;
@@ -735,8 +778,8 @@ int main(int argc, char **argv)
 	if (o.priority > 0)
 		arflex_sys_set_sched(SCHED_OTHER, 0);
 
-	st[C_RAW_SHM] = stats_of(samples + o.warmup, o.n_port);
-	st[C_STATE_PORT] = stats_of(samples + (o.n_port + o.warmup) + o.warmup, o.n_port);
+	st[C_RAW_SHM] = stats_of(samples, o.n_port);
+	st[C_STATE_PORT] = stats_of(samples + o.n_port, o.n_port);
 	st[C_RAW_MQ] = stats_of(mq_samples[0], o.n_mq);
 	st[C_MAILBOX] = stats_of(mq_samples[1], o.n_mq);
 	r_port = (double)st[C_STATE_PORT].p50 / (double)st[C_RAW_SHM].p50;
