@@ -1,0 +1,337 @@
+package org.arflex.it;
+
+import static org.junit.jupiter.api.Assertions.assertTrue;
+import static org.junit.jupiter.api.Assertions.fail;
+
+import com.sun.jna.Library;
+import com.sun.jna.Native;
+import java.io.BufferedReader;
+import java.io.IOException;
+import java.io.InputStreamReader;
+import java.io.OutputStreamWriter;
+import java.io.PrintWriter;
+import java.io.Writer;
+import java.nio.charset.StandardCharsets;
+import java.nio.file.DirectoryStream;
+import java.nio.file.Files;
+import java.nio.file.Path;
+import java.nio.file.StandardCopyOption;
+import java.util.ArrayList;
+import java.util.Comparator;
+import java.util.List;
+import java.util.Map;
+import java.util.Set;
+import java.util.TreeSet;
+import java.util.concurrent.BlockingQueue;
+import java.util.concurrent.LinkedBlockingQueue;
+import java.util.concurrent.TimeUnit;
+import java.util.concurrent.atomic.AtomicInteger;
+import java.util.function.Predicate;
+import java.util.regex.Matcher;
+import java.util.regex.Pattern;
+import java.util.stream.Stream;
+
+/**
+ * The assembled runtime as a child process: a private copy of the assembly (fresh bundle cache),
+ * the freshly built DRCR, planner and contracts bundles, a unique runtime id. Commands go to
+ * Gogo on stdin; each reply is delimited by an {@code echo} marker. Stderr (the DRCR's log) is
+ * kept for failure messages. {@link #close()} stops the framework, waits for the JVM with a
+ * deadline and asserts that nothing of this runtime is left: no shm, no queue, no process.
+ */
+final class Runtime implements AutoCloseable {
+
+    private static final AtomicInteger SEQ = new AtomicInteger();
+    private static final Pattern BUNDLE_ID = Pattern.compile("Bundle ID: (\\d+)");
+
+    /** libc, for the queue leak check (/dev/mqueue may not be mounted). */
+    interface LibC extends Library {
+        LibC C = Native.load("c", LibC.class);
+
+        int mq_open(String name, int oflag);
+
+        int mq_close(int d);
+    }
+
+    final String rid;
+    final Path dir;
+    private final Process process;
+    private final Writer stdin;
+    private final BlockingQueue<String> out = new LinkedBlockingQueue<>();
+    private final List<String> log = new ArrayList<>();
+    private final Set<String> instancesSeen = new TreeSet<>();
+    private int marker;
+
+    Runtime(String name) throws IOException, InterruptedException {
+        Path assembly = Path.of(System.getProperty("arflex.it.runtime"));
+        if (!Files.isRegularFile(assembly.resolve("bin/felix.jar"))) {
+            fail("runtime assembly not found at " + assembly + " (build management/runtime first)");
+        }
+        int n = SEQ.incrementAndGet();
+        rid = "it" + ProcessHandle.current().pid() + "-" + n;
+        dir = Path.of(System.getProperty("arflex.it.work")).resolve(name + "-" + n);
+        deleteTree(dir);
+        copyTree(assembly, dir);
+        for (String jar : System.getProperty("arflex.it.bundles").split(",")) {
+            Path j = Path.of(jar.trim());
+            assertTrue(Files.isRegularFile(j), "bundle to test not built: " + j);
+            // the fresh build replaces the assembly's copy (same file name) or joins it
+            Files.copy(j, dir.resolve("bundle").resolve(j.getFileName()), StandardCopyOption.REPLACE_EXISTING);
+        }
+        ProcessBuilder pb = new ProcessBuilder(Path.of(System.getProperty("java.home"), "bin", "java").toString(),
+                "-Darflex.runtime.id=" + rid, "-Darflex.nomlock=true", "-Dorg.osgi.service.http.port=0",
+                "-jar", "bin/felix.jar").directory(dir.toFile());
+        process = pb.start();
+        stdin = new OutputStreamWriter(process.getOutputStream(), StandardCharsets.UTF_8);
+        pump(new BufferedReader(new InputStreamReader(process.getInputStream(), StandardCharsets.UTF_8)), true);
+        pump(new BufferedReader(new InputStreamReader(process.getErrorStream(), StandardCharsets.UTF_8)), false);
+        // The DRCR is ready when arflex:dto answers with JSON.
+        waitUntil("the DRCR to start", 60_000, () -> cmd("arflex:dto").startsWith("{"));
+    }
+
+    private void pump(BufferedReader r, boolean stdout) {
+        Thread t = new Thread(() -> {
+            try {
+                String line;
+                while ((line = r.readLine()) != null) {
+                    if (stdout) {
+                        out.add(line);
+                    }
+                    synchronized (log) {
+                        log.add((stdout ? "out| " : "err| ") + line);
+                    }
+                }
+            } catch (IOException ignored) {
+                // process ended
+            }
+        }, "it-" + (stdout ? "out" : "err"));
+        t.setDaemon(true);
+        t.start();
+    }
+
+    /** The last lines of the runtime's output, for failure messages. */
+    String tail() {
+        synchronized (log) {
+            return String.join("\n", log.subList(Math.max(0, log.size() - 80), log.size()));
+        }
+    }
+
+    /** Sends one Gogo command and returns its output (prompts removed), waiting at most 60 s. */
+    synchronized String cmd(String command) {
+        String m = "__arflex_end_" + (++marker) + "__";
+        try {
+            stdin.write(command + "\necho " + m + "\n");
+            stdin.flush();
+            StringBuilder sb = new StringBuilder();
+            long deadline = System.nanoTime() + TimeUnit.SECONDS.toNanos(60);
+            while (true) {
+                long left = deadline - System.nanoTime();
+                String line = left > 0 ? out.poll(left, TimeUnit.NANOSECONDS) : null;
+                if (line == null) {
+                    fail("no reply to '" + command + "' within 60 s\n" + tail());
+                }
+                while (line.startsWith("g! ")) {
+                    line = line.substring(3);
+                }
+                if (line.trim().equals(m)) {
+                    return sb.toString().strip();
+                }
+                sb.append(line).append('\n');
+            }
+        } catch (IOException e) {
+            throw new IllegalStateException("runtime stdin closed: " + e + "\n" + tail());
+        } catch (InterruptedException e) {
+            Thread.currentThread().interrupt();
+            throw new IllegalStateException(e);
+        }
+    }
+
+    /** Installs and starts a bundle through Felix's own commands; returns its id. */
+    long installAndStart(Path jar) {
+        long id = install(jar);
+        String r = cmd("start " + id);
+        assertTrue(r.isEmpty(), "start " + id + ": " + r + "\n" + tail());
+        return id;
+    }
+
+    long install(Path jar) {
+        String r = cmd("install " + jar.toUri());
+        Matcher m = BUNDLE_ID.matcher(r);
+        assertTrue(m.find(), "install " + jar + ": " + r);
+        return Long.parseLong(m.group(1));
+    }
+
+    /** The cell DTO. */
+    @SuppressWarnings("unchecked")
+    Map<String, Object> dto() {
+        String j = cmd("arflex:dto");
+        Map<String, Object> d = (Map<String, Object>) JsonReader.parse(j);
+        for (Map<String, Object> i : list(d, "instances")) {
+            instancesSeen.add((String) i.get("name"));
+        }
+        return d;
+    }
+
+    @SuppressWarnings("unchecked")
+    static List<Map<String, Object>> list(Map<String, Object> m, String key) {
+        return (List<Map<String, Object>>) m.get(key);
+    }
+
+    /** The instance DTO, or null. */
+    Map<String, Object> instance(String name) {
+        return list(dto(), "instances").stream().filter(i -> name.equals(i.get("name"))).findFirst().orElse(null);
+    }
+
+    String state(String name) {
+        Map<String, Object> i = instance(name);
+        return i == null ? null : (String) i.get("state");
+    }
+
+    long pid(String name) {
+        return ((Number) instance(name).get("pid")).longValue();
+    }
+
+    /** Waits (polling the DTO, deadline) until every named instance is in {@code state}. */
+    void awaitState(String state, long timeoutMs, String... names) {
+        waitUntil(String.join(",", names) + " " + state, timeoutMs, () -> {
+            for (String n : names) {
+                if (!state.equals(state(n))) {
+                    return false;
+                }
+            }
+            return true;
+        });
+    }
+
+    interface Cond {
+        boolean test() throws Exception;
+    }
+
+    void waitUntil(String what, long timeoutMs, Cond c) {
+        long deadline = System.nanoTime() + timeoutMs * 1_000_000L;
+        Exception last = null;
+        while (System.nanoTime() - deadline < 0) {
+            try {
+                if (c.test()) {
+                    return;
+                }
+            } catch (Exception e) {
+                last = e;
+            }
+            try {
+                Thread.sleep(50); // poll interval of a condition with a deadline
+            } catch (InterruptedException e) {
+                Thread.currentThread().interrupt();
+                return;
+            }
+        }
+        String state;
+        try {
+            state = process.isAlive() ? cmd("arflex:list") : "(runtime exited)";
+        } catch (RuntimeException e) {
+            state = e.toString();
+        }
+        fail("timed out after " + timeoutMs + " ms waiting for " + what + (last != null ? " (last error " + last + ")" : "")
+                + "\n--- arflex:list\n" + state + "\n--- runtime output\n" + tail());
+    }
+
+    /** An output port segment of an instance of this runtime. */
+    Path segment(String instance, String port) {
+        return Path.of("/dev/shm/arflex." + rid + "." + instance + ".out." + port);
+    }
+
+    /** Names of this runtime's shm objects. */
+    List<String> shmObjects() throws IOException {
+        List<String> l = new ArrayList<>();
+        try (DirectoryStream<Path> ds = Files.newDirectoryStream(Path.of("/dev/shm"), "arflex." + rid + ".*")) {
+            ds.forEach(p -> l.add(p.toString()));
+        }
+        return l;
+    }
+
+    /** Processes (anywhere) started for this runtime id. */
+    static List<String> rtProcesses(String rid) throws IOException {
+        List<String> l = new ArrayList<>();
+        try (DirectoryStream<Path> ds = Files.newDirectoryStream(Path.of("/proc"))) {
+            for (Path p : ds) {
+                if (!p.getFileName().toString().matches("\\d+")) {
+                    continue;
+                }
+                try {
+                    String cl = new String(Files.readAllBytes(p.resolve("cmdline")), StandardCharsets.UTF_8).replace('\0', ' ');
+                    if (cl.contains("--runtime " + rid + " ")) {
+                        l.add(p.getFileName() + ": " + cl.trim());
+                    }
+                } catch (IOException ignored) {
+                    // process ended while we looked
+                }
+            }
+        }
+        return l;
+    }
+
+    /** Stops the framework and checks that nothing of this runtime is left behind. */
+    @Override
+    public void close() throws Exception {
+        try {
+            if (process.isAlive()) {
+                try {
+                    stdin.write("stop 0\n");
+                    stdin.close();
+                } catch (IOException ignored) {
+                    // already gone
+                }
+            }
+            if (!process.waitFor(60, TimeUnit.SECONDS)) {
+                process.destroyForcibly();
+                process.waitFor(10, TimeUnit.SECONDS);
+                fail("runtime did not stop within 60 s\n" + tail());
+            }
+        } finally {
+            process.descendants().forEach(ProcessHandle::destroyForcibly);
+        }
+        List<String> leaks = new ArrayList<>(shmObjects());
+        for (String inst : instancesSeen) {
+            for (String ch : new String[] {"cmd", "rsp"}) {
+                String q = "/arflex." + rid + "." + inst + "." + ch;
+                int d = LibC.C.mq_open(q, 0);
+                if (d >= 0) {
+                    LibC.C.mq_close(d);
+                    leaks.add("mq " + q);
+                }
+            }
+        }
+        leaks.addAll(rtProcesses(rid));
+        assertTrue(leaks.isEmpty(), "left behind by runtime " + rid + ": " + leaks + "\n" + tail());
+        deleteTree(dir);
+    }
+
+    static void copyTree(Path from, Path to) throws IOException {
+        try (Stream<Path> s = Files.walk(from)) {
+            for (Path p : (Iterable<Path>) s::iterator) {
+                if (from.relativize(p).startsWith("felix-cache")) {
+                    continue; // every test starts with a fresh bundle cache
+                }
+                Path t = to.resolve(from.relativize(p).toString());
+                if (Files.isDirectory(p)) {
+                    Files.createDirectories(t);
+                } else {
+                    Files.copy(p, t, StandardCopyOption.REPLACE_EXISTING);
+                }
+            }
+        }
+    }
+
+    static void deleteTree(Path p) throws IOException {
+        if (!Files.exists(p)) {
+            return;
+        }
+        try (Stream<Path> s = Files.walk(p)) {
+            s.sorted(Comparator.reverseOrder()).forEach(f -> f.toFile().delete());
+        }
+    }
+
+    /** The instance names a predicate selects. */
+    static List<String> names(Map<String, Object> dto, Predicate<Map<String, Object>> p) {
+        return list(dto, "instances").stream().filter(p).map(i -> (String) i.get("name")).toList();
+    }
+}
