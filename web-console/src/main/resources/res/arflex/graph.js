@@ -33,6 +33,7 @@
         {selector: 'edge', style: {'curve-style': 'bezier', 'target-arrow-shape': 'triangle', 'label': 'data(label)',
           'font-size': 10, 'text-background-color': '#fff', 'text-background-opacity': 1, 'width': 2}}],
       layout: {name: typeof cytoscapeDagre !== 'undefined' ? 'dagre' : 'breadthfirst', rankDir: 'LR', nodeSep: 40, rankSep: 120}});
+    box.arflexGraph = cy; // lets a test find where a component is drawn
     cy.on('tap', 'node', ev => { window.location.href = pageUrl('arflex-component', {name: ev.target.id()}); });
   }
 

@@ -57,6 +57,14 @@ final class RuntimeUnderTest implements AutoCloseable {
         copyTree(assembled, runtimeDir);
         deleteTree(runtimeDir.resolve("felix-cache"));
         deleteTree(runtimeDir.resolve("cell"));
+        // The freshly built console bundle replaces any copy the assembly already carries.
+        for (String dir : List.of("bundle", "console")) {
+            try (Stream<Path> s = Files.list(runtimeDir.resolve(dir))) {
+                for (Path p : s.filter(p -> p.getFileName().toString().startsWith("org.arflex.webconsole")).toList()) {
+                    Files.delete(p);
+                }
+            }
+        }
         Files.copy(jar, runtimeDir.resolve("console/org.arflex.webconsole.jar"));
         this.port = freePort();
         Path conf = runtimeDir.resolve("conf/config.properties");

@@ -229,6 +229,13 @@ class WebConsoleIT {
         WebElement name = await(By.id("arflex-f-name"));
         name.clear();
         name.sendKeys("demo-filter");
+        // Markup typed into a field stays text everywhere (XML and form), never becomes an element.
+        WebElement description = browser.findElement(By.cssSelector("input[data-field='description']"));
+        description.sendKeys("<img id='xss' src='x' onerror='window.arflexXss=1'>");
+        browser.findElement(By.id("arflex-from-xml")).click();
+        assertTrue(browser.findElements(By.id("xss")).isEmpty());
+        assertEquals(null, browser.executeScript("return window.arflexXss === undefined ? null : window.arflexXss;"));
+        assertTrue(browser.findElement(By.id("arflex-xml")).getAttribute("value").contains("&lt;img id='xss'"));
         await(By.id("arflex-add-port")).click();
         await(By.id("arflex-add-prop")).click();
         WebElement period = await(By.id("arflex-f-timing-period"));
@@ -339,6 +346,19 @@ class WebConsoleIT {
         new WebDriverWait(browser, WAIT).until(d -> "2".equals(g.getAttribute("data-nodes")));
         assertEquals("1", g.getAttribute("data-edges"));
         shot("09-graph");
+        // Clicking a component opens its page.
+        @SuppressWarnings("unchecked")
+        Map<String, Object> pos = (Map<String, Object>) browser.executeScript(
+                "const cy = arguments[0].arflexGraph; const n = cy.getElementById('sample-scaler');"
+                + "return {x: n.renderedPosition().x, y: n.renderedPosition().y};", g);
+        int w = g.getRect().getWidth();
+        int h = g.getRect().getHeight();
+        new org.openqa.selenium.interactions.Actions(browser)
+                .moveToElement(g, (int) (((Number) pos.get("x")).doubleValue() - w / 2.0),
+                        (int) (((Number) pos.get("y")).doubleValue() - h / 2.0))
+                .click().perform();
+        new WebDriverWait(browser, WAIT).until(d -> d.getCurrentUrl().contains("arflex-component?name=sample-scaler"));
+        await(By.id("arflex-param-gain"));
     }
 
     @Test

@@ -1,0 +1,105 @@
+package org.arflex.webconsole.impl;
+
+import static org.junit.jupiter.api.Assertions.assertEquals;
+import static org.junit.jupiter.api.Assertions.assertFalse;
+import static org.junit.jupiter.api.Assertions.assertThrows;
+import static org.junit.jupiter.api.Assertions.assertTrue;
+
+import java.io.ByteArrayInputStream;
+import java.io.IOException;
+import java.io.OutputStream;
+import java.nio.file.Files;
+import java.nio.file.Path;
+import java.security.MessageDigest;
+import java.util.HexFormat;
+import java.util.jar.Attributes;
+import java.util.jar.JarOutputStream;
+import java.util.jar.Manifest;
+import java.util.stream.Stream;
+import org.junit.jupiter.api.Test;
+import org.junit.jupiter.api.io.TempDir;
+
+/** The install-from-URL rules: https or file only, SHA-256 pinned and checked, bundles only. */
+class ArtifactsTest {
+    @TempDir
+    Path dir;
+
+    private Path bundle(String bsn) throws IOException {
+        Manifest m = new Manifest();
+        m.getMainAttributes().put(Attributes.Name.MANIFEST_VERSION, "1.0");
+        m.getMainAttributes().putValue("Bundle-SymbolicName", bsn + ";singleton:=true");
+        m.getMainAttributes().putValue("Bundle-Version", "1.2.3");
+        Path p = dir.resolve(bsn + ".jar");
+        try (OutputStream out = new JarOutputStream(Files.newOutputStream(p), m)) {
+            out.flush();
+        }
+        return p;
+    }
+
+    private static String sha(Path p) throws Exception {
+        return HexFormat.of().formatHex(MessageDigest.getInstance("SHA-256").digest(Files.readAllBytes(p)));
+    }
+
+    private long staged() throws IOException {
+        Path s = dir.resolve("staging");
+        if (!Files.isDirectory(s)) {
+            return 0;
+        }
+        try (Stream<Path> l = Files.list(s)) {
+            return l.count();
+        }
+    }
+
+    @Test
+    void httpAndOtherSchemesAreRefused() {
+        String pin = "a".repeat(64);
+        for (String url : new String[] {"http://example.org/x.jar", "ftp://h/x.jar", "jar:file:/x.jar!/", "x.jar"}) {
+            HttpError e = assertThrows(HttpError.class, () -> Artifacts.checkUrl(url, pin), url);
+            assertEquals(400, e.status);
+            assertTrue(e.getMessage().startsWith("url:"), e.getMessage());
+        }
+    }
+
+    @Test
+    void aPinIsRequiredAndMustBeSha256() {
+        assertTrue(assertThrows(HttpError.class, () -> Artifacts.checkUrl("https://h/x.jar", null))
+                .getMessage().contains("missing"));
+        assertTrue(assertThrows(HttpError.class, () -> Artifacts.checkUrl("https://h/x.jar", "abc"))
+                .getMessage().contains("64 hexadecimal"));
+        assertTrue(assertThrows(HttpError.class, () -> Artifacts.checkUrl("https://user:pw@h/x.jar", "a".repeat(64)))
+                .getMessage().contains("user info"));
+    }
+
+    @Test
+    void aFileUrlWithTheRightPinIsStaged() throws Exception {
+        Path jar = bundle("org.example.good");
+        Artifacts.Staged s = Artifacts.fetch(Artifacts.checkUrl(jar.toUri().toString(), sha(jar)), sha(jar),
+                dir.resolve("staging"));
+        assertEquals("org.example.good", s.symbolicName());
+        assertEquals("1.2.3", s.version());
+        assertEquals(sha(jar), s.sha256());
+        assertTrue(Files.isRegularFile(s.file()));
+    }
+
+    @Test
+    void aWrongPinIsRefusedAndLeavesNothingBehind() throws Exception {
+        Path jar = bundle("org.example.pinned");
+        String wrong = "0".repeat(64);
+        HttpError e = assertThrows(HttpError.class, () -> Artifacts.fetch(
+                Artifacts.checkUrl(jar.toUri().toString(), wrong), wrong, dir.resolve("staging")));
+        assertTrue(e.getMessage().contains(sha(jar)) && e.getMessage().contains(wrong), e.getMessage());
+        assertEquals(0, staged());
+    }
+
+    @Test
+    void anUploadThatIsNotABundleIsRefused() throws IOException {
+        HttpError notJar = assertThrows(HttpError.class, () -> Artifacts.upload(
+                new ByteArrayInputStream("hello".getBytes()), "x.jar", dir.resolve("staging")));
+        assertTrue(notJar.getMessage().contains("not a jar"), notJar.getMessage());
+        HttpError empty = assertThrows(HttpError.class, () -> Artifacts.upload(
+                new ByteArrayInputStream(new byte[0]), "x.jar", dir.resolve("staging")));
+        assertTrue(empty.getMessage().contains("empty"));
+        assertEquals(0, staged());
+        assertFalse(Files.exists(dir.resolve("staging/x.jar")));
+    }
+}
