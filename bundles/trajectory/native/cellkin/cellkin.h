@@ -1,0 +1,106 @@
+// cellkin - what the cell's motion components know about the robot: the NOMINAL arm only.
+//
+// Kinematics come from the simulator's NominalKinematics (product of exponentials from
+// simulator/src/{params,kinematics}.cc, compiled in here without MuJoCo, so this library also
+// builds in the sanitizer build). Added here: damped-least-squares IK, the nominal static
+// gravity torques (link masses, tool, payload), the tool's weight as the wrist sensor sees it,
+// and the program file format shared by trajectory (reader) and teach (writer).
+//
+// Threads: every function is pure computation on caller-owned data except LoadProgramFile /
+// WriteProgramFile (file I/O; never call them on the RT thread). No function allocates except
+// ParseProgram (into a Program whose capacity is fixed at construction) and the file helpers.
+#ifndef ARFLEX_CELLKIN_H_
+#define ARFLEX_CELLKIN_H_
+
+#include <Eigen/Dense>
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+#include "arflex_sim/kinematics.h"
+#include "arflex_sim/params.h"
+
+namespace arflex {
+namespace cellkin {
+
+using Q = Eigen::Matrix<double, 6, 1>;
+constexpr double kGravity = 9.81;
+
+class Model {
+ public:
+  Model();  // the default (nominal) arm of the cell: sim::DefaultArm()
+
+  Eigen::Isometry3d Tcp(const Q& q) const;
+  Eigen::Isometry3d Flange(const Q& q) const;
+  sim::Jacobian6 Jacobian(const Q& q) const;
+
+  // Moves *q towards the joint angles whose TCP pose is `target` by at most `iters` damped
+  // least-squares Newton steps (starting from *q: pass the previous solution for continuity).
+  // Returns the remaining error: position error (m) + rotation error (rad). Never allocates.
+  double Ik(const Eigen::Isometry3d& target, Q* q, int iters) const;
+
+  // Joint torques (N m) the drives must deliver to hold the arm still at q: link masses,
+  // the tool (sim::ArmParams::tool_mass at tool_com) and a payload of `payload_kg` at
+  // payload_com. Same sign convention as the measured drive torques of arflex.JointState.
+  Q GravityTorque(const Q& q, double payload_kg) const;
+
+  // Force (N) and torque (N m) in the flange frame that the wrist sensor reads with the tool
+  // and a payload at rest and nothing else touching them (the arm holds them up).
+  void ToolWeightWrench(const Q& q, double payload_kg, Eigen::Vector3d* f,
+                        Eigen::Vector3d* t) const;
+
+  const sim::ArmParams& arm() const { return arm_; }
+  double lower(int j) const { return arm_.links[j].lower; }
+  double upper(int j) const { return arm_.links[j].upper; }
+
+ private:
+  sim::ArmParams arm_;
+  sim::NominalKinematics kin_;
+};
+
+// ---- program files ----------------------------------------------------------------------
+//
+// Text, one statement per line, '#' starts a comment, blank lines ignored. The first
+// statement must be `arflex-program 1`. Then, in any number:
+//   start q1 .. q6                  initial reference when no joint_state is bound (rad; once)
+//   ptp q1 .. q6 [speed f]          joint motion to the joint target (rad); f in (0, 1] scales
+//                                   the joint velocity limits for this motion (default 1)
+//   lin x y z qw qx qy qz [speed v] Cartesian straight line of the TCP to the pose (m, unit
+//                                   quaternion w x y z, normalised on load); v (m/s) caps the
+//                                   linear speed (default: the component's lin_speed)
+//   wait s                          hold still for s seconds (0 < s <= 3600)
+// Joint targets must lie within the nominal joint limits. Errors name file:line and what is
+// wrong.
+
+struct Motion {
+  enum Kind { kPtp, kLin, kWait } kind;
+  double v[7];   // ptp: q[6]; lin: x y z qw qx qy qz; wait: v[0] seconds
+  double speed;  // ptp: fraction (0, 1]; lin: m/s (0 = component default)
+  int line;      // source line
+};
+
+struct Program {
+  bool has_start = false;
+  Q start = Q::Zero();
+  std::vector<Motion> motions;  // filled at load time; RT code only reads it
+  std::string origin;           // file name or "built-in"
+};
+
+constexpr size_t kMaxMotions = 20000;
+
+// Parses `text`; `origin` names it in messages. Returns true, or false with *err set
+// ("<origin>:<line>: <what>").
+bool ParseProgram(const std::string& text, const std::string& origin, const Model& model,
+                  Program* out, std::string* err);
+bool LoadProgramFile(const std::string& path, const Model& model, Program* out,
+                     std::string* err);
+// Writes `p` to `path` atomically (temporary file in the same directory, fsync, rename),
+// mode 0600. Returns true or false with *err.
+bool WriteProgramFile(const std::string& path, const Program& p, std::string* err);
+// "<dir>/program-<n>.arp"
+std::string ProgramPath(const std::string& dir, long n);
+
+}  // namespace cellkin
+}  // namespace arflex
+
+#endif  // ARFLEX_CELLKIN_H_

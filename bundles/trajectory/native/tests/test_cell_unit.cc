@@ -1,0 +1,274 @@
+// test_cell_unit - CTest cell.unit.*: the nominal model (cellkin) and the trajectory player,
+// in process, every cycle checked.
+//   test_cell_unit <kinematics|program|trajectory_limits|trajectory_pause|builtin>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <unistd.h>
+
+#include "cellkin.h"
+#include "trajectory_plan.h"
+
+using arflex::cellkin::Model;
+using arflex::cellkin::Program;
+using arflex::cellkin::Q;
+namespace traj = arflex::traj;
+
+static int failures;
+#define CHECK(c, ...)                                                      \
+  do {                                                                     \
+    if (!(c)) {                                                            \
+      fprintf(stderr, "FAIL %s:%d: %s: ", __FILE__, __LINE__, #c);         \
+      fprintf(stderr, __VA_ARGS__);                                        \
+      fputc('\n', stderr);                                                 \
+      ++failures;                                                          \
+      return;                                                              \
+    }                                                                      \
+  } while (0)
+
+// Potential energy of the nominal arm (links + tool + payload) at q, for a finite-difference
+// check of GravityTorque (which must equal dV/dq).
+static double Potential(const Model& m, const Q& q, double payload) {
+  const auto& arm = m.arm();
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  double v = 0;
+  for (int i = 0; i < 6; ++i) {
+    const auto& l = arm.links[i];
+    t = t * Eigen::Translation3d(l.offset[0], l.offset[1], l.offset[2]) *
+        Eigen::AngleAxisd(q[i], Eigen::Vector3d(l.axis[0], l.axis[1], l.axis[2]).normalized());
+    v += l.mass * 9.81 * (t * Eigen::Vector3d(l.com[0], l.com[1], l.com[2])).z();
+  }
+  v += arm.tool_mass * 9.81 *
+       (t * Eigen::Vector3d(arm.tool_com[0], arm.tool_com[1], arm.tool_com[2])).z();
+  v += payload * 9.81 *
+       (t * Eigen::Vector3d(arm.payload_com[0], arm.payload_com[1], arm.payload_com[2])).z();
+  return v;
+}
+
+static void TestKinematics() {
+  Model m;
+  Q q;
+  q << 0.3, 0.2, 0.5, -0.4, 0.7, 0.1;
+  // IK: perturb, solve back to the FK pose.
+  const Eigen::Isometry3d target = m.Tcp(q);
+  Q q2 = q + Q::Constant(0.05);
+  const double err = m.Ik(target, &q2, 20);
+  CHECK(err < 1e-9, "IK error %g", err);
+  CHECK((m.Tcp(q2).translation() - target.translation()).norm() < 1e-9, "IK position");
+  // Gravity = dV/dq (central differences), with and without payload.
+  for (double payload : {0.0, 100.0}) {
+    const Q g = m.GravityTorque(q, payload);
+    for (int j = 0; j < 6; ++j) {
+      Q a = q, b = q;
+      a[j] += 1e-6;
+      b[j] -= 1e-6;
+      const double fd = (Potential(m, a, payload) - Potential(m, b, payload)) / 2e-6;
+      CHECK(std::fabs(fd - g[j]) < 1e-3 * (1 + std::fabs(fd)), "joint %d gravity %g vs dV/dq %g",
+            j + 1, g[j], fd);
+    }
+  }
+  // Tool weight at the wrist at q = 0: the flange frame is the world frame, force up.
+  Eigen::Vector3d f, t;
+  m.ToolWeightWrench(Q::Zero(), 0, &f, &t);
+  CHECK(std::fabs(f.z() - m.arm().tool_mass * 9.81) < 1e-9 && std::fabs(f.x()) < 1e-9,
+        "tool weight %g %g %g", f.x(), f.y(), f.z());
+}
+
+static void TestProgram() {
+  Model m;
+  Program p;
+  std::string err;
+  CHECK(arflex::cellkin::ParseProgram("arflex-program 1\nptp 0 0 0 0 0 0\nwait 1\n", "t", m, &p,
+                                      &err),
+        "%s", err.c_str());
+  CHECK(p.motions.size() == 2, "motions %zu", p.motions.size());
+  struct Bad {
+    const char* text;
+    const char* expect;
+  } bad[] = {
+      {"ptp 0 0 0 0 0 0\n", "t:1: expected the header"},
+      {"arflex-program 1\nptp 0 0 0 0 0\n", "t:2: ptp needs 6 joint angles"},
+      {"arflex-program 1\n\nptp 0 9 0 0 0 0\n", "t:3: joint 2 target"},
+      {"arflex-program 1\nlin 1 2 3 0 0 0 0\n", "t:2: lin orientation quaternion is zero"},
+      {"arflex-program 1\nptp 0 0 0 0 0 x\n", "t:2: 'x' is not a number"},
+      {"arflex-program 1\nfly 1\n", "t:2: unknown statement 'fly'"},
+      {"arflex-program 1\nptp 0 0 0 0 0 0 speed 2\n", "t:2: ptp speed must be in (0, 1]"},
+      {"arflex-program 1\nwait -1\n", "t:2: wait duration"},
+      {"arflex-program 1\n# nothing\n", "t:2: program has no motion"},
+      {"", "t:0: empty program"},
+  };
+  for (const Bad& b : bad) {
+    CHECK(!arflex::cellkin::ParseProgram(b.text, "t", m, &p, &err), "accepted: %s", b.text);
+    CHECK(err.rfind(b.expect, 0) == 0, "message '%s' does not start with '%s'", err.c_str(),
+          b.expect);
+  }
+  // Round trip through a file.
+  char dir[] = "/tmp/arflex-cell-unit-XXXXXX";
+  CHECK(mkdtemp(dir), "mkdtemp");
+  Program w;
+  w.origin = "test";
+  w.has_start = true;
+  w.start << 0.1, 0.2, 0.3, 0.4, 0.5, 0.6;
+  arflex::cellkin::Motion mo{};
+  mo.kind = arflex::cellkin::Motion::kPtp;
+  for (int j = 0; j < 6; ++j) mo.v[j] = 0.1 * j + 1.0 / 3.0;
+  mo.speed = 0.5;
+  w.motions.push_back(mo);
+  const std::string path = arflex::cellkin::ProgramPath(dir, 7);
+  const bool wrote = arflex::cellkin::WriteProgramFile(path, w, &err);
+  const bool read = wrote && arflex::cellkin::LoadProgramFile(path, m, &p, &err);
+  unlink(path.c_str());
+  rmdir(dir);
+  CHECK(wrote && read, "%s", err.c_str());
+  CHECK(p.has_start && (p.start - w.start).norm() == 0, "start lost");
+  CHECK(p.motions.size() == 1 && p.motions[0].speed == 0.5 && p.motions[0].v[0] == mo.v[0],
+        "motion lost");
+}
+
+// Runs the program cycle by cycle and checks every cycle against the limits.
+struct RunStats {
+  double max_v_ratio = 0;  // max |dq|/dt / vmax_j
+  double max_a = 0;        // max |ddq| (rad/s^2)
+  double max_plan_a = 0;
+  uint64_t cycles = 0;
+};
+
+static bool Run(traj::Player* pl, const traj::Limits& lim, uint64_t max_cycles, RunStats* st,
+                double (*rate)(uint64_t) = nullptr) {
+  Q prev = pl->q_out(), prev_v = Q::Zero();
+  const double dt = 0.001;
+  for (uint64_t k = 0; k < max_cycles && !pl->done(); ++k) {
+    pl->Step(lim, rate ? rate(k) : 1.0, false);
+    const Q v = (pl->q_out() - prev) / dt;
+    for (int j = 0; j < 6; ++j) {
+      st->max_v_ratio = std::max(st->max_v_ratio, std::fabs(v[j]) / lim.vmax[j]);
+      st->max_a = std::max(st->max_a, std::fabs(v[j] - prev_v[j]) / dt);
+    }
+    prev = pl->q_out();
+    prev_v = v;
+    st->cycles++;
+  }
+  return pl->done();
+}
+
+static void TestTrajectoryLimits() {
+  Model m;
+  Program p;
+  std::string err;
+  const char* text =
+      "arflex-program 1\nstart 0 0 0 0 0 0\n"
+      "ptp 0.5 0.3 0.6 -0.4 0.8 0.3\n"
+      "ptp -0.4 0.1 0.9 0.5 -0.6 -0.2 speed 0.5\n"
+      "ptp 0 0.2 0.5 0 0.6 0\n";
+  CHECK(arflex::cellkin::ParseProgram(text, "three", m, &p, &err), "%s", err.c_str());
+  for (int prof = 0; prof < 2; ++prof) {
+    traj::Limits lim = traj::DefaultLimits();
+    lim.profile = prof ? traj::kTrapezoid : traj::kQuintic;
+    traj::Player pl;
+    pl.Begin(&m, &p, 0.001);
+    pl.Init(p.start);
+    RunStats st;
+    const bool done = Run(&pl, lim, 60000, &st);
+    CHECK(done, "profile %d did not finish in %llu cycles", prof, (unsigned long long)st.cycles);
+    for (int j = 0; j < 6; ++j)
+      CHECK(std::fabs(pl.q_out()[j] - p.motions[2].v[j]) < 1e-9, "final joint %d off by %g",
+            j + 1, pl.q_out()[j] - p.motions[2].v[j]);
+    // Velocity within the limits; acceleration within the planning limit (+ rounding of the
+    // finite differences), so the limiter never had to act on a clean program.
+    CHECK(st.max_v_ratio <= 1.0 + 1e-9, "profile %d speed ratio %g", prof, st.max_v_ratio);
+    CHECK(st.max_a <= lim.accel * 1.02 + 1e-6, "profile %d accel %g > %g", prof, st.max_a,
+          lim.accel);
+    CHECK(pl.limited_cycles() == 0, "profile %d limiter acted %llu times", prof,
+          (unsigned long long)pl.limited_cycles());
+    printf("profile %s: %llu cycles, max speed %.3f of vmax, max accel %.3f rad/s^2\n",
+           prof ? "trapezoid" : "quintic", (unsigned long long)st.cycles, st.max_v_ratio,
+           st.max_a);
+  }
+}
+
+static double PauseRate(uint64_t k) { return (k > 700 && k < 2500) ? 0.0 : 1.0; }
+
+static void TestTrajectoryPause() {
+  Model m;
+  Program p;
+  std::string err;
+  CHECK(arflex::cellkin::ParseProgram("arflex-program 1\nptp 1.0 0.4 0.6 0 0 0\n", "p", m, &p,
+                                      &err),
+        "%s", err.c_str());
+  traj::Limits lim = traj::DefaultLimits();
+  traj::Player pl;
+  pl.Begin(&m, &p, 0.001);
+  pl.Init(Q::Zero());
+  RunStats st;
+  // Paused in the middle of the motion: must stop smoothly (accel within accel_max), hold,
+  // then resume and finish on the target.
+  Q held;
+  for (uint64_t k = 0; k < 2400; ++k) pl.Step(lim, PauseRate(k), false);
+  held = pl.q_out();
+  pl.Step(lim, 0.0, false);
+  CHECK((pl.q_out() - held).norm() == 0, "moving while paused");
+  CHECK(!pl.done() && held[0] > 0.01 && held[0] < 0.99, "paused at %g", held[0]);
+  traj::Player pl2;
+  pl2.Begin(&m, &p, 0.001);
+  pl2.Init(Q::Zero());
+  const bool done = Run(&pl2, lim, 20000, &st, PauseRate);
+  CHECK(done, "did not finish after the pause");
+  CHECK(st.max_v_ratio <= 1.0 + 1e-9 && st.max_a <= lim.accel_max * (1 + 1e-6),
+        "limits: v %g a %g", st.max_v_ratio, st.max_a);
+  CHECK(std::fabs(pl2.q_out()[0] - 1.0) < 1e-9, "final %g", pl2.q_out()[0]);
+}
+
+static void TestBuiltin() {
+  // The built-in program of the trajectory component must run through with IK converging
+  // on every lin cycle. (Same text as trajectory.cc's kBuiltin: read from the source file
+  // would be nicer; the component's own test cell.trajectory runs it as a process.)
+  Model m;
+  Program p;
+  std::string err;
+  const char* text =
+      "arflex-program 1\nstart 0 0 0 0 0 0\nptp 0 0.2 0.5 0 0.6 0\n"
+      "lin 2.0 0.3 1.2 0.70710678 0 0.70710678 0 speed 0.4\n"
+      "lin 2.0 -0.3 1.2 0.70710678 0 0.70710678 0 speed 0.4\n"
+      "lin 1.7 -0.3 0.9 0.70710678 0 0.70710678 0 speed 0.4\n"
+      "ptp 0.4 0.3 0.4 0 0.8 0.2 speed 0.5\nwait 0.5\nptp 0 0.2 0.5 0 0.6 0\n";
+  CHECK(arflex::cellkin::ParseProgram(text, "builtin", m, &p, &err), "%s", err.c_str());
+  printf("TCP at ptp 0 0.2 0.5 0 0.6 0: %s\n", "");
+  Q q;
+  q << 0, 0.2, 0.5, 0, 0.6, 0;
+  const Eigen::Isometry3d t = m.Tcp(q);
+  const Eigen::Quaterniond r(t.linear());
+  printf("  p = %.4f %.4f %.4f  quat = %.6f %.6f %.6f %.6f\n", t.translation().x(),
+         t.translation().y(), t.translation().z(), r.w(), r.x(), r.y(), r.z());
+  traj::Limits lim = traj::DefaultLimits();
+  traj::Player pl;
+  pl.Begin(&m, &p, 0.001);
+  pl.Init(p.start);
+  RunStats st;
+  CHECK(Run(&pl, lim, 200000, &st), "builtin did not finish");
+  CHECK(pl.ik_warnings() == 0, "%llu IK warnings", (unsigned long long)pl.ik_warnings());
+  CHECK(st.max_v_ratio <= 1 + 1e-9 && st.max_a <= lim.accel_max * (1 + 1e-6), "limits");
+  printf("builtin: %llu cycles, limiter active %llu cycles, max accel %.2f\n",
+         (unsigned long long)st.cycles, (unsigned long long)pl.limited_cycles(), st.max_a);
+}
+
+int main(int argc, char** argv) {
+  if (argc != 2) {
+    fprintf(stderr, "usage: %s <kinematics|program|trajectory_limits|trajectory_pause|builtin>\n",
+            argv[0]);
+    return 2;
+  }
+  const std::string c = argv[1];
+  if (c == "kinematics") TestKinematics();
+  else if (c == "program") TestProgram();
+  else if (c == "trajectory_limits") TestTrajectoryLimits();
+  else if (c == "trajectory_pause") TestTrajectoryPause();
+  else if (c == "builtin") TestBuiltin();
+  else {
+    fprintf(stderr, "unknown case '%s'\n", argv[1]);
+    return 2;
+  }
+  if (failures) return 1;
+  printf("ok %s\n", argv[1]);
+  return 0;
+}

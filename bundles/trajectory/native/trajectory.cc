@@ -1,0 +1,201 @@
+// trajectory - RT half of the trajectory component (README.md): plays a program of joint
+// (ptp) and Cartesian straight-line (lin) motions and writes the joint reference every period.
+//
+// Ports: out joint_ref (arflex.JointRef, state); in safety (arflex.SafetyState, optional),
+// in joint_state (arflex.JointState, optional: the first reference starts at the measured
+// position). Parameters: see the contract (src/main/resources/OSGI-INF/arflex/trajectory.xml).
+//
+// Threads: configure loads every program (main thread, file I/O); start/update/safe/stop run
+// on the RT thread and only read the loaded programs: no allocation, I/O or printing there.
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "arflex/component.h"
+#include "arflex_types/joint_ref.h"
+#include "arflex_types/joint_state.h"
+#include "arflex_types/safety_state.h"
+#include "cellkin.h"
+#include "trajectory_plan.h"
+
+namespace {
+
+using arflex::cellkin::Model;
+using arflex::cellkin::Motion;
+using arflex::cellkin::Program;
+using arflex::cellkin::Q;
+namespace traj = arflex::traj;
+
+constexpr int kMaxPrograms = 100;  // program indices 0 (built-in) .. 99
+
+// The built-in demonstration program (index 0): a loop through the work space in front of
+// the robot, joint and Cartesian motions mixed. The lin targets are reachable from the
+// preceding poses (checked by the cell.trajectory.builtin test).
+const char kBuiltin[] =
+    "arflex-program 1\n"
+    "# built-in demonstration program (trajectory, index 0)\n"
+    "start 0 0 0 0 0 0\n"
+    "ptp 0 0.2 0.5 0 0.6 0\n"
+    "lin 2.0 0.3 1.2 0.70710678 0 0.70710678 0 speed 0.4\n"
+    "lin 2.0 -0.3 1.2 0.70710678 0 0.70710678 0 speed 0.4\n"
+    "lin 1.7 -0.3 0.9 0.70710678 0 0.70710678 0 speed 0.4\n"
+    "ptp 0.4 0.3 0.4 0 0.8 0.2 speed 0.5\n"
+    "wait 0.5\n"
+    "ptp 0 0.2 0.5 0 0.6 0\n";
+
+struct State {
+  Model model;
+  std::vector<Program> programs;  // index = program number; empty motions = not loaded
+  struct arflex_port* out = nullptr;
+  struct arflex_input* in_safety = nullptr;
+  struct arflex_input* in_state = nullptr;
+  int p_program = -1, p_run, p_loop, p_profile, p_speed, p_accel, p_accel_max, p_lin_speed,
+      p_lin_accel, p_stop_time;
+  traj::Player player;
+  struct arflex_safety_state safety{};
+  bool safety_seen = false;
+  uint64_t seq = 0;
+} g;
+
+int Param(struct arflex_component* c, const char* name, int* idx) {
+  *idx = arflex_component_param(c, name);
+  if (*idx < 0) fprintf(stderr, "trajectory: parameter '%s' missing from the control block\n", name);
+  return *idx;
+}
+
+int Configure(struct arflex_component* c, void*) {
+  static const struct arflex_port_type ref_t = {ARFLEX_TYPE_JOINT_REF_NAME, 1, 0,
+                                                sizeof(struct arflex_joint_ref)};
+  static const struct arflex_port_type safety_t = {ARFLEX_TYPE_SAFETY_STATE_NAME, 1, 0,
+                                                   sizeof(struct arflex_safety_state)};
+  static const struct arflex_port_type state_t = {ARFLEX_TYPE_JOINT_STATE_NAME, 1, 0,
+                                                  sizeof(struct arflex_joint_state)};
+  int r = arflex_component_output(c, "joint_ref", ARFLEX_PORT_STATE, &ref_t, &g.out);
+  if (r < 0) {
+    fprintf(stderr, "trajectory: output joint_ref: %s\n", strerror(-r));
+    return r;
+  }
+  if ((r = arflex_component_input(c, "safety", ARFLEX_PORT_STATE, &safety_t, &g.in_safety)) < 0 ||
+      (r = arflex_component_input(c, "joint_state", ARFLEX_PORT_STATE, &state_t, &g.in_state)) < 0)
+    return r;
+  if (Param(c, "program", &g.p_program) < 0 || Param(c, "run", &g.p_run) < 0 ||
+      Param(c, "loop", &g.p_loop) < 0 || Param(c, "profile", &g.p_profile) < 0 ||
+      Param(c, "speed", &g.p_speed) < 0 || Param(c, "accel", &g.p_accel) < 0 ||
+      Param(c, "accel_max", &g.p_accel_max) < 0 || Param(c, "lin_speed", &g.p_lin_speed) < 0 ||
+      Param(c, "lin_accel", &g.p_lin_accel) < 0 || Param(c, "stop_time", &g.p_stop_time) < 0)
+    return -ENOENT;
+
+  g.programs.resize(kMaxPrograms);
+  std::string err;
+  if (!arflex::cellkin::ParseProgram(kBuiltin, "built-in program 0", g.model, &g.programs[0],
+                                     &err)) {
+    fprintf(stderr, "trajectory: %s\n", err.c_str());
+    return -EINVAL;
+  }
+  const char* dir = getenv("ARFLEX_DATA_DIR");
+  int loaded = 1;
+  if (dir && *dir) {
+    for (int n = 1; n < kMaxPrograms; ++n) {
+      const std::string path = arflex::cellkin::ProgramPath(dir, n);
+      FILE* f = fopen(path.c_str(), "r");
+      if (!f) continue;
+      fclose(f);
+      if (!arflex::cellkin::LoadProgramFile(path, g.model, &g.programs[n], &err)) {
+        fprintf(stderr, "trajectory: bad program file: %s\n", err.c_str());
+        return -EINVAL;
+      }
+      ++loaded;
+    }
+  }
+  const int64_t sel = arflex_param_i64(c, g.p_program);
+  fprintf(stderr, "trajectory: %d program(s) loaded (data dir %s); program %lld %s\n", loaded,
+          dir && *dir ? dir : "unset", (long long)sel,
+          sel >= 0 && sel < kMaxPrograms && !g.programs[sel].motions.empty() ? "present"
+                                                                            : "NOT present");
+  return 0;
+}
+
+traj::Limits CurrentLimits(struct arflex_component* c) {
+  traj::Limits l = traj::DefaultLimits();
+  l.speed = arflex_param_f64(c, g.p_speed);
+  l.accel = arflex_param_f64(c, g.p_accel);
+  l.accel_max = arflex_param_f64(c, g.p_accel_max);
+  l.lin_speed = arflex_param_f64(c, g.p_lin_speed);
+  l.lin_accel = arflex_param_f64(c, g.p_lin_accel);
+  l.stop_time = arflex_param_f64(c, g.p_stop_time);
+  l.profile = arflex_param_i64(c, g.p_profile) == 1 ? traj::kTrapezoid : traj::kQuintic;
+  return l;
+}
+
+int Start(struct arflex_component* c, void*) {
+  const int64_t n = arflex_param_i64(c, g.p_program);
+  if (n < 0 || n >= kMaxPrograms || g.programs[n].motions.empty()) return -ENOENT;
+  const struct arflex_ctl* ctl = arflex_component_ctl(c);
+  g.player.Begin(&g.model, &g.programs[n], ctl->config.period_ns * 1e-9);
+  g.safety_seen = false;
+  return 0;
+}
+
+int Step(struct arflex_component* c, uint64_t release_ns, bool force_stop) {
+  if (!g.player.initialized()) {
+    struct arflex_joint_state js;
+    Q q0 = g.player.program()->has_start ? g.player.program()->start : Q::Zero();
+    if (arflex_input_bound(g.in_state) &&
+        arflex_input_state_read(g.in_state, &js, sizeof(js), nullptr) == 1) {
+      for (int j = 0; j < 6; ++j) q0[j] = js.q[j];
+    } else if (arflex_input_bound(g.in_state)) {
+      return 0;  // wait for the first measurement before commanding anything
+    }
+    g.player.Init(q0);
+  }
+  struct arflex_safety_state s;
+  if (arflex_input_bound(g.in_safety)) {
+    if (arflex_input_state_read(g.in_safety, &s, sizeof(s), nullptr) == 1) {
+      g.safety = s;
+      g.safety_seen = true;
+    }
+  } else {
+    g.safety_seen = false;
+  }
+  // Target time rate: 0 = hold. A bound safety input that has not spoken yet holds too.
+  double rate = arflex_param_bool(c, g.p_run) ? 1.0 : 0.0;
+  if (force_stop) rate = 0;
+  if (arflex_input_bound(g.in_safety)) {
+    if (!g.safety_seen || g.safety.mode == ARFLEX_SAFETY_STATE_MODE_PROTECTIVE_STOP)
+      rate = 0;
+    else if (g.safety.mode == ARFLEX_SAFETY_STATE_MODE_LIMITED)
+      rate = std::min(rate, std::max(0.0, std::min(1.0, g.safety.power_scale)));
+  }
+  const traj::Limits lim = CurrentLimits(c);
+  g.player.Step(lim, rate, arflex_param_bool(c, g.p_loop));
+  struct arflex_joint_ref ref;
+  ref.t_ns = (int64_t)release_ns;
+  ref.seq = ++g.seq;
+  for (int j = 0; j < 6; ++j) ref.q[j] = g.player.q_out()[j];
+  return arflex_state_write(g.out, &ref, sizeof(ref));
+}
+
+int Update(struct arflex_component* c, void*, uint64_t release_ns) {
+  return Step(c, release_ns, false);
+}
+
+// rt-core safe mode (runtime heartbeat lost): stop along the path as fast as the limits
+// allow, then hold.
+int Safe(struct arflex_component* c, void*, enum arflex_safe_mode, bool) {
+  const uint64_t now = arflex_sys_now_ns();
+  if (!g.player.initialized()) return 0;
+  return Step(c, now, true);
+}
+
+const struct arflex_component_ops kOps = {
+    "trajectory", nullptr, Configure, Start, Update, nullptr, nullptr, Safe,
+};
+
+}  // namespace
+
+int main(int argc, char** argv) { return arflex_component_main(argc, argv, &kOps); }
