@@ -62,12 +62,17 @@ final class Runtime implements AutoCloseable {
     private int marker;
 
     Runtime(String name) throws IOException, InterruptedException {
+        this(name, null);
+    }
+
+    /** A runtime with a given runtime id (null: a fresh unique one). */
+    Runtime(String name, String fixedRid) throws IOException, InterruptedException {
         Path assembly = Path.of(System.getProperty("arflex.it.runtime"));
         if (!Files.isRegularFile(assembly.resolve("bin/felix.jar"))) {
             fail("runtime assembly not found at " + assembly + " (build management/runtime first)");
         }
         int n = SEQ.incrementAndGet();
-        rid = "it" + ProcessHandle.current().pid() + "-" + n;
+        rid = fixedRid != null ? fixedRid : "it" + ProcessHandle.current().pid() + "-" + n;
         dir = Path.of(System.getProperty("arflex.it.work")).resolve(name + "-" + n);
         deleteTree(dir);
         copyTree(assembly, dir);
@@ -269,9 +274,28 @@ final class Runtime implements AutoCloseable {
         return l;
     }
 
+    private boolean crashed;
+
+    /** Kills the runtime's JVM with SIGKILL (its RT halves stay behind, as after a real crash). */
+    void crash() throws InterruptedException {
+        crashed = true;
+        process.destroyForcibly();
+        process.waitFor(30, TimeUnit.SECONDS);
+    }
+
+    /** Whether the log contains a line with {@code text}. */
+    boolean logContains(String text) {
+        synchronized (log) {
+            return log.stream().anyMatch(l -> l.contains(text));
+        }
+    }
+
     /** Stops the framework and checks that nothing of this runtime is left behind. */
     @Override
     public void close() throws Exception {
+        if (crashed) {
+            return; // what it left is the next runtime's to sweep (and that runtime's check)
+        }
         try {
             if (process.isAlive()) {
                 try {
@@ -288,6 +312,10 @@ final class Runtime implements AutoCloseable {
             }
         } finally {
             process.descendants().forEach(ProcessHandle::destroyForcibly);
+        }
+        synchronized (log) {
+            List<String> thrown = log.stream().filter(l -> l.contains("at org.arflex.drcr")).toList();
+            assertTrue(thrown.isEmpty(), "stack traces of the DRCR in the runtime log:\n" + tail());
         }
         List<String> leaks = new ArrayList<>(shmObjects());
         for (String inst : instancesSeen) {
