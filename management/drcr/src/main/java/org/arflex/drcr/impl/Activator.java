@@ -96,7 +96,8 @@ public final class Activator implements BundleActivator {
         Hashtable<String, Object> shell = new Hashtable<>();
         shell.put("osgi.command.scope", Commands.SCOPE);
         shell.put("osgi.command.function", Commands.FUNCTIONS);
-        regs.add(ctx.registerService(Commands.class, new Commands(services, rm[0], services, services::management), shell));
+        // The shell finds management services in the registry, as any other client does.
+        regs.add(ctx.registerService(Commands.class, new Commands(services, rm[0], services, name -> lookup(ctx, name)), shell));
         ticker = new ScheduledThreadPoolExecutor(1, r -> {
             Thread t = new Thread(r, "arflex-drcr-heartbeat");
             t.setDaemon(true);
@@ -115,6 +116,26 @@ public final class Activator implements BundleActivator {
         tracker.open();
         log.accept("arflex: DRCR started, runtime id " + rid + ", cpus " + cpus + ", memory " + memory + ", network "
                 + network);
+    }
+
+    private static java.util.Optional<org.arflex.drcr.ComponentManagement> lookup(BundleContext ctx, String name) {
+        if (!name.matches("[a-z][a-z0-9-]{0,47}")) {
+            return java.util.Optional.empty();
+        }
+        try {
+            for (var ref : ctx.getServiceReferences(org.arflex.drcr.ComponentManagement.class,
+                    "(" + org.arflex.drcr.ComponentManagement.COMPONENT_PROPERTY + "=" + name + ")")) {
+                org.arflex.drcr.ComponentManagement cm = ctx.getService(ref);
+                if (cm != null) {
+                    // our own service object: no need to keep the reference counted
+                    ctx.ungetService(ref);
+                    return java.util.Optional.of(cm);
+                }
+            }
+        } catch (org.osgi.framework.InvalidSyntaxException e) {
+            return java.util.Optional.empty();
+        }
+        return java.util.Optional.empty();
     }
 
     private static List<Integer> allCpus() {

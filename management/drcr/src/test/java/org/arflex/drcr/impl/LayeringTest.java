@@ -41,7 +41,8 @@ class LayeringTest {
             "impl/shell", Set.of("impl/abi", "impl/lifecycle", "impl/supervisor", "impl/extender",
                     "impl/services", "impl/runtime", "impl"),
             "impl/extender", Set.of("impl/services", "impl/shell", "impl", "impl/supervisor", "impl/abi"),
-            "impl/services", Set.of("impl/shell", "impl/extender", "impl/abi", "impl"));
+            "impl/services", Set.of("impl/shell", "impl/extender", "impl/abi", "impl"),
+            "impl/runtime", Set.of("impl/shell", "impl/extender", "impl/services", "impl"));
 
     @Test
     void packagesRespectTheLayering() throws IOException {
