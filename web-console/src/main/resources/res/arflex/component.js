@@ -16,6 +16,12 @@
   }
 
   const summary = el('div', {id: 'arflex-summary'});
+  // Commands stay on the page even when the component left the cell (a stopped bundle).
+  const cmd = (what) => el('button', {type: 'button', id: 'arflex-cmd-' + what, onclick: async () => {
+    try { await post('command', {name, cmd: what}); message(status, what + ': done', 'ok'); load(); }
+    catch (e) { message(status, what + ': ' + e.message, 'error'); }
+  }}, what);
+  const commands = el('p', {id: 'arflex-commands'}, 'Commands: ', cmd('start'), ' ', cmd('stop'), ' ', cmd('reset'));
   const params = el('div', {id: 'arflex-params'});
   const plots = el('div', {id: 'arflex-plots'});
   const histo = el('div', {id: 'arflex-histogram'});
@@ -31,14 +37,10 @@
       el('td', {}, p.type + ' ' + p.typeVersion), el('td', {}, p.method), el('td', {}, p.binding || (p.direction === 'IN' ? 'any' : '')),
       el('td', {}, p.optional ? 'optional' : '')));
     const bindings = (i.bindings || []).map(b => el('li', {}, b.provider + '.' + b.output + ' → ' + b.consumer + '.' + b.input));
-    const cmd = (what) => el('button', {type: 'button', id: 'arflex-cmd-' + what, onclick: async () => {
-      try { await post('command', {name, cmd: what}); message(status, what + ': done', 'ok'); load(); }
-      catch (e) { message(status, what + ': ' + e.message, 'error'); }
-    }}, what);
     summary.replaceChildren(
       el('div', {}, 'State ', stateBadge(i.state), ' target ', i.targetState || '', ' ',
         i.failureReason ? el('span', {class: 'arflex-reason'}, '— ' + i.failureReason) : '',
-        ' ', cmd('start'), ' ', cmd('stop'), ' ', cmd('reset')),
+        ''),
       el('h2', {}, 'Contract'),
       kv([['Name', c.name + ' ' + (c.version || '')], ['Description', c.description || ''],
         ['Task', (c.taskType || '') + (c.movesHardware ? ' (moves hardware)' : '')],
@@ -131,12 +133,12 @@
       renderSummary(d);
       renderParams(d);
     } catch (e) {
-      message(status, 'Cannot read component ' + name + ': ' + e.message, 'error');
+      message(status, 'Component ' + name + ' is not in the cell now (' + e.message + ')', 'error');
     }
   }
 
   if (!name) { chooser(); return; }
-  app.replaceChildren(el('h2', {id: 'arflex-component-name'}, 'Component ', el('code', {}, name)), status, summary, params, plots, histo);
+  app.replaceChildren(el('h2', {id: 'arflex-component-name'}, 'Component ', el('code', {}, name)), status, commands, summary, params, plots, histo);
   load().then(startStream);
   setInterval(refreshHistogram, 2000);
   window.addEventListener('beforeunload', () => source && source.close());

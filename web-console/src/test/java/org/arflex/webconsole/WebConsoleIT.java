@@ -378,6 +378,37 @@ class WebConsoleIT {
         shot("11-cell-after-uninstall");
     }
 
+    @Test
+    @Order(10)
+    void theCellSaysWhyAComponentIsNotActiveAndStopStartWork() throws IOException {
+        Path scaler = sample("scaler");
+        open("arflex-deploy");
+        await(By.id("arflex-url")).sendKeys(scaler.toUri().toString());
+        browser.findElement(By.id("arflex-sha256")).sendKeys(sha256(scaler));
+        browser.findElement(By.id("arflex-fetch")).click();
+        await(By.id("arflex-confirm")).click();
+        RuntimeUnderTest.awaitCondition("sample-scaler Active again", WAIT, () -> "ACTIVE".equals(instanceState("sample-scaler")));
+
+        // Stop the provider: the consumer loses its input and the cell says why.
+        open("arflex-component?name=sample-counter");
+        await(By.id("arflex-cmd-stop")).click();
+        RuntimeUnderTest.awaitCondition("sample-scaler not Active", WAIT,
+                () -> !"ACTIVE".equals(instanceState("sample-scaler")));
+        open("arflex-cell");
+        By reason = By.cssSelector("tr[data-component='sample-scaler'] .arflex-reason");
+        new WebDriverWait(browser, WAIT).until(d -> !d.findElement(reason).getText().isBlank());
+        String why = browser.findElement(reason).getText();
+        shot("12-cell-why-not-active");
+        assertTrue(why.contains("sample-counter") || why.contains("x"), "reason names the missing input: " + why);
+
+        // Start it again from its page: both Active.
+        open("arflex-component?name=sample-counter");
+        await(By.id("arflex-component-status"));
+        browser.findElement(By.id("arflex-cmd-start")).click();
+        RuntimeUnderTest.awaitCondition("both Active", WAIT,
+                () -> "ACTIVE".equals(instanceState("sample-counter")) && "ACTIVE".equals(instanceState("sample-scaler")));
+    }
+
     private static String sha256(Path p) throws IOException {
         try {
             return HexFormat.of().formatHex(MessageDigest.getInstance("SHA-256").digest(Files.readAllBytes(p)));

@@ -64,6 +64,7 @@ public class Backend {
     private final ContractParser parser = ContractParser.create();
     private final Map<String, Artifacts.Staged> staged = new ConcurrentHashMap<>();
     private final SecureRandom random = new SecureRandom();
+    private final Map<String, Long> knownBundles = new ConcurrentHashMap<>();
     private BundleContext context;
     private Path dataDir;
     private Path contractsDir;
@@ -224,10 +225,17 @@ public class Backend {
     }
 
     private Bundle bundleOf(String name) throws HttpError {
-        ContractDTO c = drcr().contract(name).orElseThrow(() -> new HttpError(404, "no contract named '" + name + "'"));
-        Bundle b = context.getBundle(c.bundleId);
+        Optional<ContractDTO> c = drcr().contract(name);
+        // A stopped bundle's contract leaves the cell; remember where it was so start works.
+        Long id = c.map(x -> x.bundleId).orElse(knownBundles.get(name));
+        if (id == null) {
+            throw new HttpError(404, "no contract named '" + name + "'");
+        }
+        knownBundles.put(name, id);
+        Bundle b = context.getBundle(id);
         if (b == null) {
-            throw new HttpError(404, "the bundle " + c.bundleId + " of '" + name + "' is gone");
+            knownBundles.remove(name);
+            throw new HttpError(404, "the bundle " + id + " of '" + name + "' is gone");
         }
         return b;
     }
