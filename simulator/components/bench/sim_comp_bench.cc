@@ -45,21 +45,43 @@ struct Result {
   std::string name;
   uint64_t cycles = 0, overruns = 0, deadline_misses = 0, update_errors = 0;
   MetricSummary latency{}, exec{};
+  double latency_max_all_us = 0, exec_max_all_us = 0;  // including the start-up cycles
+  uint64_t steady_cycles = 0;
+  long robot_rss_kib = 0, camera_rss_kib = 0;
   bool fifo = false;
   uint64_t frames = 0;
   double camera_fps = 0, render_mean_ms = 0, render_max_ms = 0;
   uint64_t camera_overruns = 0;
 };
 
-MetricSummary Summarise(const arflex_metric& m) {
+// Summary of the samples taken between two snapshots `a` (earlier) and `b` of a metric: the
+// histograms, counts and sums subtract; min and max come from the histogram's 100 ns bins
+// (the max exactly when it was set inside the window).
+MetricSummary Summarise(const arflex_metric& a, const arflex_metric& b, double* max_all_us) {
   MetricSummary s{};
-  if (m.count == 0) return s;
-  s.min_us = m.min_ns / 1e3;
-  s.mean_us = static_cast<double>(m.sum_ns) / m.count / 1e3;
-  s.p50_us = arflex_metric_percentile(&m, 0.5) / 1e3;
-  s.p99_us = arflex_metric_percentile(&m, 0.99) / 1e3;
-  s.p999_us = arflex_metric_percentile(&m, 0.999) / 1e3;
-  s.max_us = m.max_ns / 1e3;
+  *max_all_us = b.count ? b.max_ns / 1e3 : 0;
+  static arflex_metric d;  // 16 KB: not on the stack
+  std::memset(&d, 0, sizeof(d));
+  d.count = b.count - a.count;
+  d.sum_ns = b.sum_ns - a.sum_ns;
+  int first = -1, last = -1;
+  for (unsigned i = 0; i <= ARFLEX_HIST_BINS; ++i) {
+    d.hist[i] = b.hist[i] - a.hist[i];
+    if (d.hist[i]) {
+      if (first < 0) first = static_cast<int>(i);
+      last = static_cast<int>(i);
+    }
+  }
+  if (d.count == 0 || first < 0) return s;
+  d.max_ns = (b.max_ns > a.max_ns || a.count == 0) ? b.max_ns
+                                                   : static_cast<uint64_t>(last + 1) * ARFLEX_HIST_BIN_NS;
+  if (d.max_ns > b.max_ns) d.max_ns = b.max_ns;
+  s.min_us = first * ARFLEX_HIST_BIN_NS / 1e3;
+  s.mean_us = static_cast<double>(d.sum_ns) / d.count / 1e3;
+  s.p50_us = arflex_metric_percentile(&d, 50.0) / 1e3;
+  s.p99_us = arflex_metric_percentile(&d, 99.0) / 1e3;
+  s.p999_us = arflex_metric_percentile(&d, 99.9) / 1e3;
+  s.max_us = d.max_ns / 1e3;
   return s;
 }
 
@@ -72,6 +94,21 @@ arflex_param_slot ParamI(const char* name, int64_t v) {
   s.max_bits = static_cast<uint64_t>(v);
   s.default_bits = static_cast<uint64_t>(v);
   return s;
+}
+
+// VmRSS of process `pid` in KiB (0 if unreadable).
+long RssKib(pid_t pid) {
+  char path[64];
+  std::snprintf(path, sizeof(path), "/proc/%d/status", static_cast<int>(pid));
+  FILE* f = std::fopen(path, "r");
+  if (!f) return 0;
+  char line[256];
+  long kib = 0;
+  while (std::fgets(line, sizeof(line), f)) {
+    if (std::sscanf(line, "VmRSS: %ld kB", &kib) == 1) break;
+  }
+  std::fclose(f);
+  return kib;
 }
 
 void Sleep(uint64_t ns) {
@@ -124,7 +161,7 @@ bool Run(const Options& opt, bool with_camera, Result* out) {
   co.outputs = cam_outs;
   co.noutputs = 1;
 
-  arflex_stats st, cst;
+  static arflex_stats st, cst, st0, cst0;  // 32 KB each
   int r = arflex_host_create(&robot, &ro);
   if (r == 0) r = arflex_host_spawn(&robot, SIM_ROBOT_EXE, nullptr, nullptr);
   if (r == 0) r = arflex_host_wait_state(&robot, ARFLEX_STATE_READY, 60 * kSec);
@@ -144,7 +181,16 @@ bool Run(const Options& opt, bool with_camera, Result* out) {
                  with_camera ? "rendering" : "alone", std::strerror(-r));
     goto out;
   }
+  // Warm-up (start-up page faults, first frames), then the measured window.
+  Sleep(1 * kSec);
+  if (arflex_ctl_stats_read(robot.ctl, &st0) != 0 ||
+      (with_camera && arflex_ctl_stats_read(camera.ctl, &cst0) != 0)) {
+    std::fprintf(stderr, "arflex-sim-comp-bench: statistics unreadable\n");
+    goto out;
+  }
   Sleep(static_cast<uint64_t>(opt.seconds * 1e9));
+  out->robot_rss_kib = RssKib(robot.pid);
+  if (with_camera) out->camera_rss_kib = RssKib(camera.pid);
   if (with_camera) arflex_host_stop(&camera, 5 * kSec);
   arflex_host_stop(&robot, 5 * kSec);
   if (arflex_ctl_stats_read(robot.ctl, &st) != 0 ||
@@ -157,15 +203,17 @@ bool Run(const Options& opt, bool with_camera, Result* out) {
   out->overruns = st.overruns;
   out->deadline_misses = st.deadline_misses;
   out->update_errors = st.update_errors;
-  out->latency = Summarise(st.latency);
-  out->exec = Summarise(st.exec);
+  out->latency = Summarise(st0.latency, st.latency, &out->latency_max_all_us);
+  out->exec = Summarise(st0.exec, st.exec, &out->exec_max_all_us);
+  out->steady_cycles = st.cycles - st0.cycles;
   out->fifo = (arflex_ctl_flags(robot.ctl) & ARFLEX_FLAG_SCHED_FIFO) != 0;
   if (with_camera) {
-    out->frames = cst.cycles;
-    out->camera_fps = cst.cycles / opt.seconds;
-    out->render_mean_ms = cst.exec.count ? cst.exec.sum_ns / 1e6 / cst.exec.count : 0;
+    out->frames = cst.cycles - cst0.cycles;
+    out->camera_fps = out->frames / opt.seconds;
+    const uint64_t n = cst.exec.count - cst0.exec.count;
+    out->render_mean_ms = n ? (cst.exec.sum_ns - cst0.exec.sum_ns) / 1e6 / n : 0;
     out->render_max_ms = cst.exec.max_ns / 1e6;
-    out->camera_overruns = cst.overruns;
+    out->camera_overruns = cst.overruns - cst0.overruns;
   }
   ok = true;
 out:
@@ -236,14 +284,20 @@ int main(int argc, char** argv) {
   std::printf("  %-22s %8s %8s %8s %8s %8s %8s\n", "(us)", "min", "mean", "p50", "p99",
               "p99.9", "max");
   for (const Result& r : res) {
-    std::printf("%s: cycles %llu, overruns %llu, deadline misses %llu, update errors %llu\n",
+    std::printf("%s: cycles %llu (measured %llu after 1 s warm-up), overruns %llu, deadline "
+                "misses %llu, update errors %llu (all cycles); max incl. start-up: latency "
+                "%.1f us, execution %.1f us\n",
                 r.name.c_str(), static_cast<unsigned long long>(r.cycles),
+                static_cast<unsigned long long>(r.steady_cycles),
                 static_cast<unsigned long long>(r.overruns),
                 static_cast<unsigned long long>(r.deadline_misses),
-                static_cast<unsigned long long>(r.update_errors));
+                static_cast<unsigned long long>(r.update_errors), r.latency_max_all_us,
+                r.exec_max_all_us);
     PrintRow("wake-up latency", r.latency);
     PrintRow("execution time", r.exec);
   }
+  std::printf("resident memory: sim-robot %.0f MiB (mlockall), sim-camera %.0f MiB\n",
+              res[1].robot_rss_kib / 1024.0, res[1].camera_rss_kib / 1024.0);
   std::printf("camera: %llu frames, %.1f fps, render+publish mean %.1f ms, max %.1f ms, "
               "overruns %llu\n",
               static_cast<unsigned long long>(res[1].frames), res[1].camera_fps,
@@ -258,16 +312,20 @@ int main(int argc, char** argv) {
   std::fprintf(f, "{\n  \"benchmark\": \"sim-comp\",\n  \"seconds\": %.1f,\n  \"priority\": %d,\n"
                "  \"sched_fifo\": %s,\n  \"camera\": {\"width\": %d, \"height\": %d, "
                "\"period_ms\": %d, \"frames\": %llu, \"fps\": %.2f, \"render_mean_ms\": %.2f, "
-               "\"render_max_ms\": %.2f, \"overruns\": %llu},\n  \"scenarios\": [\n",
+               "\"render_max_ms\": %.2f, \"overruns\": %llu, \"rss_mib\": %.0f},\n  \"robot_rss_mib\": %.0f,\n  \"scenarios\": [\n",
                opt.seconds, opt.priority, res[0].fifo ? "true" : "false", opt.width,
                opt.height, opt.camera_ms, static_cast<unsigned long long>(res[1].frames),
                res[1].camera_fps, res[1].render_mean_ms, res[1].render_max_ms,
-               static_cast<unsigned long long>(res[1].camera_overruns));
+               static_cast<unsigned long long>(res[1].camera_overruns),
+               res[1].camera_rss_kib / 1024.0, res[1].robot_rss_kib / 1024.0);
   for (int k = 0; k < 2; ++k) {
     const Result& r = res[k];
-    std::fprintf(f, "    {\"name\": \"%s\", \"cycles\": %llu, \"overruns\": %llu, "
-                 "\"deadline_misses\": %llu, \"update_errors\": %llu,\n",
+    std::fprintf(f, "    {\"name\": \"%s\", \"cycles\": %llu, \"measured_cycles\": %llu, "
+                 "\"latency_max_incl_startup_us\": %.1f, \"exec_max_incl_startup_us\": %.1f, "
+                 "\"overruns\": %llu, \"deadline_misses\": %llu, \"update_errors\": %llu,\n",
                  r.name.c_str(), static_cast<unsigned long long>(r.cycles),
+                 static_cast<unsigned long long>(r.steady_cycles), r.latency_max_all_us,
+                 r.exec_max_all_us,
                  static_cast<unsigned long long>(r.overruns),
                  static_cast<unsigned long long>(r.deadline_misses),
                  static_cast<unsigned long long>(r.update_errors));
