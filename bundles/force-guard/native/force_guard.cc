@@ -1,0 +1,184 @@
+// force-guard - RT half of the force-guard component (README.md): watches the joint torques
+// and the wrist wrench against the nominal model; above a threshold it puts the cell in a
+// protective stop in the same cycle and keeps it there until an operator reset.
+//
+// Ports: in joint_state (arflex.JointState), in wrench (arflex.Wrench), out safety
+// (arflex.SafetyState, written every cycle). An unbound input is simply not checked.
+//
+// Latch: on a trip the RT half sets ARFLEX_FLAG_RESET_REQUIRED in its own control block
+// (the RT process is the writer of `flags`, rt-core/docs/ABI.md §3), so rt-core calls the safe
+// hook instead of update until the operator's RESET command clears it; the safe hook keeps
+// writing PROTECTIVE_STOP. A rising edge 0 -> 1 of the mutable parameter `reset` clears it as
+// well. Runtime heartbeat loss (rt-core safe mode) also writes PROTECTIVE_STOP, with the
+// HEARTBEAT_LOST reason.
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+#include "arflex/component.h"
+#include "arflex_types/joint_state.h"
+#include "arflex_types/safety_state.h"
+#include "arflex_types/wrench.h"
+#include "cellkin.h"
+
+namespace {
+
+using arflex::cellkin::Q;
+
+struct State {
+  arflex::cellkin::Model model;
+  struct arflex_port* out = nullptr;
+  struct arflex_input* in_js = nullptr;
+  struct arflex_input* in_w = nullptr;
+  int p_force, p_torque, p_power, p_reset, p_payload;
+  struct arflex_joint_state js{};
+  struct arflex_wrench w{};
+  bool have_js = false, have_w = false;
+  bool latched = false;
+  bool reset_prev = false;
+  uint32_t reason = 0;
+  double force_norm = 0;
+  uint64_t seq = 0;
+  uint64_t trips = 0;
+} g;
+
+struct arflex_ctl* Ctl(struct arflex_component* c) {
+  // The control block is shared memory this process may write (`flags` is RT-written);
+  // the component API hands it out read-only for the common case.
+  return const_cast<struct arflex_ctl*>(arflex_component_ctl(c));
+}
+
+int Configure(struct arflex_component* c, void*) {
+  static const struct arflex_port_type js_t = {ARFLEX_TYPE_JOINT_STATE_NAME, 1, 0,
+                                               sizeof(struct arflex_joint_state)};
+  static const struct arflex_port_type w_t = {ARFLEX_TYPE_WRENCH_NAME, 1, 0,
+                                              sizeof(struct arflex_wrench)};
+  static const struct arflex_port_type s_t = {ARFLEX_TYPE_SAFETY_STATE_NAME, 1, 0,
+                                              sizeof(struct arflex_safety_state)};
+  int r = arflex_component_output(c, "safety", ARFLEX_PORT_STATE, &s_t, &g.out);
+  if (r < 0) {
+    fprintf(stderr, "force-guard: output safety: %s\n", strerror(-r));
+    return r;
+  }
+  if ((r = arflex_component_input(c, "joint_state", ARFLEX_PORT_STATE, &js_t, &g.in_js)) < 0 ||
+      (r = arflex_component_input(c, "wrench", ARFLEX_PORT_STATE, &w_t, &g.in_w)) < 0)
+    return r;
+  const char* names[] = {"force_limit_n", "torque_limit_nm", "safe_power_fraction", "reset",
+                         "payload_kg"};
+  int* idx[] = {&g.p_force, &g.p_torque, &g.p_power, &g.p_reset, &g.p_payload};
+  for (int i = 0; i < 5; ++i) {
+    *idx[i] = arflex_component_param(c, names[i]);
+    if (*idx[i] < 0) {
+      fprintf(stderr, "force-guard: parameter '%s' missing from the control block\n", names[i]);
+      return -ENOENT;
+    }
+  }
+  return 0;
+}
+
+int Start(struct arflex_component* c, void*) {
+  g.have_js = g.have_w = false;
+  g.reset_prev = arflex_param_bool(c, g.p_reset);
+  // A restarted guard that was latched stays latched: rt-core keeps RESET_REQUIRED.
+  g.latched = (arflex_component_ctl(c)->flags & ARFLEX_FLAG_RESET_REQUIRED) != 0;
+  return 0;
+}
+
+int Write(struct arflex_component* c, uint64_t release_ns, uint32_t extra_flags) {
+  struct arflex_safety_state s;
+  memset(&s, 0, sizeof(s));
+  s.t_ns = (int64_t)release_ns;
+  s.seq = ++g.seq;
+  const bool stop = g.latched || extra_flags;
+  s.mode = stop ? ARFLEX_SAFETY_STATE_MODE_PROTECTIVE_STOP : ARFLEX_SAFETY_STATE_MODE_NORMAL;
+  s.flags = (g.latched ? g.reason | ARFLEX_SAFETY_STATE_FLAG_RESET_REQUIRED : 0) | extra_flags;
+  s.power_scale = stop ? arflex_param_f64(c, g.p_power) : 1.0;
+  s.force_norm = g.force_norm;
+  s.force_limit = arflex_param_f64(c, g.p_force);
+  return arflex_state_write(g.out, &s, sizeof(s));
+}
+
+void ReadInputs() {
+  if (arflex_input_state_read(g.in_js, &g.js, sizeof(g.js), nullptr) == 1) g.have_js = true;
+  if (arflex_input_state_read(g.in_w, &g.w, sizeof(g.w), nullptr) == 1) g.have_w = true;
+  if (!arflex_input_bound(g.in_js)) g.have_js = false;
+  if (!arflex_input_bound(g.in_w)) g.have_w = false;
+}
+
+// True when the edge 0 -> 1 of `reset` happened since the last call.
+bool ResetEdge(struct arflex_component* c) {
+  const bool now = arflex_param_bool(c, g.p_reset);
+  const bool edge = now && !g.reset_prev;
+  g.reset_prev = now;
+  return edge;
+}
+
+int Update(struct arflex_component* c, void*, uint64_t release_ns) {
+  struct arflex_ctl* ctl = Ctl(c);
+  ResetEdge(c);
+  // update runs again only when RESET_REQUIRED is clear: the operator's RESET came.
+  if (g.latched && !(__atomic_load_n(&ctl->flags, __ATOMIC_ACQUIRE) &
+                     ARFLEX_FLAG_RESET_REQUIRED)) {
+    g.latched = false;
+    g.reason = 0;
+  }
+  ReadInputs();
+  const double payload = arflex_param_f64(c, g.p_payload);
+  uint32_t reason = 0;
+  Q q;
+  if (g.have_js) {
+    Q tau;
+    for (int j = 0; j < 6; ++j) {
+      q[j] = g.js.q[j];
+      tau[j] = g.js.tau[j];
+    }
+    const Q ext = tau - g.model.GravityTorque(q, payload);
+    if (ext.cwiseAbs().maxCoeff() > arflex_param_f64(c, g.p_torque))
+      reason |= ARFLEX_SAFETY_STATE_FLAG_FORCE_LIMIT;
+  }
+  g.force_norm = 0;
+  if (g.have_w) {
+    const Eigen::Vector3d f(g.w.force[0], g.w.force[1], g.w.force[2]);
+    if (g.have_js) {
+      Eigen::Vector3d f0, t0;
+      g.model.ToolWeightWrench(q, payload, &f0, &t0);
+      g.force_norm = (f - f0).norm();
+    } else {
+      // No joint angles: the tool's weight direction is unknown; the contact force is at
+      // least | |F| - weight |.
+      const double weight = (g.model.arm().tool_mass + payload) * arflex::cellkin::kGravity;
+      g.force_norm = std::fabs(f.norm() - weight);
+    }
+    if (g.force_norm > arflex_param_f64(c, g.p_force)) reason |= ARFLEX_SAFETY_STATE_FLAG_FORCE_LIMIT;
+  }
+  if (reason && !g.latched) {
+    g.latched = true;
+    g.reason = reason;
+    ++g.trips;
+    __atomic_or_fetch(&ctl->flags, ARFLEX_FLAG_RESET_REQUIRED, __ATOMIC_RELEASE);
+  }
+  return Write(c, release_ns, 0);
+}
+
+int Safe(struct arflex_component* c, void*, enum arflex_safe_mode, bool) {
+  struct arflex_ctl* ctl = Ctl(c);
+  const uint64_t now = arflex_sys_now_ns();
+  ReadInputs();
+  if (ResetEdge(c) && g.latched) {
+    g.latched = false;
+    g.reason = 0;
+    __atomic_and_fetch(&ctl->flags, ~(uint32_t)ARFLEX_FLAG_RESET_REQUIRED, __ATOMIC_RELEASE);
+    return Write(c, now, 0);
+  }
+  // In safe mode without a latch of ours: the runtime heartbeat is lost.
+  return Write(c, now, g.latched ? 0 : ARFLEX_SAFETY_STATE_FLAG_HEARTBEAT_LOST);
+}
+
+const struct arflex_component_ops kOps = {
+    "force-guard", nullptr, Configure, Start, Update, nullptr, nullptr, Safe,
+};
+
+}  // namespace
+
+int main(int argc, char** argv) { return arflex_component_main(argc, argv, &kOps); }

@@ -1,0 +1,524 @@
+// test_cell - CTest cell.*: the cell's RT halves as processes under the rt-core host API,
+// wired as the DRCR would wire them; the test itself plays the robot and the sensors through
+// "script" instances whose output segments it writes.
+//   test_cell <trajectory|force_guard|teach_replay|tools> <bin dir>
+// Every case uses its own runtime id and ends by checking that no /dev/shm/arflex.<rid>.*,
+// no queue and no child process is left. Waits are conditions with deadlines (counted in the
+// components' cycles where the brief is about cycles); nothing asserts on timing.
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <sched.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "arflex/host.h"
+#include "arflex_types/joint_ref.h"
+#include "arflex_types/joint_state.h"
+#include "arflex_types/safety_state.h"
+#include "arflex_types/sample.h"
+#include "arflex_types/tool_state.h"
+#include "arflex_types/wrench.h"
+#include "cellkin.h"
+
+using arflex::cellkin::Model;
+using arflex::cellkin::Q;
+
+namespace {
+
+constexpr uint64_t kSec = 1000000000ull, kMs = 1000000ull;
+constexpr uint64_t kCall = 2 * kSec, kWait = 30 * kSec;
+
+char rid[ARFLEX_ID_MAX + 1];
+std::string bindir;
+int failures;
+std::vector<struct arflex_host*> hosts;
+
+#define CHECK(c, ...)                                                      \
+  do {                                                                     \
+    if (!(c)) {                                                            \
+      fprintf(stderr, "FAIL %s:%d: %s: ", __FILE__, __LINE__, #c);         \
+      fprintf(stderr, __VA_ARGS__);                                        \
+      fputc('\n', stderr);                                                 \
+      ++failures;                                                          \
+      return;                                                              \
+    }                                                                      \
+  } while (0)
+
+const struct arflex_port_type kRefT = {ARFLEX_TYPE_JOINT_REF_NAME, 1, 0, sizeof(arflex_joint_ref)};
+const struct arflex_port_type kJsT = {ARFLEX_TYPE_JOINT_STATE_NAME, 1, 0, sizeof(arflex_joint_state)};
+const struct arflex_port_type kWT = {ARFLEX_TYPE_WRENCH_NAME, 1, 0, sizeof(arflex_wrench)};
+const struct arflex_port_type kST = {ARFLEX_TYPE_SAFETY_STATE_NAME, 1, 0, sizeof(arflex_safety_state)};
+const struct arflex_port_type kToolT = {ARFLEX_TYPE_TOOL_STATE_NAME, 1, 0, sizeof(arflex_tool_state)};
+const struct arflex_port_type kSampleT = {ARFLEX_TYPE_SAMPLE_NAME, 1, 0, sizeof(arflex_sample)};
+
+struct arflex_param_slot P(const char* name, uint32_t type, double def, double lo, double hi,
+                           bool mut) {
+  struct arflex_param_slot s;
+  memset(&s, 0, sizeof(s));
+  snprintf(s.name, sizeof(s.name), "%s", name);
+  s.type = type;
+  s.flags = mut ? ARFLEX_PARAM_MUTABLE : 0;
+  if (type == ARFLEX_PARAM_DOUBLE) {
+    s.min_bits = arflex_f64_bits(lo);
+    s.max_bits = arflex_f64_bits(hi);
+    s.default_bits = arflex_f64_bits(def);
+  } else {
+    s.min_bits = (uint64_t)(int64_t)lo;
+    s.max_bits = (uint64_t)(int64_t)hi;
+    s.default_bits = (uint64_t)(int64_t)def;
+  }
+  return s;
+}
+struct arflex_param_slot PB(const char* n, bool def, bool mut) {
+  return P(n, ARFLEX_PARAM_BOOL, def, 0, 1, mut);
+}
+struct arflex_param_slot PD(const char* n, double def, double lo, double hi, bool mut) {
+  return P(n, ARFLEX_PARAM_DOUBLE, def, lo, hi, mut);
+}
+struct arflex_param_slot PI(const char* n, double def, double lo, double hi, bool mut) {
+  return P(n, ARFLEX_PARAM_INT64, def, lo, hi, mut);
+}
+
+struct arflex_ctl_config Config(uint64_t period) {
+  struct arflex_ctl_config c;
+  memset(&c, 0, sizeof(c));
+  c.period_ns = period;
+  c.cfg_flags = ARFLEX_CFG_NO_MLOCK | ARFLEX_CFG_NO_DMA_LATENCY;
+  return c;
+}
+
+struct Out {
+  const char* port;
+  struct arflex_port_type type;
+};
+
+// Creates an instance with state outputs; spawns `exe` (from bindir) unless it is NULL.
+int Make(struct arflex_host* h, const char* inst, uint64_t period, const std::vector<Out>& outs,
+         const std::vector<struct arflex_param_slot>& params, const char* exe,
+         char* const* envp = nullptr) {
+  struct arflex_host_output o[8];
+  memset(h, 0, sizeof(*h));
+  for (size_t i = 0; i < outs.size(); ++i) {
+    o[i].port = outs[i].port;
+    o[i].spec = {ARFLEX_PORT_STATE, outs[i].type, 1, ARFLEX_OVERFLOW_NONE};
+  }
+  struct arflex_host_opts opts;
+  memset(&opts, 0, sizeof(opts));
+  opts.runtime = rid;
+  opts.instance = inst;
+  opts.config = Config(period);
+  opts.params = params.empty() ? nullptr : params.data();
+  opts.nparams = (unsigned)params.size();
+  opts.outputs = o;
+  opts.noutputs = (unsigned)outs.size();
+  int r = arflex_host_create(h, &opts);
+  if (r < 0) return r;
+  hosts.push_back(h);
+  if (!exe) return 0;
+  const std::string path = bindir + "/" + exe;
+  if ((r = arflex_host_spawn(h, path.c_str(), nullptr, envp)) < 0) return r;
+  return arflex_host_wait_state(h, ARFLEX_STATE_READY, 10 * kSec);
+}
+
+void DestroyAll() {
+  for (auto* h : hosts) {
+    if (h->pid > 0 && !h->reaped && arflex_host_shutdown(h, kCall) == 0)
+      arflex_host_wait_exit(h, 5 * kSec);
+    arflex_host_destroy(h);
+  }
+  hosts.clear();
+}
+
+bool Leaked() {
+  const char* dirs[] = {"/dev/shm", "/dev/mqueue"};
+  char prefix[64];
+  bool any = false;
+  snprintf(prefix, sizeof(prefix), "arflex.%s.", rid);
+  for (const char* dn : dirs) {
+    DIR* d = opendir(dn);
+    if (!d) continue;
+    while (struct dirent* e = readdir(d)) {
+      if (strncmp(e->d_name, prefix, strlen(prefix)) == 0) {
+        fprintf(stderr, "leak: %s/%s\n", dn, e->d_name);
+        any = true;
+      }
+    }
+    closedir(d);
+  }
+  if (waitpid(-1, nullptr, WNOHANG) != -1 || errno != ECHILD) {
+    fprintf(stderr, "leak: a child process is left\n");
+    any = true;
+  }
+  return any;
+}
+
+// A reader of an output port with its own handle.
+struct Reader {
+  struct arflex_port port;
+  bool open = false;
+  int Open(struct arflex_host* h, const char* p, const struct arflex_port_type* t) {
+    const char* name = arflex_host_output_name(h, p);
+    if (!name) return -ENOENT;
+    int r = arflex_port_open(&port, name, false, false, ARFLEX_PORT_STATE, t);
+    open = r == 0;
+    return r;
+  }
+  template <typename T>
+  int Read(T* v, uint64_t* seq) { return arflex_state_read(&port, v, sizeof(*v), seq); }
+  uint64_t Head() const { return __atomic_load_n(&port.hdr->head, __ATOMIC_ACQUIRE); }
+  ~Reader() {
+    if (open) arflex_port_close(&port);
+  }
+};
+
+uint64_t Now() { return arflex_sys_now_ns(); }
+
+int SetI(struct arflex_host* h, const char* n, int64_t v) {
+  return arflex_host_set_param(h, n, (uint64_t)v, nullptr, kCall);
+}
+
+std::vector<struct arflex_param_slot> TrajectoryParams() {
+  return {PI("program", 0, 0, 99, false),      PB("run", true, true),
+          PB("loop", false, true),             PI("profile", 0, 0, 1, true),
+          PD("speed", 1, 0.01, 1, true),       PD("accel", 3, 0.1, 50, true),
+          PD("accel_max", 20, 0.1, 200, true), PD("lin_speed", 0.25, 0.001, 2, true),
+          PD("lin_accel", 1, 0.01, 10, true),  PD("stop_time", 0.3, 0.001, 5, true)};
+}
+
+std::string MakeDataDir() {
+  char dir[] = "/tmp/arflex-cell-XXXXXX";
+  if (!mkdtemp(dir)) return "";
+  return dir;
+}
+
+void RemoveDir(const std::string& d) {
+  if (d.empty()) return;
+  if (DIR* dd = opendir(d.c_str())) {
+    while (struct dirent* e = readdir(dd)) {
+      if (e->d_name[0] == '.') continue;
+      unlink((d + "/" + e->d_name).c_str());
+    }
+    closedir(dd);
+  }
+  rmdir(d.c_str());
+}
+
+bool WriteText(const std::string& path, const char* text) {
+  FILE* f = fopen(path.c_str(), "w");
+  if (!f) return false;
+  fputs(text, f);
+  return fclose(f) == 0;
+}
+
+struct Sample {
+  uint64_t seq;
+  Q q;
+};
+
+// ---- trajectory ----------------------------------------------------------------------------
+
+void CaseTrajectory() {
+  static struct arflex_host traj;
+  const std::string dir = MakeDataDir();
+  CHECK(!dir.empty(), "mkdtemp");
+  const char* prog =
+      "arflex-program 1\nstart 0 0 0 0 0 0\n"
+      "ptp 0.5 0.3 0.6 -0.4 0.8 0.3\n"
+      "ptp -0.4 0.1 0.9 0.5 -0.6 -0.2 speed 0.5\n"
+      "ptp 0 0.2 0.5 0 0.6 0\n";
+  const double target[3][6] = {{0.5, 0.3, 0.6, -0.4, 0.8, 0.3},
+                               {-0.4, 0.1, 0.9, 0.5, -0.6, -0.2},
+                               {0, 0.2, 0.5, 0, 0.6, 0}};
+  bool ok = WriteText(arflex::cellkin::ProgramPath(dir, 1), prog);
+  std::string env = "ARFLEX_DATA_DIR=" + dir;
+  char* envp[] = {const_cast<char*>(env.c_str()), nullptr};
+  int r = ok ? Make(&traj, "trajectory", kMs, {{"joint_ref", kRefT}}, TrajectoryParams(),
+                    "trajectory", envp)
+             : -EIO;
+  RemoveDir(dir);  // loaded at configure: the process does not need the file any more
+  CHECK(r == 0, "create/spawn trajectory: %d", r);
+  CHECK(SetI(&traj, "program", 1) == 0, "set program");
+  Reader rd;
+  CHECK(rd.Open(&traj, "joint_ref", &kRefT) == 0, "open joint_ref");
+  CHECK(arflex_host_start(&traj, kCall) == 0, "start");
+
+  const double deg = M_PI / 180;
+  const double vmax[6] = {123 * deg, 115 * deg, 112 * deg, 179 * deg, 172 * deg, 219 * deg};
+  std::vector<Sample> s;
+  s.reserve(200000);
+  bool paused_checked = false;
+  double near[3] = {1e9, 1e9, 1e9};
+  uint64_t pause_at = 0, stable = 0;
+  const uint64_t deadline = Now() + kWait;
+  while (Now() < deadline) {
+    struct arflex_joint_ref ref;
+    uint64_t seq;
+    if (rd.Read(&ref, &seq) != 1) {
+      sched_yield();
+      continue;
+    }
+    Sample x{seq, Q::Zero()};
+    for (int j = 0; j < 6; ++j) x.q[j] = ref.q[j];
+    for (int k = 0; k < 3; ++k) {
+      double d = 0;
+      for (int j = 0; j < 6; ++j) d = std::max(d, std::fabs(x.q[j] - target[k][j]));
+      near[k] = std::min(near[k], d);
+    }
+    const bool same = !s.empty() && (s.back().q - x.q).norm() == 0;
+    s.push_back(x);
+    // Pause in the middle of the second motion, check the hold, resume.
+    if (!paused_checked && near[0] < 1e-4 && seq > 0 && pause_at == 0 &&
+        std::fabs(x.q[0] - 0.05) < 0.05) {
+      CHECK(arflex_host_set_param(&traj, "run", 0, nullptr, kCall) == 0, "run=0");
+      pause_at = seq;
+    }
+    if (pause_at && !paused_checked) {
+      stable = same ? stable + 1 : 0;
+      if (stable >= 300) {  // 300 consecutive reads without motion while paused
+        paused_checked = true;
+        CHECK(arflex_host_set_param(&traj, "run", 1, nullptr, kCall) == 0, "run=1");
+      }
+    }
+    if (near[2] < 1e-9 && paused_checked) {
+      // at the last target; finished when it stays there
+      if (same && ++stable > 50) break;
+    }
+  }
+  CHECK(paused_checked, "the pause was never observed (pause_at %llu)", (unsigned long long)pause_at);
+  for (int k = 0; k < 3; ++k) CHECK(near[k] < 1e-4, "target %d missed by %g rad", k + 1, near[k]);
+  // Never jumps: on every pair of consecutive cycles, |dq_j| <= vmax_j * dt.
+  uint64_t pairs = 0;
+  double worst = 0;
+  for (size_t i = 1; i < s.size(); ++i) {
+    if (s[i].seq != s[i - 1].seq + 1) continue;
+    ++pairs;
+    for (int j = 0; j < 6; ++j)
+      worst = std::max(worst, std::fabs(s[i].q[j] - s[i - 1].q[j]) / (vmax[j] * 1e-3));
+  }
+  printf("trajectory: %zu samples, %llu consecutive pairs, max |dq| per cycle %.3f of vmax*dt\n",
+         s.size(), (unsigned long long)pairs, worst);
+  CHECK(pairs > 1000, "only %llu consecutive cycle pairs observed", (unsigned long long)pairs);
+  CHECK(worst <= 1.0 + 1e-9, "a joint moved %.4f x vmax*dt in one cycle", worst);
+  CHECK(arflex_host_stop(&traj, kCall) == 0, "stop");
+}
+
+
+// ---- force-guard ----------------------------------------------------------------------------
+
+std::vector<struct arflex_param_slot> GuardParams() {
+  return {PD("force_limit_n", 150, 1, 10000, true), PD("torque_limit_nm", 3000, 1, 100000, true),
+          PD("safe_power_fraction", 0.1, 0, 1, true), PB("reset", false, true),
+          PD("payload_kg", 0, 0, 500, true)};
+}
+
+// Writes a resting robot at q (torques = nominal gravity) plus extra joint torque, and a
+// wrench = tool weight + extra contact force (world frame, what a push adds).
+void WriteRobot(struct arflex_host* script, const Model& m, const Q& q, const Q& extra_tau,
+                const Eigen::Vector3d& push_world, uint64_t* seq) {
+  struct arflex_joint_state js;
+  memset(&js, 0, sizeof(js));
+  js.t_ns = (int64_t)Now();
+  js.seq = ++*seq;
+  const Q tau = m.GravityTorque(q, 0) + extra_tau;
+  for (int j = 0; j < 6; ++j) {
+    js.q[j] = q[j];
+    js.tau[j] = tau[j];
+  }
+  struct arflex_wrench w;
+  memset(&w, 0, sizeof(w));
+  w.t_ns = js.t_ns;
+  w.seq = js.seq;
+  Eigen::Vector3d f0, t0;
+  m.ToolWeightWrench(q, 0, &f0, &t0);
+  // The arm pushes back against a push on the tool: sensor force = weight - R^T push.
+  const Eigen::Vector3d f = f0 - m.Flange(q).linear().transpose() * push_world;
+  for (int k = 0; k < 3; ++k) {
+    w.force[k] = f[k];
+    w.torque[k] = t0[k];
+  }
+  arflex_state_write(arflex_host_output(script, "joint_state"), &js, sizeof(js));
+  arflex_state_write(arflex_host_output(script, "wrench"), &w, sizeof(w));
+}
+
+// Waits for the next guard output; returns false at the deadline.
+bool NextSafety(Reader* rd, struct arflex_safety_state* s, uint64_t* seq, uint64_t deadline) {
+  while (Now() < deadline) {
+    if (rd->Read(s, seq) == 1) return true;
+    sched_yield();
+  }
+  return false;
+}
+
+// Scripts a push and checks that the guard's first PROTECTIVE_STOP output is at most two
+// outputs after the guard's output counter observed right after the push was written (one
+// output may come from a cycle that had read its inputs just before the write: that is the
+// "same cycle" allowance; the next one must have seen it). Repeats when the reader missed
+// outputs and so cannot decide. Returns the cycles from the push to the stop, or -1.
+int PushAndCount(struct arflex_host* script, Reader* rd, const Model& m, const Q& q,
+                 const Q& extra_tau, const Eigen::Vector3d& push, uint64_t* wseq) {
+  struct arflex_safety_state s;
+  uint64_t seq;
+  WriteRobot(script, m, q, extra_tau, push, wseq);
+  const uint64_t h0 = rd->Head();
+  uint64_t last = 0;
+  bool gap = false;
+  while (NextSafety(rd, &s, &seq, Now() + 5 * kSec)) {
+    if (last && seq != last + 1 && seq <= h0 + 2) gap = true;
+    last = seq;
+    if (s.mode == ARFLEX_SAFETY_STATE_MODE_PROTECTIVE_STOP) {
+      if (seq <= h0 + 2) return (int)(seq - h0);
+      return gap ? -2 : -1;
+    }
+    if (seq > h0 + 2 && !gap) return -1;
+  }
+  return -1;
+}
+
+void CaseForceGuard() {
+  static struct arflex_host script, guard, traj;
+  Model m;
+  uint64_t wseq = 0;
+  int r = Make(&script, "script", kMs, {{"joint_state", kJsT}, {"wrench", kWT}}, {}, nullptr);
+  CHECK(r == 0, "script: %d", r);
+  // A slower guard period (20 ms) lets the test see each of its outputs.
+  r = Make(&guard, "guard", 20 * kMs, {{"safety", kST}}, GuardParams(), "force-guard");
+  CHECK(r == 0, "guard: %d", r);
+  r = Make(&traj, "trajectory", kMs, {{"joint_ref", kRefT}}, TrajectoryParams(), "trajectory");
+  CHECK(r == 0, "trajectory: %d", r);
+  CHECK(SetI(&traj, "loop", 1) == 0, "loop");
+  Q q;
+  q << 0.1, 0.2, 0.5, 0.1, 0.6, 0.2;
+  WriteRobot(&script, m, q, Q::Zero(), Eigen::Vector3d::Zero(), &wseq);
+  CHECK(arflex_host_bind(&guard, "joint_state", arflex_host_output_name(&script, "joint_state"), kCall) == 0, "bind js");
+  CHECK(arflex_host_bind(&guard, "wrench", arflex_host_output_name(&script, "wrench"), kCall) == 0, "bind wrench");
+  CHECK(arflex_host_bind(&traj, "safety", arflex_host_output_name(&guard, "safety"), kCall) == 0, "bind safety");
+  Reader rd, tr;
+  CHECK(rd.Open(&guard, "safety", &kST) == 0 && tr.Open(&traj, "joint_ref", &kRefT) == 0, "readers");
+  CHECK(arflex_host_start(&guard, kCall) == 0 && arflex_host_start(&traj, kCall) == 0, "start");
+
+  struct arflex_safety_state s;
+  uint64_t seq;
+  // Rest with a 100 N push (below the 150 N limit): NORMAL for 10 outputs.
+  WriteRobot(&script, m, q, Q::Zero(), Eigen::Vector3d(0, 100, 0), &wseq);
+  for (int i = 0; i < 10; ++i) {
+    CHECK(NextSafety(&rd, &s, &seq, Now() + 5 * kSec), "no guard output");
+    if (i < 2) continue;  // outputs of cycles before the write
+    CHECK(s.mode == ARFLEX_SAFETY_STATE_MODE_NORMAL, "mode %u at rest (force %.1f N)", s.mode, s.force_norm);
+    CHECK(std::fabs(s.force_norm - 100) < 1e-6, "contact force %.6f N, expected 100", s.force_norm);
+  }
+  // The trajectory moves while NORMAL.
+  struct arflex_joint_ref ref0, ref1;
+  uint64_t tseq;
+  const uint64_t dl = Now() + kWait;
+  while (tr.Read(&ref0, &tseq) != 1 && Now() < dl) sched_yield();
+  bool moved = false;
+  while (!moved && Now() < dl) {
+    if (tr.Read(&ref1, &tseq) == 1) moved = std::fabs(ref1.q[1] - ref0.q[1]) > 1e-3;
+  }
+  CHECK(moved, "trajectory does not move in NORMAL mode");
+
+  // 1. A 300 N push: protective stop in the same or the next cycle.
+  int cycles = -2;
+  for (int attempt = 0; attempt < 5 && cycles == -2; ++attempt) {
+    cycles = PushAndCount(&script, &rd, m, q, Q::Zero(), Eigen::Vector3d(300, 0, 0), &wseq);
+    if (cycles == -2) {  // undecidable (missed outputs): reset and try again
+      WriteRobot(&script, m, q, Q::Zero(), Eigen::Vector3d::Zero(), &wseq);
+      CHECK(arflex_host_reset(&guard, kCall) == 0, "reset for retry");
+      do {
+        CHECK(NextSafety(&rd, &s, &seq, Now() + 5 * kSec), "no output");
+      } while (s.mode != ARFLEX_SAFETY_STATE_MODE_NORMAL);
+    }
+  }
+  CHECK(cycles >= 1 && cycles <= 2, "protective stop %d outputs after the push (want 1..2)", cycles);
+  printf("force-guard: push -> protective stop in output +%d of the guard's cycle counter\n", cycles);
+  // 2. Stays stopped after the push is gone, with the reasons and the power fraction.
+  WriteRobot(&script, m, q, Q::Zero(), Eigen::Vector3d::Zero(), &wseq);
+  for (int i = 0; i < 15; ++i) {
+    CHECK(NextSafety(&rd, &s, &seq, Now() + 5 * kSec), "no output");
+    CHECK(s.mode == ARFLEX_SAFETY_STATE_MODE_PROTECTIVE_STOP, "left safe mode without reset");
+    CHECK((s.flags & ARFLEX_SAFETY_STATE_FLAG_FORCE_LIMIT) && (s.flags & ARFLEX_SAFETY_STATE_FLAG_RESET_REQUIRED),
+          "flags 0x%x", s.flags);
+    CHECK(std::fabs(s.power_scale - 0.1) < 1e-12, "power %g", s.power_scale);
+  }
+  // 3. The trajectory stopped: after its stop time its reference no longer changes, over
+  //    500 of its own cycles.
+  {
+    uint64_t first = 0, still = 0;
+    const uint64_t d2 = Now() + kWait;
+    struct arflex_joint_ref a, b;
+    bool have = false;
+    while (Now() < d2 && still < 500) {
+      if (tr.Read(&b, &tseq) != 1) continue;
+      if (!first) first = tseq;
+      if (tseq < first + 400) continue;  // 0.4 s: the stop ramp (stop_time 0.3 s) is over
+      if (have && memcmp(a.q, b.q, sizeof(a.q)) != 0) {
+        CHECK(false, "trajectory moved during the protective stop (seq %llu)", (unsigned long long)tseq);
+      }
+      if (!have) {
+        a = b;
+        have = true;
+        still = tseq;
+      }
+      if (tseq - still >= 500) break;
+    }
+    CHECK(have, "no trajectory output during the stop");
+  }
+  // 4. Operator reset by the parameter edge: NORMAL again.
+  CHECK(arflex_host_set_param(&guard, "reset", 1, nullptr, kCall) == 0, "reset=1");
+  bool normal = false;
+  for (int i = 0; i < 20 && !normal; ++i) {
+    CHECK(NextSafety(&rd, &s, &seq, Now() + 5 * kSec), "no output");
+    normal = s.mode == ARFLEX_SAFETY_STATE_MODE_NORMAL;
+  }
+  CHECK(normal, "reset parameter edge did not leave safe mode");
+  CHECK(arflex_host_set_param(&guard, "reset", 0, nullptr, kCall) == 0, "reset=0");
+  // 5. An external joint torque (4 kN m on joint 2) trips it too; the RESET command clears it.
+  cycles = PushAndCount(&script, &rd, m, q, (Q() << 0, 4000, 0, 0, 0, 0).finished(),
+                        Eigen::Vector3d::Zero(), &wseq);
+  CHECK(cycles >= 1 && cycles <= 2, "torque trip %d outputs after (want 1..2)", cycles);
+  WriteRobot(&script, m, q, Q::Zero(), Eigen::Vector3d::Zero(), &wseq);
+  for (int i = 0; i < 5; ++i) {
+    CHECK(NextSafety(&rd, &s, &seq, Now() + 5 * kSec), "no output");
+    CHECK(s.mode == ARFLEX_SAFETY_STATE_MODE_PROTECTIVE_STOP, "left safe mode without reset");
+  }
+  CHECK(arflex_host_reset(&guard, kCall) == 0, "RESET command");
+  normal = false;
+  for (int i = 0; i < 20 && !normal; ++i) {
+    CHECK(NextSafety(&rd, &s, &seq, Now() + 5 * kSec), "no output");
+    normal = s.mode == ARFLEX_SAFETY_STATE_MODE_NORMAL;
+  }
+  CHECK(normal, "RESET command did not leave safe mode");
+  CHECK(arflex_host_stop(&traj, kCall) == 0 && arflex_host_stop(&guard, kCall) == 0, "stop");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 3) {
+    fprintf(stderr, "usage: %s <trajectory|force_guard|teach_replay|tools> <bin dir>\n", argv[0]);
+    return 2;
+  }
+  bindir = argv[2];
+  snprintf(rid, sizeof(rid), "cell-%d", (int)getpid());
+  const std::string c = argv[1];
+  if (c == "trajectory") CaseTrajectory();
+  else if (c == "force_guard") CaseForceGuard();
+  else {
+    fprintf(stderr, "unknown case '%s'\n", argv[1]);
+    return 2;
+  }
+  DestroyAll();
+  if (Leaked()) ++failures;
+  if (failures) return 1;
+  printf("ok %s\n", argv[1]);
+  return 0;
+}
