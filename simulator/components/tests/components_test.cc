@@ -410,8 +410,52 @@ TEST_F(SimComponents, RobotScriptedPushShowsInWrenchAndTorques) {
   Shutdown(&robot_);
 }
 
+TEST_F(SimComponents, RobotPayloadObstacleAndHandGuideParameters) {
+  CreateRobot(1 * kMs, 1, true);
+  arflex_port wr_port, truth_port;
+  OpenReader(&robot_, "wrench", ARFLEX_PORT_STATE, &kWrenchType, &wr_port);
+  OpenReader(&robot_, "truth", ARFLEX_PORT_STATE, &kTruthType, &truth_port);
+  ASSERT_EQ(arflex_host_start(&robot_, kCall), 0);
+  arflex_wrench wr{};
+  arflex_sim_ground_truth g{};
+  bool hw = false, hg = false;
+  auto force = [&] {
+    return std::sqrt(wr.force[0] * wr.force[0] + wr.force[1] * wr.force[1] +
+                     wr.force[2] * wr.force[2]);
+  };
+  // Payload: the wrist carries tool (25 kg) + payload once the arm has settled.
+  SetF(&robot_, "payload_kg", 100);
+  ASSERT_TRUE(WaitFor([&] {
+    return Latest(&wr_port, &wr, &hw) && std::fabs(force() - 125.0 * 9.81) < 0.02 * 125 * 9.81;
+  }));
+  // Obstacle: a box placed at the tool centre point touches the arm.
+  ASSERT_TRUE(WaitFor([&] { return Latest(&truth_port, &g, &hg); }));
+  EXPECT_EQ(g.obstacle_contacts, 0u);
+  SetF(&robot_, "obstacle_x", g.p[0]);
+  SetF(&robot_, "obstacle_y", g.p[1]);
+  SetF(&robot_, "obstacle_z", g.p[2]);
+  ASSERT_EQ(arflex_host_set_param(&robot_, "obstacle_enable", 1, nullptr, kCall), 0);
+  ASSERT_TRUE(WaitFor([&] { return Latest(&truth_port, &g, &hg) && g.obstacle_contacts > 0; }));
+  ASSERT_EQ(arflex_host_set_param(&robot_, "obstacle_enable", 0, nullptr, kCall), 0);
+  ASSERT_TRUE(WaitFor([&] { return Latest(&truth_port, &g, &hg) && g.obstacle_contacts == 0; }));
+  // Hand guiding: a hand pulls the TCP along +y, saturated at 150 N.
+  SetF(&robot_, "guide_force_n", 150);
+  ASSERT_TRUE(WaitFor([&] {
+    return Latest(&truth_port, &g, &hg) &&
+           std::sqrt(g.ext_force[0] * g.ext_force[0] + g.ext_force[1] * g.ext_force[1] +
+                     g.ext_force[2] * g.ext_force[2]) > 100.0;
+  }));
+  EXPECT_GT(g.ext_force[1], 0.0) << "pulling towards +y";
+  SetF(&robot_, "guide_force_n", 0);
+  ASSERT_TRUE(WaitFor([&] { return Latest(&truth_port, &g, &hg) && g.ext_force[1] == 0.0; }));
+  EXPECT_EQ(arflex_host_stop(&robot_, kCall), 0);
+  arflex_port_close(&wr_port);
+  arflex_port_close(&truth_port);
+  Shutdown(&robot_);
+}
+
 TEST_F(SimComponents, RobotSafeHookHoldsPosition) {
-  CreateRobot(1 * kMs, 1, true, 300 * kMs);
+  CreateRobot(1 * kMs, 1, true, 1000 * kMs);
   CreateReference();
   arflex_port js_port, truth_port;
   OpenReader(&robot_, "joint_state", ARFLEX_PORT_STATE, &kJointStateType, &js_port);
@@ -478,9 +522,8 @@ class TagDetector {
     apriltag_detector_destroy(det_);
     tag36h11_destroy(family_);
   }
-  std::set<int> Detect(const uint8_t* gray, int w, int h, int stride) {
-    std::vector<uint8_t> copy(gray, gray + static_cast<size_t>(stride) * h);
-    image_u8_t im = {w, h, stride, copy.data()};
+  std::set<int> Detect(uint8_t* gray, int w, int h, int stride) {
+    image_u8_t im = {w, h, stride, gray};
     zarray_t* dets = apriltag_detector_detect(det_, &im);
     std::set<int> ids;
     for (int i = 0; i < zarray_size(dets); ++i) {
@@ -520,10 +563,10 @@ TEST_F(SimComponents, CameraRendersArmFromJointStateAndTagsAreFound) {
     if (hdr.width == 800 && hdr.height == 600 && hdr.format == ARFLEX_IMAGE_FRAME_FORMAT_GRAY8 &&
         v.length == ARFLEX_TYPE_IMAGE_FRAME_SIZE + hdr.bytes) {
       const uint8_t* px = static_cast<const uint8_t*>(v.data) + ARFLEX_TYPE_IMAGE_FRAME_SIZE;
-      std::set<int> got = detector.Detect(px, 800, 600, static_cast<int>(hdr.stride));
-      if (arflex_frame_valid(&v)) {
+      std::vector<uint8_t> copy(px, px + hdr.bytes);
+      if (arflex_frame_valid(&v)) {  // not overwritten while copied
         ++frames_seen;
-        ids = got;
+        ids = detector.Detect(copy.data(), 800, 600, static_cast<int>(hdr.stride));
       }
     }
     return frames_seen >= 2;
