@@ -107,7 +107,7 @@ public final class Admission {
     }
 
     /** The outcome of testing one task on one CPU. */
-    private record Fit(boolean ok, String reason, Map<Entry, Long> newR, Map<Entry, Long> newDemand) {
+    private record Fit(boolean ok, String reason, Map<Entry, Long> newR) {
     }
 
     private static long ceilDiv(long a, long b) {
@@ -201,37 +201,33 @@ public final class Admission {
             double u = util + t.utilisation();
             if (u > cap + 1e-9) {
                 return new Fit(false, "cpu " + id + ": utilisation " + Text.util(u) + " with '" + t.name()
-                        + "' exceeds cap " + Text.util(cap), Map.of(), Map.of());
+                        + "' exceeds cap " + Text.util(cap), Map.of());
             }
             if (rmOkWith(t) && hyper * (t.utilisation() + 1) <= 2 + 1e-12) {
-                return new Fit(true, null, Map.of(), Map.of());
+                return new Fit(true, null, Map.of());
             }
             List<Schedulability.Task> all = null;
             Map<Entry, Long> newR = new HashMap<>();
-            Map<Entry, Long> newDemand = new HashMap<>();
-            // The new task first, then the tasks it can delay (lower or equal priority), most
-            // urgent first, so the first miss reported is the most telling one.
+            // Only tasks whose processor demand in their deadline window exceeds the deadline
+            // need exact analysis: the new task, and those it delays (lower or equal priority).
             Entry fresh = new Entry(t);
             long d0 = t.wcetNs();
+            List<Entry> tight = new ArrayList<>();
             for (Entry e : tasks) {
                 if (e.task.priority() >= t.priority()) {
                     d0 += ceilDiv(t.deadlineNs(), e.task.periodNs()) * e.task.wcetNs();
                 }
-            }
-            newDemand.put(fresh, d0);
-            List<Entry> affected = new ArrayList<>();
-            for (Entry e : tasks) {
-                if (e.task.priority() <= t.priority()) {
-                    affected.add(e);
-                    newDemand.put(e, e.demand + ceilDiv(e.task.deadlineNs(), t.periodNs()) * t.wcetNs());
+                if (e.task.priority() <= t.priority()
+                        && e.demand + ceilDiv(e.task.deadlineNs(), t.periodNs()) * t.wcetNs() > e.task.deadlineNs()) {
+                    tight.add(e);
                 }
             }
-            affected.sort(Comparator.comparingInt((Entry e) -> -e.task.priority()).thenComparing(e -> e.task.name()));
-            affected.add(0, fresh);
-            for (Entry e : affected) {
-                if (newDemand.get(e) <= e.task.deadlineNs()) {
-                    continue; // demand within the deadline: R <= D without iterating
-                }
+            // Most urgent first, so the first miss reported is the most telling one.
+            tight.sort(Comparator.comparingInt((Entry e) -> -e.task.priority()).thenComparing(e -> e.task.name()));
+            if (d0 > t.deadlineNs()) {
+                tight.add(0, fresh);
+            }
+            for (Entry e : tight) {
                 if (all == null) {
                     all = taskList(t);
                 }
@@ -243,11 +239,11 @@ public final class Admission {
                     String who = e == fresh ? rt + " of '" + t.name() + "'"
                             : "adding '" + t.name() + "' gives " + rt + " of '" + e.task.name() + "', which";
                     return new Fit(false, "cpu " + id + ": " + who + " exceeds deadline "
-                            + Text.duration(e.task.deadlineNs()) + " (U=" + Text.util(u) + ")", Map.of(), Map.of());
+                            + Text.duration(e.task.deadlineNs()) + " (U=" + Text.util(u) + ")", Map.of());
                 }
                 newR.put(e, r);
             }
-            return new Fit(true, null, newR, newDemand);
+            return new Fit(true, null, newR);
         }
 
         String testName() {
@@ -315,8 +311,14 @@ public final class Admission {
                 if (c == null) {
                     continue;
                 }
-                PortSpec in = c.port(w.inPort()).orElse(null);
-                if (in != null && !in.optional()) {
+                PortSpec in = null;
+                for (PortSpec ps : c.ports()) {
+                    if (ps.name().equals(w.inPort())) {
+                        in = ps;
+                        break;
+                    }
+                }
+                if (in != null && in.direction() == PortSpec.Direction.IN && !in.optional()) {
                     requiredIn.computeIfAbsent(w.consumer(), k -> new ArrayList<>()).add(w);
                 }
             }
@@ -332,16 +334,20 @@ public final class Admission {
             }
         }
 
+        final Map<String, Set<String>> providerCache = new HashMap<>();
+
         Set<String> providersOf(String n) {
             List<Wire> ws = requiredIn.get(n);
             if (ws == null) {
                 return Set.of();
             }
-            Set<String> s = new TreeSet<>();
-            for (Wire w : ws) {
-                s.add(w.provider());
-            }
-            return s;
+            return providerCache.computeIfAbsent(n, k -> {
+                Set<String> s = new TreeSet<>();
+                for (Wire w : ws) {
+                    s.add(w.provider());
+                }
+                return s;
+            });
         }
 
         AdmissionResult run() {
@@ -566,14 +572,28 @@ public final class Admission {
             List<CpuLoad> loads = new ArrayList<>();
             for (Cpu cpu : cpus.values()) {
                 String test = cpu.testName();
-                List<Schedulability.Task> all = cpu.taskList(null);
                 boolean rta = test.equals("response-time analysis");
                 List<Entry> sorted = new ArrayList<>(cpu.tasks);
                 sorted.sort(Comparator.comparingInt((Entry e) -> -e.task.priority()).thenComparing(e -> e.task.name()));
                 List<String> names = new ArrayList<>();
+                List<Schedulability.Task> ordered = new ArrayList<>(sorted.size());
                 for (Entry e : sorted) {
+                    ordered.add(e.task);
+                }
+                // Exact response times for display; each task only against the tasks of higher or
+                // equal priority (a prefix of the sorted list plus its equals).
+                int k = 0;
+                for (int i = 0; i < sorted.size(); i++) {
+                    Entry e = sorted.get(i);
                     names.add(e.task.name());
-                    e.r = rta ? Schedulability.responseTime(e.task, all, Math.max(e.r, e.task.wcetNs())) : -1;
+                    if (!rta) {
+                        e.r = -1;
+                        continue;
+                    }
+                    while (k < sorted.size() && sorted.get(k).task.priority() >= e.task.priority()) {
+                        k++;
+                    }
+                    e.r = Schedulability.responseTime(e.task, ordered.subList(0, k), Math.max(e.r, e.task.wcetNs()));
                 }
                 loads.add(new CpuLoad(cpu.id, cpu.cap, cpu.util, names, test));
             }

@@ -24,16 +24,19 @@ final class Graphs {
      * {@code providers} gives (edges to names outside {@code nodes} are ignored). Each component
      * is sorted; the list is in no particular order.
      */
+    @SuppressWarnings("unchecked")
     static List<List<String>> sccs(Collection<String> nodes, Function<String, ? extends Collection<String>> providers) {
         // Iterative Tarjan. Nodes and edges are visited in sorted order for determinism.
-        TreeSet<String> all = new TreeSet<>(nodes);
+        Set<String> all = nodes instanceof Set<?> ? (Set<String>) nodes : new java.util.HashSet<>(nodes);
+        List<String> roots = new ArrayList<>(nodes);
+        Collections.sort(roots);
         Map<String, Integer> index = new HashMap<>();
         Map<String, Integer> low = new HashMap<>();
         ArrayDeque<String> stack = new ArrayDeque<>();
         Set<String> onStack = new java.util.HashSet<>();
         List<List<String>> out = new ArrayList<>();
         int counter = 0;
-        for (String root : all) {
+        for (String root : roots) {
             if (index.containsKey(root)) {
                 continue;
             }
@@ -89,11 +92,14 @@ final class Graphs {
         if (ps == null || ps.isEmpty()) {
             return List.of();
         }
-        List<String> s = new ArrayList<>();
-        for (String p : new TreeSet<>(ps)) {
+        List<String> s = new ArrayList<>(ps.size());
+        for (String p : ps) {
             if (all.contains(p)) {
                 s.add(p);
             }
+        }
+        if (s.size() > 1 && !(ps instanceof java.util.SortedSet<?>)) {
+            Collections.sort(s);
         }
         return s;
     }

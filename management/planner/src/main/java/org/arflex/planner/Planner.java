@@ -314,7 +314,7 @@ public final class Planner {
                 prevCpu.put(e.getKey(), e.getValue());
             }
         }
-        AdmissionResult adm = Admission.admit(candContracts, resolver.wires(), newCaps, newMeasured, prevCpu, active);
+        AdmissionResult adm = Admission.admit(candContracts, resolver.wiresUnsorted(), newCaps, newMeasured, prevCpu, active);
         TreeSet<String> target = new TreeSet<>(adm.admitted());
         inactive.putAll(adm.refused());
         for (String n : resolver.names()) {

@@ -462,7 +462,14 @@ public final class Resolver {
         }
     }
 
+    /** Bumped by every change; the cycle cache is valid for one version. */
+    private long version;
+    private long sccVersion = -1;
+    private final Map<String, Integer> sccOf = new HashMap<>();
+    private final Map<Integer, Integer> sccSize = new HashMap<>();
+
     private ResolveDelta finish(Change ch) {
+        version++;
         // Local status of every dirty node (its wires may have changed).
         List<Node> dirty = new ArrayList<>();
         for (String d : ch.dirty) {
@@ -586,6 +593,19 @@ public final class Resolver {
     /** True when a component of that name is installed. */
     public boolean contains(String name) {
         return nodes.containsKey(name);
+    }
+
+    /** Every wire, in no particular order (for callers that sort or index themselves). */
+    List<Wire> wiresUnsorted() {
+        List<Wire> out = new ArrayList<>();
+        for (Node n : nodes.values()) {
+            for (In in : n.inputs) {
+                if (in.wire != null) {
+                    out.add(in.wire);
+                }
+            }
+        }
+        return out;
     }
 
     /** Every wire, sorted (whether or not its ends are satisfied). */
@@ -792,6 +812,23 @@ public final class Resolver {
      * consumer), starting and ending at n; empty when n is on no cycle.
      */
     private List<String> cycleThrough(Node n) {
+        if (sccVersion != version) {
+            sccOf.clear();
+            sccSize.clear();
+            int id = 0;
+            for (List<String> comp : Graphs.sccs(nodes.keySet(), this::requiredProviders)) {
+                for (String m : comp) {
+                    sccOf.put(m, id);
+                }
+                sccSize.put(id, comp.size());
+                id++;
+            }
+            sccVersion = version;
+        }
+        int mine = sccOf.get(n.name());
+        if (sccSize.get(mine) == 1 && !requiredProviders(n.name()).contains(n.name())) {
+            return List.of();
+        }
         Map<String, String> parent = new HashMap<>();
         ArrayDeque<String> q = new ArrayDeque<>();
         q.add(n.name());
@@ -811,7 +848,7 @@ public final class Resolver {
                     path.add(n.name());
                     return path;
                 }
-                if (!parent.containsKey(d)) {
+                if (!parent.containsKey(d) && sccOf.get(d) == mine) {
                     parent.put(d, cur);
                     q.add(d);
                 }

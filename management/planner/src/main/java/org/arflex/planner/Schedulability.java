@@ -147,7 +147,7 @@ public final class Schedulability {
         while (true) {
             long next = task.wcetNs();
             for (Task o : others) {
-                if (o == task || o.priority() < task.priority() || o.equals(task)) {
+                if (o == task || o.priority() < task.priority() || (o.name().equals(task.name()) && o.equals(task))) {
                     continue;
                 }
                 long releases = (r + o.periodNs() - 1) / o.periodNs();
