@@ -500,6 +500,127 @@ void CaseForceGuard() {
   CHECK(arflex_host_stop(&traj, kCall) == 0 && arflex_host_stop(&guard, kCall) == 0, "stop");
 }
 
+// ---- teach + replay -------------------------------------------------------------------------
+
+void CaseTeachReplay() {
+  static struct arflex_host script, teach, traj;
+  Model m;
+  const std::string dir = MakeDataDir();
+  CHECK(!dir.empty(), "mkdtemp");
+  std::string env = "ARFLEX_DATA_DIR=" + dir;
+  char* envp[] = {const_cast<char*>(env.c_str()), nullptr};
+  int r = Make(&script, "script", kMs, {{"joint_state", kJsT}, {"wrench", kWT}}, {}, nullptr);
+  CHECK(r == 0, "script: %d", r);
+  r = Make(&teach, "teach", kMs, {{"joint_ref", kRefT}},
+           {PB("teach", false, true), PD("mass", 20, 0.1, 1000, true),
+            PD("damping", 400, 1, 100000, true), PD("deadband_n", 5, 0, 1000, true),
+            PD("max_speed", 0.25, 0.001, 2, true), PD("payload_kg", 0, 0, 500, true),
+            PD("record_step", 0.005, 1e-5, 1, true), PB("save", false, true),
+            PI("save_slot", 1, 1, 99, true)},
+           "teach", envp);
+  if (r != 0) RemoveDir(dir);
+  CHECK(r == 0, "teach: %d", r);
+  Q q;
+  q << 0, 0.2, 0.5, 0, 0.6, 0;
+  uint64_t wseq = 0;
+  WriteRobot(&script, m, q, Q::Zero(), Eigen::Vector3d::Zero(), &wseq);
+  bool ok = arflex_host_bind(&teach, "joint_state", arflex_host_output_name(&script, "joint_state"), kCall) == 0 &&
+            arflex_host_bind(&teach, "wrench", arflex_host_output_name(&script, "wrench"), kCall) == 0 &&
+            SetI(&teach, "save_slot", 3) == 0 && arflex_host_start(&teach, kCall) == 0 &&
+            arflex_host_set_param(&teach, "teach", 1, nullptr, kCall) == 0;
+  if (!ok) RemoveDir(dir);
+  CHECK(ok, "bind/start teach");
+  Reader tr;
+  CHECK(tr.Open(&teach, "joint_ref", &kRefT) == 0, "open teach ref");
+  // The test plays a perfect robot: the measured position is teach's reference; the hand
+  // pulls 60 N along +y for 1500 of teach's cycles, then along -z for 1000, then lets go.
+  std::vector<Q> taught;
+  uint64_t first = 0, seq = 0;
+  const uint64_t dl = Now() + kWait;
+  struct arflex_joint_ref ref;
+  while (Now() < dl) {
+    if (tr.Read(&ref, &seq) != 1) {
+      sched_yield();
+      continue;
+    }
+    if (!first) first = seq;
+    const uint64_t k = seq - first;
+    Q qr;
+    for (int j = 0; j < 6; ++j) qr[j] = ref.q[j];
+    taught.push_back(qr);
+    Eigen::Vector3d hand = Eigen::Vector3d::Zero();
+    if (k < 1500) hand = Eigen::Vector3d(0, 60, 0);
+    else if (k < 2500) hand = Eigen::Vector3d(0, 0, -60);
+    else if (k > 3000) break;
+    WriteRobot(&script, m, qr, Q::Zero(), hand, &wseq);
+  }
+  const Eigen::Vector3d p0 = m.Tcp(q).translation(), p1 = m.Tcp(taught.back()).translation();
+  printf("teach: TCP moved by (%.4f, %.4f, %.4f) m\n", p1.x() - p0.x(), p1.y() - p0.y(), p1.z() - p0.z());
+  ok = p1.y() - p0.y() > 0.1 && p0.z() - p1.z() > 0.05 && std::fabs(p1.x() - p0.x()) < 0.01;
+  if (!ok) RemoveDir(dir);
+  CHECK(ok, "the arm did not follow the hand");
+  // Leave teach mode, save.
+  const std::string path = arflex::cellkin::ProgramPath(dir, 3);
+  ok = arflex_host_set_param(&teach, "teach", 0, nullptr, kCall) == 0 &&
+       arflex_host_set_param(&teach, "save", 1, nullptr, kCall) == 0;
+  struct stat st;
+  const uint64_t d2 = Now() + 10 * kSec;
+  while (ok && stat(path.c_str(), &st) != 0 && Now() < d2) sched_yield();
+  arflex::cellkin::Program prog;
+  std::string err;
+  ok = ok && arflex::cellkin::LoadProgramFile(path, m, &prog, &err);
+  if (!ok) RemoveDir(dir);
+  CHECK(ok, "saved program %s: %s", path.c_str(), err.c_str());
+  printf("teach: %zu waypoints saved\n", prog.motions.size() + 1);
+  // Recording faithful: every waypoint lies on the taught path (samples the test saw).
+  std::vector<Q> wps{prog.start};
+  for (const auto& mo : prog.motions) {
+    Q w;
+    for (int j = 0; j < 6; ++j) w[j] = mo.v[j];
+    wps.push_back(w);
+  }
+  double worst_rec = 0;
+  for (const Q& w : wps) {
+    double best = 1e9;
+    for (const Q& t : taught) best = std::min(best, (t - w).cwiseAbs().maxCoeff());
+    worst_rec = std::max(worst_rec, best);
+  }
+  // Replay: trajectory with the saved program, no joint_state bound: starts at `start`.
+  r = Make(&traj, "trajectory", kMs, {{"joint_ref", kRefT}}, TrajectoryParams(), "trajectory", envp);
+  RemoveDir(dir);
+  CHECK(worst_rec < 0.006, "a waypoint is %.5f rad from the taught path", worst_rec);
+  CHECK(r == 0, "trajectory: %d", r);
+  CHECK(SetI(&traj, "program", 3) == 0 && arflex_host_start(&traj, kCall) == 0, "start replay");
+  Reader rr;
+  CHECK(rr.Open(&traj, "joint_ref", &kRefT) == 0, "open replay");
+  std::vector<double> best(wps.size(), 1e9);
+  const uint64_t d3 = Now() + kWait;
+  uint64_t still = 0;
+  Q last = Q::Constant(1e9);
+  while (Now() < d3) {
+    if (rr.Read(&ref, &seq) != 1) {
+      sched_yield();
+      continue;
+    }
+    Q qr;
+    for (int j = 0; j < 6; ++j) qr[j] = ref.q[j];
+    for (size_t i = 0; i < wps.size(); ++i)
+      best[i] = std::min(best[i], (qr - wps[i]).cwiseAbs().maxCoeff());
+    still = (qr - last).norm() == 0 ? still + 1 : 0;
+    last = qr;
+    if (best.back() < 1e-9 && still > 100) break;
+  }
+  double worst = 0;
+  for (double b : best) worst = std::max(worst, b);
+  const double tcp_err = (m.Tcp(last).translation() - p1).norm();
+  printf("replay: passes within %.2e rad of every waypoint; final TCP %.2e m from the taught one\n",
+         worst, tcp_err);
+  // Stated tolerance: every recorded waypoint within 0.2 mrad, the end within 1 um.
+  CHECK(worst < 2e-4, "replay missed a waypoint by %g rad", worst);
+  CHECK(tcp_err < 1e-6, "replay ends %g m from the taught end", tcp_err);
+  CHECK(arflex_host_stop(&traj, kCall) == 0 && arflex_host_stop(&teach, kCall) == 0, "stop");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -512,6 +633,7 @@ int main(int argc, char** argv) {
   const std::string c = argv[1];
   if (c == "trajectory") CaseTrajectory();
   else if (c == "force_guard") CaseForceGuard();
+  else if (c == "teach_replay") CaseTeachReplay();
   else {
     fprintf(stderr, "unknown case '%s'\n", argv[1]);
     return 2;

@@ -1,0 +1,272 @@
+// teach - RT half of the teach component (README.md): in teach mode the arm yields to a
+// guiding hand (Cartesian admittance M a + D v = F_ext on the TCP position, orientation held,
+// the tool's weight compensated with the nominal model) and the path is recorded; a rising
+// edge of `save` writes it as a program file that trajectory replays.
+//
+// Ports: in joint_state (arflex.JointState), in wrench (arflex.Wrench), out joint_ref
+// (arflex.JointRef). Recording: a preallocated buffer of kMaxPoints joint waypoints, a new one
+// whenever the reference moved more than record_step (rad, any joint) from the last one. The
+// file is written by a non-RT writer thread woken with sem_post (async-signal-safe, never
+// blocks) to $ARFLEX_DATA_DIR/program-<save_slot>.arp, atomically (temporary file + rename).
+#include <pthread.h>
+#include <semaphore.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+#include "arflex/component.h"
+#include "arflex_types/joint_ref.h"
+#include "arflex_types/joint_state.h"
+#include "arflex_types/wrench.h"
+#include "cellkin.h"
+
+namespace {
+
+using arflex::cellkin::Q;
+constexpr size_t kMaxPoints = 20000;
+
+struct State {
+  arflex::cellkin::Model model;
+  struct arflex_port* out = nullptr;
+  struct arflex_input* in_js = nullptr;
+  struct arflex_input* in_w = nullptr;
+  int p_teach, p_mass, p_damping, p_deadband, p_max_speed, p_payload, p_step, p_save, p_slot;
+  struct arflex_joint_state js{};
+  struct arflex_wrench w{};
+  bool have_js = false, have_w = false, initialized = false;
+  bool teach_prev = false, save_prev = false;
+  Q q_ref = Q::Zero();
+  Eigen::Vector3d x = Eigen::Vector3d::Zero(), v = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d r_hold = Eigen::Matrix3d::Identity();
+  uint64_t seq = 0;
+  // recording (RT thread writes points and count; the writer reads under `saving`)
+  Q* points = nullptr;
+  size_t count = 0;
+  std::atomic<bool> saving{false};
+  std::atomic<size_t> save_count{0};
+  std::atomic<long> save_slot{0};
+  std::atomic<bool> quit{false};
+  std::atomic<uint64_t> saved{0}, save_errors{0}, dropped{0};
+  sem_t sem;
+  pthread_t writer;
+  bool writer_started = false;
+  std::string dir;
+} g;
+
+void* Writer(void*) {
+  for (;;) {
+    while (sem_wait(&g.sem) != 0 && errno == EINTR) {
+    }
+    if (g.quit.load()) return nullptr;
+    const size_t n = g.save_count.load();
+    arflex::cellkin::Program p;
+    p.origin = "teach (" + std::to_string(n) + " recorded waypoints)";
+    if (n > 0) {
+      p.has_start = true;
+      p.start = g.points[0];
+    }
+    for (size_t i = 1; i < n; ++i) {
+      arflex::cellkin::Motion m{};
+      m.kind = arflex::cellkin::Motion::kPtp;
+      for (int j = 0; j < 6; ++j) m.v[j] = g.points[i][j];
+      m.speed = 1.0;
+      p.motions.push_back(m);
+    }
+    std::string err;
+    if (g.dir.empty()) {
+      fprintf(stderr, "teach: cannot save: ARFLEX_DATA_DIR is not set\n");
+      g.save_errors++;
+    } else if (n < 2) {
+      fprintf(stderr, "teach: nothing to save (%zu waypoint(s) recorded)\n", n);
+      g.save_errors++;
+    } else if (!arflex::cellkin::WriteProgramFile(
+                   arflex::cellkin::ProgramPath(g.dir, g.save_slot.load()), p, &err)) {
+      fprintf(stderr, "teach: save failed: %s\n", err.c_str());
+      g.save_errors++;
+    } else {
+      fprintf(stderr, "teach: saved %zu waypoints to %s\n", n,
+              arflex::cellkin::ProgramPath(g.dir, g.save_slot.load()).c_str());
+      g.saved++;
+    }
+    g.saving.store(false, std::memory_order_release);
+  }
+}
+
+int Configure(struct arflex_component* c, void*) {
+  static const struct arflex_port_type js_t = {ARFLEX_TYPE_JOINT_STATE_NAME, 1, 0,
+                                               sizeof(struct arflex_joint_state)};
+  static const struct arflex_port_type w_t = {ARFLEX_TYPE_WRENCH_NAME, 1, 0,
+                                              sizeof(struct arflex_wrench)};
+  static const struct arflex_port_type ref_t = {ARFLEX_TYPE_JOINT_REF_NAME, 1, 0,
+                                                sizeof(struct arflex_joint_ref)};
+  int r = arflex_component_output(c, "joint_ref", ARFLEX_PORT_STATE, &ref_t, &g.out);
+  if (r < 0) {
+    fprintf(stderr, "teach: output joint_ref: %s\n", strerror(-r));
+    return r;
+  }
+  if ((r = arflex_component_input(c, "joint_state", ARFLEX_PORT_STATE, &js_t, &g.in_js)) < 0 ||
+      (r = arflex_component_input(c, "wrench", ARFLEX_PORT_STATE, &w_t, &g.in_w)) < 0)
+    return r;
+  const char* names[] = {"teach", "mass", "damping", "deadband_n", "max_speed",
+                         "payload_kg", "record_step", "save", "save_slot"};
+  int* idx[] = {&g.p_teach, &g.p_mass, &g.p_damping, &g.p_deadband, &g.p_max_speed,
+                &g.p_payload, &g.p_step, &g.p_save, &g.p_slot};
+  for (int i = 0; i < 9; ++i) {
+    *idx[i] = arflex_component_param(c, names[i]);
+    if (*idx[i] < 0) {
+      fprintf(stderr, "teach: parameter '%s' missing from the control block\n", names[i]);
+      return -ENOENT;
+    }
+  }
+  const char* dir = getenv("ARFLEX_DATA_DIR");
+  g.dir = dir ? dir : "";
+  if (g.dir.empty())
+    fprintf(stderr, "teach: ARFLEX_DATA_DIR is not set: teaching works, saving will fail\n");
+  g.points = new (std::nothrow) Q[kMaxPoints];
+  if (!g.points) return -ENOMEM;
+  if (sem_init(&g.sem, 0, 0) != 0) {
+    delete[] g.points;
+    return -errno;
+  }
+  r = pthread_create(&g.writer, nullptr, Writer, nullptr);
+  if (r != 0) {
+    sem_destroy(&g.sem);
+    delete[] g.points;
+    return -r;
+  }
+  g.writer_started = true;
+  return 0;
+}
+
+void Cleanup(struct arflex_component*, void*) {
+  if (g.writer_started) {
+    // wait for a save in progress, then stop the writer
+    g.quit.store(true);
+    sem_post(&g.sem);
+    pthread_join(g.writer, nullptr);
+  }
+  sem_destroy(&g.sem);
+  delete[] g.points;
+  g.points = nullptr;
+}
+
+int Start(struct arflex_component* c, void*) {
+  g.have_js = g.have_w = false;
+  g.teach_prev = false;
+  g.save_prev = arflex_param_bool(c, g.p_save);
+  g.v.setZero();
+  return 0;
+}
+
+void Record(struct arflex_component* c, bool force) {
+  if (g.saving.load(std::memory_order_acquire)) return;  // the writer is reading the buffer
+  if (g.count > 0 && !force) {
+    const double d = (g.q_ref - g.points[g.count - 1]).cwiseAbs().maxCoeff();
+    if (d < arflex_param_f64(c, g.p_step)) return;
+  }
+  if (g.count > 0 && force && (g.q_ref - g.points[g.count - 1]).cwiseAbs().maxCoeff() == 0) return;
+  if (g.count >= kMaxPoints) {
+    g.dropped++;
+    return;
+  }
+  g.points[g.count++] = g.q_ref;
+}
+
+int Update(struct arflex_component* c, void*, uint64_t release_ns) {
+  if (arflex_input_state_read(g.in_js, &g.js, sizeof(g.js), nullptr) == 1) g.have_js = true;
+  if (arflex_input_state_read(g.in_w, &g.w, sizeof(g.w), nullptr) == 1) g.have_w = true;
+  if (!g.initialized) {
+    if (!g.have_js) return 0;  // nothing is commanded before the arm's position is known
+    for (int j = 0; j < 6; ++j) g.q_ref[j] = g.js.q[j];
+    g.initialized = true;
+  }
+  const double dt = arflex_component_ctl(c)->config.period_ns * 1e-9;
+  const bool teach = arflex_param_bool(c, g.p_teach);
+  if (teach && !g.teach_prev) {
+    // Teach mode begins: a new recording from here, holding the orientation.
+    const Eigen::Isometry3d t = g.model.Tcp(g.q_ref);
+    g.x = t.translation();
+    g.r_hold = t.linear();
+    g.v.setZero();
+    if (!g.saving.load(std::memory_order_acquire)) g.count = 0;
+    Record(c, true);
+  }
+  if (!teach && g.teach_prev) Record(c, true);  // the end point
+  g.teach_prev = teach;
+
+  if (teach) {
+    Eigen::Vector3d f_hand = Eigen::Vector3d::Zero();
+    if (g.have_w && g.have_js) {
+      Q qm;
+      for (int j = 0; j < 6; ++j) qm[j] = g.js.q[j];
+      Eigen::Vector3d f0, t0;
+      g.model.ToolWeightWrench(qm, arflex_param_f64(c, g.p_payload), &f0, &t0);
+      const Eigen::Vector3d f(g.w.force[0], g.w.force[1], g.w.force[2]);
+      // The sensor reads what the arm exerts on the tool: a hand force shows with the
+      // opposite sign, on top of the tool's weight.
+      f_hand = -(g.model.Flange(qm).linear() * (f - f0));
+      const double db = arflex_param_f64(c, g.p_deadband), n = f_hand.norm();
+      if (n > db)
+        f_hand *= 1.0 - db / n;
+      else
+        f_hand.setZero();
+    }
+    const double mass = arflex_param_f64(c, g.p_mass), damp = arflex_param_f64(c, g.p_damping);
+    const Eigen::Vector3d a = (f_hand - damp * g.v) / mass;
+    g.v += a * dt;
+    const double vmax = arflex_param_f64(c, g.p_max_speed), vn = g.v.norm();
+    if (vn > vmax) g.v *= vmax / vn;
+    const Eigen::Vector3d x_next = g.x + g.v * dt;
+    Eigen::Isometry3d target = Eigen::Isometry3d::Identity();
+    target.translation() = x_next;
+    target.linear() = g.r_hold;
+    Q q = g.q_ref;
+    const double err = g.model.Ik(target, &q, 3);
+    bool inside = q.allFinite() && err < 1e-4;
+    for (int j = 0; j < 6 && inside; ++j)
+      inside = q[j] > g.model.lower(j) && q[j] < g.model.upper(j);
+    if (inside) {
+      g.q_ref = q;
+      g.x = x_next;
+    } else {
+      g.v.setZero();  // at a joint limit or out of reach: the arm stops yielding that way
+    }
+    Record(c, false);
+  } else {
+    g.v.setZero();
+  }
+  const bool save = arflex_param_bool(c, g.p_save);
+  if (save && !g.save_prev && !g.saving.load(std::memory_order_acquire)) {
+    g.save_count.store(g.count);
+    g.save_slot.store((long)arflex_param_i64(c, g.p_slot));
+    g.saving.store(true, std::memory_order_release);
+    sem_post(&g.sem);
+  }
+  g.save_prev = save;
+
+  struct arflex_joint_ref ref;
+  ref.t_ns = (int64_t)release_ns;
+  ref.seq = ++g.seq;
+  for (int j = 0; j < 6; ++j) ref.q[j] = g.q_ref[j];
+  return arflex_state_write(g.out, &ref, sizeof(ref));
+}
+
+// rt-core safe mode: stop yielding, hold the reference.
+int Safe(struct arflex_component*, void*, enum arflex_safe_mode, bool) {
+  g.v.setZero();
+  return 0;
+}
+
+const struct arflex_component_ops kOps = {
+    "teach", nullptr, Configure, Start, Update, nullptr, Cleanup, Safe,
+};
+
+}  // namespace
+
+int main(int argc, char** argv) { return arflex_component_main(argc, argv, &kOps); }
