@@ -621,6 +621,49 @@ void CaseTeachReplay() {
   CHECK(arflex_host_stop(&traj, kCall) == 0 && arflex_host_stop(&teach, kCall) == 0, "stop");
 }
 
+// ---- tools ----------------------------------------------------------------------------------
+
+// One tool provider after the other behind the same consumer code: the same port type, the
+// consumer's reader opens either; each follows the command from the same command segment.
+void CaseTools() {
+  static struct arflex_host script, grip, spin;
+  int r = Make(&script, "script", kMs, {{"command", kSampleT}}, {}, nullptr);
+  CHECK(r == 0, "script: %d", r);
+  struct arflex_sample cmd;
+  memset(&cmd, 0, sizeof(cmd));
+  cmd.seq = 1;
+  cmd.value = 0.4;
+  CHECK(arflex_state_write(arflex_host_output(&script, "command"), &cmd, sizeof(cmd)) == 0, "cmd");
+  struct arflex_host* tools[2] = {&grip, &spin};
+  const char* exes[2] = {"tool-gripper", "tool-spindle"};
+  const uint32_t ids[2] = {1, 2};
+  for (int i = 0; i < 2; ++i) {
+    r = Make(tools[i], exes[i] + 5, kMs, {{"tool", kToolT}},
+             {PD("command", 0, 0, 1, true), PD("rate", 2, 0.01, 100, true)}, exes[i]);
+    CHECK(r == 0, "%s: %d", exes[i], r);
+    CHECK(arflex_host_bind(tools[i], "command", arflex_host_output_name(&script, "command"), kCall) == 0, "bind");
+    CHECK(arflex_host_start(tools[i], kCall) == 0, "start");
+    Reader rd;  // the consumer: expects arflex.ToolState 1.0 from whoever provides `tool`
+    CHECK(rd.Open(tools[i], "tool", &kToolT) == 0, "%s: consumer cannot open its tool port", exes[i]);
+    struct arflex_tool_state s;
+    uint64_t seq;
+    bool ready = false;
+    const uint64_t dl = Now() + kWait;
+    while (!ready && Now() < dl) {
+      if (rd.Read(&s, &seq) != 1) {
+        sched_yield();
+        continue;
+      }
+      ready = s.status == ARFLEX_TOOL_STATE_STATUS_READY && std::fabs(s.command - 0.4) < 1e-12;
+    }
+    CHECK(ready, "%s never reached the commanded level", exes[i]);
+    CHECK(s.tool_id == ids[i] && s.mass > 0 && s.tcp_quat[0] == 1.0, "%s state", exes[i]);
+    printf("%s: tool_id %u, level %.2f, mass %.1f kg\n", exes[i], s.tool_id, s.command, s.mass);
+    CHECK(arflex_host_shutdown(tools[i], kCall) == 0 && arflex_host_wait_exit(tools[i], 5 * kSec) == 0,
+          "shutdown %s", exes[i]);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -634,6 +677,7 @@ int main(int argc, char** argv) {
   if (c == "trajectory") CaseTrajectory();
   else if (c == "force_guard") CaseForceGuard();
   else if (c == "teach_replay") CaseTeachReplay();
+  else if (c == "tools") CaseTools();
   else {
     fprintf(stderr, "unknown case '%s'\n", argv[1]);
     return 2;
