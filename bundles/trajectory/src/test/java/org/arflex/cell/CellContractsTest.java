@@ -1,0 +1,57 @@
+package org.arflex.cell;
+
+import static org.junit.jupiter.api.Assertions.assertEquals;
+import static org.junit.jupiter.api.Assertions.assertTrue;
+
+import java.nio.file.Files;
+import java.nio.file.Path;
+import java.util.List;
+import org.arflex.contract.Contract;
+import org.arflex.contract.ContractParser;
+import org.arflex.contract.PortSpec;
+import org.junit.jupiter.api.Test;
+
+/** The cell components' contracts (trajectory, force-guard, teach, tools) parse and validate. */
+class CellContractsTest {
+
+    private static final List<String> COMPONENTS =
+            List.of("trajectory", "force-guard", "teach", "tool-gripper", "tool-spindle");
+
+    private static Contract load(String name) throws Exception {
+        Path p = Path.of("..", name, "src/main/resources/OSGI-INF/arflex", name + ".xml");
+        return ContractParser.create().parse(Files.readString(p), p.toString());
+    }
+
+    @Test
+    void everyContractIsValid() throws Exception {
+        for (String n : COMPONENTS) {
+            Contract c = load(n);
+            assertEquals(n, c.name());
+            assertEquals(n, c.executable());
+        }
+    }
+
+    @Test
+    void toolsProvideTheSameToolPort() throws Exception {
+        PortSpec g = load("tool-gripper").port("tool").orElseThrow();
+        PortSpec s = load("tool-spindle").port("tool").orElseThrow();
+        assertEquals(PortSpec.Direction.OUT, g.direction());
+        assertEquals(g.direction(), s.direction());
+        assertEquals("arflex.ToolState", g.type());
+        assertEquals(g.type(), s.type());
+        assertEquals(g.typeVersion(), s.typeVersion());
+        assertEquals(g.method(), s.method());
+        assertEquals("tool", load("tool-gripper").attributes().get("role"));
+        assertEquals("tool", load("tool-spindle").attributes().get("role"));
+    }
+
+    @Test
+    void motionComponentsObeyTheSafetyPortTheGuardProvides() throws Exception {
+        PortSpec out = load("force-guard").port("safety").orElseThrow();
+        PortSpec in = load("trajectory").port("safety").orElseThrow();
+        assertEquals(out.type(), in.type());
+        assertEquals(out.method(), in.method());
+        assertTrue(in.optional());
+        assertTrue(load("trajectory").movesHardware());
+    }
+}
