@@ -55,6 +55,10 @@ class WebConsoleIT {
     @BeforeAll
     static void start() throws IOException {
         Path work = Path.of(System.getProperty("arflex.it.work", "target/it")).toAbsolutePath();
+        for (String exe : List.of("/usr/bin/chromium", "/usr/bin/chromedriver")) {
+            assertTrue(Files.isExecutable(Path.of(exe)), exe + " is missing: install the Debian packages chromium and"
+                    + " chromium-driver (scripts/setup.sh)");
+        }
         screenshots = Path.of(System.getProperty("arflex.screenshots", "target/screenshots")).toAbsolutePath();
         Files.createDirectories(screenshots);
         rt = new RuntimeUnderTest(work);
