@@ -391,8 +391,19 @@ public final class Admission {
                 eff[i] = e;
             }
             int[] pending = new int[g];
-            PriorityQueue<Integer> ready = new PriorityQueue<>(Comparator.comparingInt((Integer i) -> -eff[i])
-                    .thenComparing(i -> isRunning[i] ? 0 : 1).thenComparing(i -> groups.get(i).get(0)));
+            // Rank every group once by (effective criticality desc, running first, name); the
+            // queue then compares plain ints.
+            Integer[] byKey = new Integer[g];
+            for (int i = 0; i < g; i++) {
+                byKey[i] = i;
+            }
+            java.util.Arrays.sort(byKey, Comparator.comparingInt((Integer i) -> -eff[i])
+                    .thenComparingInt(i -> isRunning[i] ? 0 : 1).thenComparing(i -> groups.get(i).get(0)));
+            int[] rank = new int[g];
+            for (int k = 0; k < g; k++) {
+                rank[byKey[k]] = k;
+            }
+            PriorityQueue<Integer> ready = new PriorityQueue<>((x, y) -> Integer.compare(rank[x], rank[y]));
             for (int i = 0; i < g; i++) {
                 pending[i] = providersOfGroup.get(i).size();
                 if (pending[i] == 0) {

@@ -153,7 +153,16 @@ final class Graphs {
                 consumers.get(j).add(i);
             }
         }
-        PriorityQueue<Integer> ready = new PriorityQueue<>(Comparator.comparing(i -> comps.get(i).get(0)));
+        Integer[] byName = new Integer[comps.size()];
+        for (int i = 0; i < byName.length; i++) {
+            byName[i] = i;
+        }
+        java.util.Arrays.sort(byName, Comparator.comparing(i -> comps.get(i).get(0)));
+        int[] rank = new int[comps.size()];
+        for (int k = 0; k < byName.length; k++) {
+            rank[byName[k]] = k;
+        }
+        PriorityQueue<Integer> ready = new PriorityQueue<>((x, y) -> Integer.compare(rank[x], rank[y]));
         for (int i = 0; i < comps.size(); i++) {
             if (pending[i] == 0) {
                 ready.add(i);

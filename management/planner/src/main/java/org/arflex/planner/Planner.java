@@ -52,6 +52,8 @@ public final class Planner {
     private final TreeMap<String, String> blocked = new TreeMap<>();
     private final TreeMap<String, Long> measured = new TreeMap<>();
     private final TreeMap<String, Integer> cpuOf = new TreeMap<>();
+    /** Components admission refused at the last apply, with the reason (for START reasons). */
+    private final TreeMap<String, String> lastRefused = new TreeMap<>();
     private Capacities capacities;
 
     /** An empty cell with these capacities. */
@@ -242,6 +244,8 @@ public final class Planner {
                 measured.clear();
                 measured.putAll(newMeasured);
                 capacities = newCaps;
+                lastRefused.clear();
+                lastRefused.putAll(plan.admission().refused());
             }
             done = true;
             return plan;
@@ -356,6 +360,8 @@ public final class Planner {
                     why = "replaced " + replaced.get(n).version() + " -> " + resolver.contract(n).get().version();
                 } else if (change.unblocks().contains(n)) {
                     why = "unblocked";
+                } else if (lastRefused.containsKey(n)) {
+                    why = "admitted now (was refused: " + lastRefused.get(n) + ")";
                 } else {
                     List<String> ins = new ArrayList<>();
                     for (Wire w : newEff.get(n)) {
@@ -417,11 +423,11 @@ public final class Planner {
                 startGroups, active, target, inactive, wiring, adm, cycles, notes);
     }
 
-    private static Set<String> providers(List<Wire> ws) {
+    private static List<String> providers(List<Wire> ws) {
         if (ws == null) {
-            return Set.of();
+            return List.of();
         }
-        Set<String> s = new TreeSet<>();
+        List<String> s = new ArrayList<>(ws.size());
         for (Wire w : ws) {
             s.add(w.provider());
         }

@@ -169,6 +169,20 @@ class PlannerTest {
         p.apply(Change.capacities(Capacities.of(1, 1.0, 200 * MIB, 0)));
         Plan grow = p.apply(Change.capacities(Capacities.of(1, 1.0, 512 * MIB, 0)));
         assertEquals(List.of("camera", "logger", "vision"), grow.startOrder());
+        assertEquals("admitted now (was refused: memory: 150 MiB requested, 100 MiB free); cpu 0: hyperbolic bound holds (U=0.30)",
+                grow.action("camera").get().reason());
+    }
+
+    @Test
+    void losingACpuMovesItsTasks() {
+        Planner p = new Planner(Capacities.of(2, 0.9, 512 * MIB, 0));
+        p.apply(Change.install(C.of("a").timing(10, 10, 3, 5).build(), C.of("b").timing(10, 10, 2, 5).build()));
+        assertEquals(Map.of("a", 0, "b", 1), p.cpuAssignment());
+        Plan plan = p.apply(Change.capacities(Capacities.of(1, 0.9, 512 * MIB, 0)));
+        assertEquals(List.of(new Plan.Action(Plan.Op.RESTART, "b", "moved cpu 1 -> 0")), plan.actions());
+        assertEquals(Map.of("a", 0, "b", 0), p.cpuAssignment());
+        // Growing again does not move anything back: running components keep their CPU.
+        assertTrue(p.plan(Change.capacities(Capacities.of(2, 0.9, 512 * MIB, 0))).isEmpty());
     }
 
     @Test

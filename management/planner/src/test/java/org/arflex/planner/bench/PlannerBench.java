@@ -39,7 +39,8 @@ import org.arflex.planner.Resolver;
  * <p>Measures: full resolve (one batch), full admission, full plan ({@link Planner#apply} of
  * the install of everything) and incremental resolver changes (add a leaf consumer, remove it,
  * replace a middle component by a new version, remove a middle component and put it back),
- * plus an incremental {@link Planner#plan} of one install. Prints a table and writes JSON.
+ * plus an incremental {@link Planner#plan} of one install. Prints a table and writes JSON, with
+ * wall-clock and thread CPU times (the latter is what the code costs when the machine is shared).
  *
  * <p>Run: {@code mvn -q -o -pl management/planner exec:java -Dexec.classpathScope=test
  * -Dexec.mainClass=org.arflex.planner.bench.PlannerBench [-Dexec.args=out.json]}.
@@ -130,6 +131,13 @@ public final class PlannerBench {
         return Capacities.of(16, 0.9, (long) n * 4 << 20, (long) n * 10_000);
     }
 
+    private static final java.lang.management.ThreadMXBean THREADS = java.lang.management.ManagementFactory.getThreadMXBean();
+
+    /** Wall and thread CPU time of one measured call, ns. */
+    static long cpuNow() {
+        return THREADS.getCurrentThreadCpuTime();
+    }
+
     record Stats(double meanUs, double p50Us, double p99Us, double maxUs) {
         static Stats of(long[] ns) {
             long[] s = ns.clone();
@@ -154,7 +162,12 @@ public final class PlannerBench {
         for (int w = 0; w < 2; w++) {
             run(1_000, 3, 100, false);
         }
-        System.out.printf(Locale.ROOT, "%-7s %-28s %10s %10s %10s %10s%n", "n", "operation", "mean", "p50", "p99", "max");
+        double load = java.lang.management.ManagementFactory.getOperatingSystemMXBean().getSystemLoadAverage();
+        json.put("loadAverageAtStart", load);
+        System.out.printf(Locale.ROOT, "load average %.2f on %d cpus (wall times suffer from other load; cpu = thread CPU time)%n",
+                load, Runtime.getRuntime().availableProcessors());
+        System.out.printf(Locale.ROOT, "%-7s %-28s %10s %10s %10s %10s %10s%n", "n", "operation", "wall mean", "wall p50",
+                "wall p99", "cpu p50", "cpu p99");
         for (int n : sizes) {
             int fullReps = n >= 10_000 ? 5 : 10;
             rows.addAll(run(n, fullReps, 300, true));
@@ -165,106 +178,129 @@ public final class PlannerBench {
         System.out.println("wrote " + out.toAbsolutePath());
     }
 
+    /** Wall-clock and thread CPU times of repeated measurements. */
+    static final class Series {
+        final long[] wall;
+        final long[] cpu;
+        int i;
+        private long w0;
+        private long c0;
+
+        Series(int reps) {
+            wall = new long[reps];
+            cpu = new long[reps];
+        }
+
+        void start() {
+            c0 = cpuNow();
+            w0 = System.nanoTime();
+        }
+
+        void stop() {
+            wall[i] = System.nanoTime() - w0;
+            cpu[i] = cpuNow() - c0;
+            i++;
+        }
+
+        static Series sum(Series a, Series b) {
+            Series s = new Series(a.wall.length);
+            for (int k = 0; k < a.wall.length; k++) {
+                s.wall[k] = a.wall[k] + b.wall[k];
+                s.cpu[k] = a.cpu[k] + b.cpu[k];
+            }
+            s.i = a.wall.length;
+            return s;
+        }
+    }
+
     static List<Map<String, Object>> run(int n, int fullReps, int incReps, boolean print) {
         List<Contract> cs = graph(n, 7);
         Capacities caps = caps(n);
         List<Map<String, Object>> rows = new ArrayList<>();
-        long[] resolve = new long[fullReps];
-        long[] admit = new long[fullReps];
-        long[] plan = new long[fullReps];
+        Series resolve = new Series(fullReps);
+        Series admit = new Series(fullReps);
+        Series plan = new Series(fullReps);
         Resolver r = null;
         AdmissionResult adm = null;
         for (int k = 0; k < fullReps; k++) {
-            long t0 = System.nanoTime();
+            resolve.start();
             r = new Resolver();
             r.apply(cs, List.of());
-            long t1 = System.nanoTime();
+            resolve.stop();
+            admit.start();
             adm = Admission.admit(r, caps, Map.of());
-            long t2 = System.nanoTime();
-            resolve[k] = t1 - t0;
-            admit[k] = t2 - t1;
-            long t3 = System.nanoTime();
+            admit.stop();
+            plan.start();
             Planner p = new Planner(caps);
             p.apply(Change.install(cs.toArray(new Contract[0])));
-            plan[k] = System.nanoTime() - t3;
+            plan.stop();
         }
-        long[] full = new long[fullReps];
-        for (int k = 0; k < fullReps; k++) {
-            full[k] = resolve[k] + admit[k];
-        }
-        int satisfied = r.satisfied().size();
-        int admitted = adm.admitted().size();
-        rows.add(row(n, "full resolve", Stats.of(resolve), Map.of("satisfied", satisfied, "wires", r.wires().size())));
-        rows.add(row(n, "full admission", Stats.of(admit), Map.of("admitted", admitted,
+        rows.add(row(n, "full resolve", resolve, Map.of("satisfied", r.satisfied().size(), "wires", r.wires().size())));
+        rows.add(row(n, "full admission", admit, Map.of("admitted", adm.admitted().size(),
                 "rtaCpus", adm.cpus().stream().filter(c -> c.test().startsWith("response")).count())));
-        rows.add(row(n, "full resolve+admit", Stats.of(full), Map.of()));
-        rows.add(row(n, "full plan (Planner.apply)", Stats.of(plan), Map.of()));
+        rows.add(row(n, "full resolve+admit", Series.sum(resolve, admit), Map.of()));
+        rows.add(row(n, "full plan (Planner.apply)", plan, Map.of()));
 
         // Incremental resolver changes on the resolved cell.
         Random rnd = new Random(11);
-        long[] add = new long[incReps];
-        long[] remove = new long[incReps];
-        long[] replace = new long[incReps];
-        long[] removeMid = new long[incReps];
-        long[] putBack = new long[incReps];
+        Series add = new Series(incReps);
+        Series remove = new Series(incReps);
+        Series replace = new Series(incReps);
+        Series removeMid = new Series(incReps);
+        Series putBack = new Series(incReps);
         long touchedAdd = 0;
         long touchedReplace = 0;
         long touchedRemoveMid = 0;
         for (int k = 0; k < incReps; k++) {
-            int target = rnd.nextInt(n);
-            Contract leaf = leaf("leaf" + k, target);
-            long t0 = System.nanoTime();
+            Contract leaf = leaf("leaf" + k, rnd.nextInt(n));
+            add.start();
             ResolveDelta d = r.put(leaf);
-            long t1 = System.nanoTime();
-            r.remove(leaf.name());
-            long t2 = System.nanoTime();
-            add[k] = t1 - t0;
-            remove[k] = t2 - t1;
+            add.stop();
             touchedAdd += d.touched();
+            remove.start();
+            r.remove(leaf.name());
+            remove.stop();
             int mid = rnd.nextInt(n);
             Contract old = r.contract("c" + mid).get();
             Contract bumped = new Contract(old.name(), "1.0." + (k + 1), old.description(), old.executable(),
                     old.taskType(), old.movesHardware(), old.attributes(), old.ports(), old.properties(), old.timing(),
                     old.resources(), old.criticality(), old.fault(), old.update(), old.source());
-            long t3 = System.nanoTime();
+            replace.start();
             d = r.put(bumped);
-            long t4 = System.nanoTime();
-            replace[k] = t4 - t3;
+            replace.stop();
             touchedReplace += d.touched();
-            long t5 = System.nanoTime();
+            removeMid.start();
             d = r.remove(bumped.name());
-            long t6 = System.nanoTime();
-            r.put(old);
-            long t7 = System.nanoTime();
-            removeMid[k] = t6 - t5;
-            putBack[k] = t7 - t6;
+            removeMid.stop();
             touchedRemoveMid += d.touched();
+            putBack.start();
+            r.put(old);
+            putBack.stop();
         }
-        rows.add(row(n, "add one (leaf)", Stats.of(add), Map.of("meanTouched", touchedAdd / (double) incReps)));
-        rows.add(row(n, "remove one (leaf)", Stats.of(remove), Map.of()));
-        rows.add(row(n, "replace one (middle)", Stats.of(replace),
-                Map.of("meanTouched", touchedReplace / (double) incReps)));
-        rows.add(row(n, "remove one (middle)", Stats.of(removeMid),
+        rows.add(row(n, "add one (leaf)", add, Map.of("meanTouched", touchedAdd / (double) incReps)));
+        rows.add(row(n, "remove one (leaf)", remove, Map.of()));
+        rows.add(row(n, "replace one (middle)", replace, Map.of("meanTouched", touchedReplace / (double) incReps)));
+        rows.add(row(n, "remove one (middle)", removeMid,
                 Map.of("meanTouched", touchedRemoveMid / (double) incReps)));
-        rows.add(row(n, "put it back (middle)", Stats.of(putBack), Map.of()));
+        rows.add(row(n, "put it back (middle)", putBack, Map.of()));
 
-        // A whole incremental plan (dry run of one install): resolver change + admission of all.
+        // A whole plan of one change (dry run): resolver change, admission of all, plan, undo.
         Planner p = new Planner(caps);
         p.apply(Change.install(cs.toArray(new Contract[0])));
         int planReps = n >= 10_000 ? 20 : 100;
-        long[] planOne = new long[planReps];
+        Series planOne = new Series(planReps);
         for (int k = 0; k < planReps; k++) {
             Contract leaf = leaf("leaf" + k, rnd.nextInt(n));
-            long t0 = System.nanoTime();
+            planOne.start();
             p.plan(Change.install(leaf));
-            planOne[k] = System.nanoTime() - t0;
+            planOne.stop();
         }
-        rows.add(row(n, "plan one install (dry run)", Stats.of(planOne), Map.of()));
+        rows.add(row(n, "plan one install (dry run)", planOne, Map.of()));
         if (print) {
             for (Map<String, Object> row : rows) {
-                System.out.printf(Locale.ROOT, "%-7d %-28s %10s %10s %10s %10s%n", n, row.get("operation"),
+                System.out.printf(Locale.ROOT, "%-7d %-28s %10s %10s %10s %10s %10s%n", n, row.get("operation"),
                         fmt((double) row.get("meanUs")), fmt((double) row.get("p50Us")), fmt((double) row.get("p99Us")),
-                        fmt((double) row.get("maxUs")));
+                        fmt((double) row.get("cpuP50Us")), fmt((double) row.get("cpuP99Us")));
             }
         }
         return rows;
@@ -284,14 +320,20 @@ public final class PlannerBench {
         return us >= 1000 ? String.format(Locale.ROOT, "%.1f ms", us / 1000) : String.format(Locale.ROOT, "%.1f us", us);
     }
 
-    static Map<String, Object> row(int n, String op, Stats s, Map<String, Object> extra) {
+    static Map<String, Object> row(int n, String op, Series series, Map<String, Object> extra) {
+        Stats s = Stats.of(series.wall);
+        Stats c = Stats.of(series.cpu);
         Map<String, Object> m = new LinkedHashMap<>();
         m.put("n", n);
         m.put("operation", op);
+        m.put("reps", series.wall.length);
         m.put("meanUs", s.meanUs());
         m.put("p50Us", s.p50Us());
         m.put("p99Us", s.p99Us());
         m.put("maxUs", s.maxUs());
+        m.put("cpuMeanUs", c.meanUs());
+        m.put("cpuP50Us", c.p50Us());
+        m.put("cpuP99Us", c.p99Us());
         m.putAll(new java.util.TreeMap<>(extra));
         return m;
     }
