@@ -121,10 +121,11 @@ class CellIT {
             // intensity 3 in 10 s: the 4th crash inside the window is one too many
             for (int k = 0; k < 4; k++) {
                 long pid = rt.pid("sample-counter");
-                ProcessHandle.of(pid).orElseThrow().destroyForcibly();
+                ProcessHandle ph = ProcessHandle.of(pid).orElseThrow(
+                        () -> new AssertionError("pid " + pid + " of ACTIVE sample-counter is gone\n" + rt.tail()));
+                ph.destroyForcibly();
                 if (k < 3) {
-                    rt.waitUntil("sample-counter back after crash " + (k + 1), T, () -> "ACTIVE".equals(rt.state("sample-counter"))
-                            && rt.pid("sample-counter") != pid);
+                    rt.waitUntil("sample-counter back after crash " + (k + 1), T, () -> rt.activeWithNewPid("sample-counter", pid));
                 }
             }
             rt.awaitState("FAILED", T, "sample-counter");

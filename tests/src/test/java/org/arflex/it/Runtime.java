@@ -191,6 +191,16 @@ final class Runtime implements AutoCloseable {
         return i == null ? null : (String) i.get("state");
     }
 
+    /** One snapshot: the instance is ACTIVE with a running process other than {@code oldPid}. */
+    boolean activeWithNewPid(String name, long oldPid) {
+        Map<String, Object> i = instance(name);
+        if (i == null || !"ACTIVE".equals(i.get("state"))) {
+            return false;
+        }
+        long pid = ((Number) i.get("pid")).longValue();
+        return pid != 0 && pid != oldPid;
+    }
+
     long pid(String name) {
         return ((Number) instance(name).get("pid")).longValue();
     }

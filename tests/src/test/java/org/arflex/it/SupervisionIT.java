@@ -24,7 +24,7 @@ class SupervisionIT {
             long pid = rt.pid("sample-counter");
             signal(pid, "STOP"); // alive but silent: only the heartbeat can tell
             rt.waitUntil("sample-counter restarted after the hang", CellIT.T,
-                    () -> "ACTIVE".equals(rt.state("sample-counter")) && rt.pid("sample-counter") != pid);
+                    () -> rt.activeWithNewPid("sample-counter", pid));
             assertTrue(rt.logContains("hung: no RT heartbeat"), rt.tail());
             assertEquals(1L, ((Number) rt.instance("sample-counter").get("restarts")).longValue());
         }
@@ -78,7 +78,7 @@ class SupervisionIT {
             long pid = rt.pid("sample-scaler");
             assertEquals("", rt.cmd("felix:update " + id));
             rt.waitUntil("sample-scaler back after Felix's update", CellIT.T,
-                    () -> "ACTIVE".equals(rt.state("sample-scaler")) && rt.pid("sample-scaler") != pid);
+                    () -> rt.activeWithNewPid("sample-scaler", pid));
             assertNotEquals(0L, rt.pid("sample-scaler"));
             CellIT.assertDataFlows(rt, 2.0);
         }
