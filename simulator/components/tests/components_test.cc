@@ -359,6 +359,31 @@ TEST_F(SimComponents, RobotLockStepPeriodsEqualPhysicsSteps) {
   Shutdown(&robot_);
 }
 
+TEST_F(SimComponents, RobotWithoutItsOutputSegmentFailsCleanly) {
+  // A manager that did not create the wrench segment: configure fails (exit code 4, state
+  // FAILED, the error in the control block), and destroying the instance leaves nothing.
+  std::vector<arflex_param_slot> params = RobotParams(1);
+  std::vector<struct arflex_host_output> outs = {
+      {"joint_state", {ARFLEX_PORT_STATE, kJointStateType, 1, ARFLEX_OVERFLOW_NONE}},
+  };
+  arflex_host_opts o{};
+  o.runtime = rid_;
+  o.instance = "robot";
+  o.config = Config(1 * kMs, true);
+  o.params = params.data();
+  o.nparams = static_cast<unsigned>(params.size());
+  o.outputs = outs.data();
+  o.noutputs = 1;
+  robot_used_ = true;
+  ASSERT_EQ(arflex_host_create(&robot_, &o), 0);
+  ASSERT_EQ(arflex_host_spawn(&robot_, SIM_ROBOT_EXE, nullptr, nullptr), 0);
+  ASSERT_EQ(arflex_host_wait_exit(&robot_, 60 * kSec), 0);
+  const int st = arflex_host_exit_status(&robot_);
+  EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == ARFLEX_EXIT_CONFIGURE) << "wait status " << st;
+  EXPECT_EQ(arflex_ctl_state(robot_.ctl), static_cast<uint32_t>(ARFLEX_STATE_FAILED));
+  EXPECT_EQ(robot_.ctl->exit_status, -ENOENT);
+}
+
 TEST_F(SimComponents, RobotScriptedPushShowsInWrenchAndTorques) {
   CreateRobot(1 * kMs, 1, true);
   arflex_port wr_port, js_port, truth_port;
@@ -547,9 +572,18 @@ TEST_F(SimComponents, CameraRendersArmFromJointStateAndTagsAreFound) {
   OpenReader(&camera_, "frames", ARFLEX_PORT_FRAME, &kFrameType, &frames);
   OpenReader(&robot_, "joint_state", ARFLEX_PORT_STATE, &kJointStateType, &js_port);
   ASSERT_EQ(arflex_host_start(&robot_, kCall), 0);
+  // Unbound: the camera runs but shows nothing (no frame without a joint state).
+  ASSERT_EQ(arflex_host_start(&camera_, kCall), 0);
+  arflex_stats cst;
+  ASSERT_TRUE(WaitFor([&] {
+    return arflex_ctl_stats_read(camera_.ctl, &cst) == 0 && cst.cycles >= 3;
+  }));
+  {
+    arflex_frame_view v;
+    EXPECT_EQ(arflex_frame_acquire(&frames, &v), 0) << "a frame without a joint state";
+  }
   ASSERT_EQ(arflex_host_bind(&camera_, "joint_state",
                              arflex_host_output_name(&robot_, "joint_state"), kCall), 0);
-  ASSERT_EQ(arflex_host_start(&camera_, kCall), 0);
 
   // Collect a few frames; each must carry the time of a joint state the robot published.
   TagDetector detector;
