@@ -1,0 +1,578 @@
+// arflex-accuracy-bench: the vision-corrected accuracy study of issue 7 on the simulated cell.
+//
+// For a fixed set of target tool poses across the work space: the NOMINAL model's inverse
+// kinematics gives the joint reference; the TRUE arm (geometry errors, compliance) moves
+// there under its own servo and settles; the cameras are rendered, the tool tags detected
+// (ROI around the prediction from the joint state) and the TCP estimated by the multi-view
+// least-squares fit; the outer loop adds gain * J_nominal^+ (desired - measured) to the servo
+// reference (size and rate limited, held when vision drops out) until it converges. Reported
+// per pose: the static absolute TCP error against the simulator's ground truth with the
+// correction off and on, the settling time; per run: mean/max, frames and poses per second,
+// frame-to-correction latency. Runs: payload 0/100/210 kg, one and two cameras blocked, and
+// the nominal (uncalibrated) tool offset. Prints tables, writes JSON.
+//
+// Usage: arflex-accuracy-bench [--json FILE] [--width W --height H] [--poses N]
+//                              [--noise SIGMA] [--blur SIGMA] [--period-ms P] [--quick]
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "arflex_sim/cell.h"
+#include "arflex_sim/render.h"
+#include "arflex_tcpcorr/correction.h"
+#include "arflex_vision/detector.h"
+#include "arflex_vision/estimator.h"
+#include "arflex_vision/geometry.h"
+
+namespace {
+
+using arflex::sim::Cell;
+using arflex::sim::CellConfig;
+using arflex::sim::JointVector;
+using arflex::sim::Renderer;
+using arflex::tcpcorr::CorrectionLaw;
+using arflex::tcpcorr::CorrectionOptions;
+using arflex::tcpcorr::Matrix6d;
+using arflex::tcpcorr::Vector6d;
+namespace vision = arflex::vision;
+using Clock = std::chrono::steady_clock;
+
+double Ms(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+struct Args {
+  std::string json = "arflex-accuracy-bench.json";
+  int width = 1280;
+  int height = 1024;
+  int poses = 24;
+  double noise = 2.0;
+  double blur = 0.0;
+  int period_ms = 100;
+  bool quick = false;
+};
+
+Eigen::Vector3d V(const arflex::sim::Vec3& v) { return Eigen::Vector3d(v[0], v[1], v[2]); }
+
+Eigen::Isometry3d TagPose(const arflex::sim::TagSpec& t) {
+  Eigen::Isometry3d p = Eigen::Isometry3d::Identity();
+  p.linear() = Eigen::Quaterniond(t.quat[0], t.quat[1], t.quat[2], t.quat[3]).toRotationMatrix();
+  p.translation() = V(t.pos);
+  // The tag is printed on the top face of a 1 mm thick box.
+  p.translate(Eigen::Vector3d(0, 0, 0.0005));
+  return p;
+}
+
+// The fixed target set: a grid over the work space in front of the robot, the tool pitched
+// down by 35 or 55 degrees towards the work area, some rolled about the tool axis.
+std::vector<Eigen::Isometry3d> Targets(int n) {
+  std::vector<Eigen::Vector3d> pts;
+  for (double z : {0.5, 1.0}) {
+    for (double x : {1.5, 1.9, 2.3}) {
+      for (double y : {-0.6, 0.0, 0.6}) pts.emplace_back(x, y, z);
+    }
+  }
+  for (const Eigen::Vector3d& p : {Eigen::Vector3d(1.7, 0.3, 0.75), Eigen::Vector3d(1.7, -0.3, 0.75),
+                                   Eigen::Vector3d(2.1, 0.3, 0.75), Eigen::Vector3d(2.1, -0.3, 0.75),
+                                   Eigen::Vector3d(1.3, 0.0, 0.8), Eigen::Vector3d(2.5, 0.0, 0.6)}) {
+    pts.push_back(p);
+  }
+  std::vector<Eigen::Isometry3d> out;
+  for (int i = 0; i < static_cast<int>(pts.size()) && i < n; ++i) {
+    const Eigen::Vector3d& p = pts[i];
+    const double yaw = std::atan2(p.y(), p.x());
+    const double pitch = (i % 2 == 0 ? 35.0 : 55.0) * M_PI / 180.0;
+    const double roll = (i % 3 == 0 ? 0.0 : (i % 3 == 1 ? 0.3 : -0.3));
+    Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+    t.linear() = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+                  Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+                  Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+                     .toRotationMatrix();
+    t.translation() = p;
+    out.push_back(t);
+  }
+  return out;
+}
+
+// Damped least-squares inverse kinematics on the NOMINAL model. Returns false if it does not
+// converge to 1e-9 m / 1e-9 rad within the iteration budget or leaves the joint limits.
+bool NominalIk(const Cell& cell, const Eigen::Isometry3d& target, JointVector* q) {
+  const auto& kin = cell.nominal();
+  for (int it = 0; it < 500; ++it) {
+    const Vector6d e = arflex::tcpcorr::PoseError(target, kin.Tcp(*q));
+    if (e.head<3>().norm() < 1e-9 && e.tail<3>().norm() < 1e-9) {
+      for (int i = 0; i < 6; ++i) {
+        const auto& l = cell.config().arm.links[i];
+        if ((*q)[i] < l.lower || (*q)[i] > l.upper) return false;
+      }
+      return true;
+    }
+    const Matrix6d j = kin.TcpJacobian(*q);
+    const Vector6d dq = arflex::tcpcorr::DampedSolve(j, e, 1e-3);
+    const double s = std::min(1.0, 0.2 / std::max(1e-12, dq.cwiseAbs().maxCoeff()));
+    for (int i = 0; i < 6; ++i) (*q)[i] += s * dq(i);
+  }
+  return false;
+}
+
+struct Stats {
+  std::vector<double> v;
+  void Add(double x) { v.push_back(x); }
+  double Mean() const {
+    double s = 0;
+    for (double x : v) s += x;
+    return v.empty() ? 0 : s / v.size();
+  }
+  double Max() const { return v.empty() ? 0 : *std::max_element(v.begin(), v.end()); }
+};
+
+struct PoseRow {
+  int index;
+  double off_mm, on_mm, off_rot_mdeg, on_rot_mdeg, vision_err_mm, settle_s;
+  int iterations, views, holds;
+  bool converged;
+};
+
+struct RunResult {
+  std::string name;
+  double payload;
+  std::vector<int> cameras;
+  bool tool_calibrated;
+  std::vector<PoseRow> rows;
+  Stats off, on, settle, vision_err;
+  Stats detect_roi_ms, detect_full_ms, render_ms, estimate_ms, latency_ms, roi_fraction;
+  double calib_trans_mm_max = 0, calib_rot_mdeg_max = 0, calib_rms_px_max = 0;
+  long frames = 0, estimates = 0, invalid = 0;
+};
+
+class Bench {
+ public:
+  Bench(const Args& args) : args_(args) {}
+
+  bool Run(const std::string& name, double payload, const std::vector<int>& cams,
+           bool tool_calibrated, RunResult* out);
+
+ private:
+  // Renders the active cameras at the current state, detects (ROI around the prediction if
+  // `use_roi`) and estimates the TCP. Accumulates timing into `r`.
+  vision::PoseEstimate Measure(bool use_roi, RunResult* r);
+
+  const Args& args_;
+  std::unique_ptr<Cell> cell_;
+  std::unique_ptr<Renderer> renderer_;
+  std::unique_ptr<vision::TagDetector> detector_;
+  std::vector<vision::Camera> cameras_;
+  std::vector<int> active_;
+  std::vector<vision::TagModel> board_, tool_;
+  Eigen::Isometry3d tcp_in_marker_ = Eigen::Isometry3d::Identity();
+  std::vector<uint8_t> rgb_;
+  vision::EstimatorOptions est_options_;
+};
+
+vision::PoseEstimate Bench::Measure(bool use_roi, RunResult* r) {
+  std::array<vision::Observation, vision::kMaxObservations> obs;
+  int nobs = 0;
+  std::array<vision::TagDetection, 16> dets;
+  JointVector q = cell_->ReadJointState().q;
+  const Eigen::Isometry3d predicted_marker = cell_->nominal().Flange(q);
+  renderer_->SetState(cell_->qpos());
+  double latency = 0;
+  for (int c : active_) {
+    arflex::sim::SensorEffects fx;
+    fx.noise_sigma = args_.noise;
+    fx.blur_sigma = args_.blur;
+    fx.seed = 1000003ull * (r->frames + 1) + c;
+    auto t0 = Clock::now();
+    renderer_->Render(c, rgb_.data(), &fx);
+    auto t1 = Clock::now();
+    r->render_ms.Add(Ms(t0, t1));
+    ++r->frames;
+    vision::FrameView frame{rgb_.data(), args_.width, args_.height, 3 * args_.width,
+                            vision::PixelFormat::kRgb8};
+    vision::Roi roi = vision::PredictRoi(cameras_[c], predicted_marker, tool_, 30.0);
+    int n;
+    if (use_roi) {
+      n = roi.empty() ? 0 : detector_->Detect(frame, &roi, 1, dets.data(), 16, nullptr);
+    } else {
+      n = detector_->Detect(frame, nullptr, 0, dets.data(), 16, nullptr);
+    }
+    auto t2 = Clock::now();
+    (use_roi ? r->detect_roi_ms : r->detect_full_ms).Add(Ms(t1, t2));
+    if (use_roi) r->roi_fraction.Add(static_cast<double>(roi.area()) / (args_.width * args_.height));
+    latency += Ms(t1, t2);
+    if (n > 0) vision::CollectObservations(c, dets.data(), n, tool_, obs.data(), &nobs);
+  }
+  auto t3 = Clock::now();
+  vision::PoseEstimate est =
+      vision::EstimateObjectPose(cameras_, tool_, obs.data(), nobs, &predicted_marker, est_options_);
+  est = vision::TransformEstimate(est, tcp_in_marker_);
+  auto t4 = Clock::now();
+  r->estimate_ms.Add(Ms(t3, t4));
+  r->latency_ms.Add(latency + Ms(t3, t4));
+  ++r->estimates;
+  if (!est.valid) ++r->invalid;
+  return est;
+}
+
+bool Bench::Run(const std::string& name, double payload, const std::vector<int>& cams,
+                bool tool_calibrated, RunResult* r) {
+  r->name = name;
+  r->payload = payload;
+  r->cameras = cams;
+  r->tool_calibrated = tool_calibrated;
+  CellConfig config = arflex::sim::DefaultCellConfig();
+  config.payload_mass = payload;
+  config.nominal_payload_mass = payload;  // the controller is told the payload
+  config.max_render_width = std::max(args_.width, 640);
+  config.max_render_height = std::max(args_.height, 480);
+  std::string error;
+  const JointVector home = {0.0, 0.3, 0.3, 0.0, 0.6, 0.0};
+  cell_ = Cell::Create(config, home, &error);
+  if (!cell_) {
+    std::fprintf(stderr, "accuracy-bench: cell: %s\n", error.c_str());
+    return false;
+  }
+  renderer_ = Renderer::Create(cell_->model(), args_.width, args_.height, &error);
+  if (!renderer_) {
+    std::fprintf(stderr, "accuracy-bench: renderer: %s\n", error.c_str());
+    return false;
+  }
+  vision::DetectorOptions dopt;
+  dopt.max_width = args_.width;
+  dopt.max_height = args_.height;
+  detector_ = vision::TagDetector::Create(dopt, &error);
+  if (!detector_) {
+    std::fprintf(stderr, "accuracy-bench: %s\n", error.c_str());
+    return false;
+  }
+  rgb_.assign(static_cast<size_t>(args_.width) * args_.height * 3, 0);
+  active_ = cams;
+  board_.clear();
+  tool_.clear();
+  for (const auto& t : config.tags) {
+    vision::TagModel m{t.id, t.size, TagPose(t)};
+    (t.body == "world" ? board_ : tool_).push_back(m);
+  }
+  // TCP in the marker (flange) frame: nominal, or as a one-time tool calibration measures it.
+  // The pivot calibration is not simulated: the calibrated offset is the TRUE model's.
+  Eigen::Vector3d tcp = V(config.arm.tcp_offset);
+  if (tool_calibrated) tcp += V(cell_->errors().offset_error[arflex::sim::kNumJoints]);
+  tcp_in_marker_ = Eigen::Isometry3d::Identity();
+  tcp_in_marker_.translation() = tcp;
+
+  // Extrinsic calibration of every camera from the reference board (full frame), at start.
+  cameras_.assign(renderer_->camera_count(), vision::Camera{});
+  renderer_->SetState(cell_->qpos());
+  for (int c = 0; c < renderer_->camera_count(); ++c) {
+    const auto k = renderer_->Intrinsics(c);
+    cameras_[c].k = vision::Intrinsics{k.width, k.height, k.fx, k.fy, k.cx, k.cy};
+    if (std::find(cams.begin(), cams.end(), c) == cams.end()) continue;  // blocked
+    arflex::sim::SensorEffects fx;
+    fx.noise_sigma = args_.noise;
+    fx.blur_sigma = args_.blur;
+    fx.seed = 77 + c;
+    renderer_->Render(c, rgb_.data(), &fx);
+    std::array<vision::TagDetection, 16> dets;
+    vision::FrameView frame{rgb_.data(), args_.width, args_.height, 3 * args_.width,
+                            vision::PixelFormat::kRgb8};
+    const int n = detector_->Detect(frame, nullptr, 0, dets.data(), 16, nullptr);
+    vision::PoseEstimate est;
+    if (!vision::CalibrateCamera(&cameras_[c], board_, dets.data(), std::max(n, 0), est_options_,
+                                 &est, &error)) {
+      std::fprintf(stderr, "accuracy-bench: camera %d: %s\n", c, error.c_str());
+      return false;
+    }
+    const Eigen::Isometry3d truth = renderer_->CameraPose(c);
+    const Eigen::Isometry3d d = truth.inverse() * cameras_[c].world_from_camera;
+    r->calib_trans_mm_max = std::max(r->calib_trans_mm_max,
+                                     1e3 * (truth.translation() - cameras_[c].world_from_camera.translation()).norm());
+    r->calib_rot_mdeg_max = std::max(r->calib_rot_mdeg_max,
+                                     1e3 * Eigen::AngleAxisd(d.linear()).angle() * 180 / M_PI);
+    r->calib_rms_px_max = std::max(r->calib_rms_px_max, cameras_[c].calibration_rms_px);
+  }
+
+  CorrectionOptions copt;
+  const double dt = cell_->timestep();
+  const int period_steps = std::max(1, static_cast<int>(std::lround(args_.period_ms * 1e-3 / dt)));
+  const std::vector<Eigen::Isometry3d> targets = Targets(args_.poses);
+  JointVector q_cmd = home;
+  JointVector start = home;
+  for (int i = 0; i < static_cast<int>(targets.size()); ++i) {
+    const Eigen::Isometry3d& target = targets[i];
+    JointVector seed = q_cmd;
+    if (!NominalIk(*cell_, target, &seed)) {
+      std::fprintf(stderr, "accuracy-bench: target %d: nominal IK did not converge\n", i);
+      return false;
+    }
+    q_cmd = seed;
+    // Move: a smooth joint-space ramp from where the reference was (incl. the last
+    // correction) to the new reference, correction off.
+    const int ramp = 1500;
+    cell_->SetCorrection(JointVector{});
+    for (int k = 1; k <= ramp; ++k) {
+      const double s = static_cast<double>(k) / ramp;
+      const double w = s * s * (3 - 2 * s);
+      JointVector ref;
+      for (int j = 0; j < 6; ++j) ref[j] = start[j] + w * (q_cmd[j] - start[j]);
+      cell_->SetJointReference(ref);
+      cell_->Step(1);
+    }
+    auto settle = [this]() {
+      for (int k = 0; k < 3000; k += 10) {
+        cell_->Step(10);
+        const auto js = cell_->ReadJointState();
+        double v = 0;
+        for (double x : js.dq) v = std::max(v, std::abs(x));
+        if (k >= 300 && v < 1e-6) break;
+      }
+    };
+    settle();
+    const Eigen::Isometry3d true_off = cell_->TrueTcp();
+    PoseRow row{};
+    row.index = i;
+    row.off_mm = 1e3 * (true_off.translation() - target.translation()).norm();
+    row.off_rot_mdeg = 1e3 * arflex::tcpcorr::PoseError(target, true_off).tail<3>().norm() * 180 / M_PI;
+    // Cold start measurement: full-frame detection (also the vision error at this pose).
+    const vision::PoseEstimate cold = Measure(false, r);
+    row.vision_err_mm = cold.valid ? 1e3 * (cold.pose.translation() - true_off.translation()).norm() : -1;
+    if (cold.valid) r->vision_err.Add(row.vision_err_mm);
+
+    // Correction on: the outer loop at the vision period, the applied correction ticked at
+    // the servo rate.
+    CorrectionLaw law(copt);
+    const Matrix6d jac = cell_->nominal().TcpJacobian(q_cmd);
+    const double e0 = row.off_mm;
+    std::vector<double> trace;  // true error (mm) at every servo step
+    int quiet = 0;
+    const int max_iterations = 40;
+    int it = 0;
+    for (; it < max_iterations; ++it) {
+      const vision::PoseEstimate est = Measure(true, r);
+      if (est.valid) row.views = std::max(row.views, est.n_views);
+      const Vector6d before = law.target();
+      law.Update(jac, target, est.pose, est.valid);
+      const double moved = (law.target() - before).cwiseAbs().maxCoeff();
+      for (int k = 0; k < period_steps; ++k) {
+        const Vector6d& a = law.Tick(dt);
+        JointVector corr;
+        for (int j = 0; j < 6; ++j) corr[j] = a(j);
+        cell_->SetCorrection(corr);
+        cell_->Step(1);
+        trace.push_back(1e3 * (cell_->TrueTcp().translation() - target.translation()).norm());
+      }
+      // Converged: three measurements in a row that move the target by < 0.2 urad.
+      quiet = (est.valid && moved < 2e-7) ? quiet + 1 : 0;
+      if (quiet >= 3) {
+        row.converged = true;
+        ++it;
+        break;
+      }
+    }
+    row.iterations = it;
+    row.holds = static_cast<int>(law.holds());
+    settle();
+    const Eigen::Isometry3d true_on = cell_->TrueTcp();
+    row.on_mm = 1e3 * (true_on.translation() - target.translation()).norm();
+    row.on_rot_mdeg = 1e3 * arflex::tcpcorr::PoseError(target, true_on).tail<3>().norm() * 180 / M_PI;
+    // Settling time: after this time the true error stays within 10 % of the way from the
+    // uncorrected to the final error.
+    const double band = row.on_mm + 0.1 * std::max(0.0, e0 - row.on_mm);
+    int last_out = -1;
+    for (int k = 0; k < static_cast<int>(trace.size()); ++k) {
+      if (trace[k] > band) last_out = k;
+    }
+    row.settle_s = (last_out + 1) * dt;
+    r->off.Add(row.off_mm);
+    r->on.Add(row.on_mm);
+    r->settle.Add(row.settle_s);
+    r->rows.push_back(row);
+    for (int j = 0; j < 6; ++j) start[j] = q_cmd[j] + law.applied()(j);
+  }
+  renderer_.reset();
+  detector_.reset();
+  cell_.reset();
+  return true;
+}
+
+void PrintRun(const RunResult& r, bool per_pose) {
+  std::printf("\n== %s: payload %.0f kg, cameras", r.name.c_str(), r.payload);
+  for (int c : r.cameras) std::printf(" %d", c);
+  std::printf(", tool offset %s ==\n", r.tool_calibrated ? "calibrated" : "nominal");
+  std::printf("camera calibration (board): max translation error %.2f mm, max rotation error "
+              "%.1f mdeg, max rms %.3f px\n",
+              r.calib_trans_mm_max, r.calib_rot_mdeg_max, r.calib_rms_px_max);
+  if (per_pose) {
+    std::printf("%4s %10s %10s %12s %12s %10s %9s %5s %5s %5s\n", "pose", "off (mm)", "on (mm)",
+                "off (mdeg)", "on (mdeg)", "vis (mm)", "settle(s)", "iter", "views", "conv");
+    for (const PoseRow& p : r.rows) {
+      std::printf("%4d %10.4f %10.4f %12.1f %12.1f %10.4f %9.2f %5d %5d %5s\n", p.index, p.off_mm,
+                  p.on_mm, p.off_rot_mdeg, p.on_rot_mdeg, p.vision_err_mm, p.settle_s,
+                  p.iterations, p.views, p.converged ? "yes" : "no");
+    }
+  }
+  const double ratio = r.on.Mean() > 0 ? r.off.Mean() / r.on.Mean() : 0;
+  std::printf("error off: mean %.4f mm, max %.4f mm | on: mean %.4f mm, max %.4f mm | "
+              "reduction %.1fx | settle mean %.2f s, max %.2f s\n",
+              r.off.Mean(), r.off.Max(), r.on.Mean(), r.on.Max(), ratio, r.settle.Mean(),
+              r.settle.Max());
+  const double n_cam = r.cameras.empty() ? 1 : r.cameras.size();
+  std::printf("vision error (uncorrected pose, full frame): mean %.4f mm, max %.4f mm; "
+              "estimates %ld, invalid %ld\n",
+              r.vision_err.Mean(), r.vision_err.Max(), r.estimates, r.invalid);
+  std::printf("per camera: render %.1f ms (%.1f fps), detect full frame %.1f ms (%.1f fps), "
+              "detect ROI %.1f ms (%.1f fps, ROI %.1f %% of the frame)\n",
+              r.render_ms.Mean(), 1e3 / r.render_ms.Mean(), r.detect_full_ms.Mean(),
+              1e3 / r.detect_full_ms.Mean(), r.detect_roi_ms.Mean(), 1e3 / r.detect_roi_ms.Mean(),
+              100 * r.roi_fraction.Mean());
+  std::printf("estimate %.2f ms; frame-to-correction latency (detect %zu views in sequence + "
+              "estimate + law) mean %.1f ms, max %.1f ms; poses/s (vision only) %.1f\n",
+              r.estimate_ms.Mean(), static_cast<size_t>(n_cam), r.latency_ms.Mean(),
+              r.latency_ms.Max(), 1e3 / r.latency_ms.Mean());
+}
+
+void WriteJson(FILE* f, const Args& a, const std::vector<RunResult>& runs) {
+  std::fprintf(f, "{\n  \"benchmark\": \"arflex-accuracy-bench\",\n");
+  std::fprintf(f, "  \"config\": {\"width\": %d, \"height\": %d, \"poses\": %d, \"noise_sigma\": %g, "
+                  "\"blur_sigma\": %g, \"vision_period_ms\": %d},\n",
+               a.width, a.height, a.poses, a.noise, a.blur, a.period_ms);
+  std::fprintf(f, "  \"runs\": [\n");
+  for (size_t i = 0; i < runs.size(); ++i) {
+    const RunResult& r = runs[i];
+    std::fprintf(f, "    {\"name\": \"%s\", \"payload_kg\": %g, \"tool_offset\": \"%s\", \"cameras\": [",
+                 r.name.c_str(), r.payload, r.tool_calibrated ? "calibrated" : "nominal");
+    for (size_t c = 0; c < r.cameras.size(); ++c) std::fprintf(f, "%s%d", c ? ", " : "", r.cameras[c]);
+    std::fprintf(f, "],\n     \"error_off_mm\": {\"mean\": %.6f, \"max\": %.6f}, \"error_on_mm\": "
+                    "{\"mean\": %.6f, \"max\": %.6f}, \"reduction\": %.3f,\n",
+                 r.off.Mean(), r.off.Max(), r.on.Mean(), r.on.Max(),
+                 r.on.Mean() > 0 ? r.off.Mean() / r.on.Mean() : 0.0);
+    std::fprintf(f, "     \"settle_s\": {\"mean\": %.4f, \"max\": %.4f}, \"vision_error_mm\": {\"mean\": "
+                    "%.6f, \"max\": %.6f},\n",
+                 r.settle.Mean(), r.settle.Max(), r.vision_err.Mean(), r.vision_err.Max());
+    std::fprintf(f, "     \"calibration\": {\"max_translation_mm\": %.4f, \"max_rotation_mdeg\": %.3f, "
+                    "\"max_rms_px\": %.4f},\n",
+                 r.calib_trans_mm_max, r.calib_rot_mdeg_max, r.calib_rms_px_max);
+    std::fprintf(f, "     \"per_camera_ms\": {\"render\": %.3f, \"detect_full\": %.3f, \"detect_roi\": %.3f, "
+                    "\"roi_fraction\": %.4f}, \"estimate_ms\": %.4f, \"latency_ms\": {\"mean\": %.3f, "
+                    "\"max\": %.3f}, \"frames\": %ld, \"estimates\": %ld, \"invalid\": %ld,\n",
+                 r.render_ms.Mean(), r.detect_full_ms.Mean(), r.detect_roi_ms.Mean(),
+                 r.roi_fraction.Mean(), r.estimate_ms.Mean(), r.latency_ms.Mean(), r.latency_ms.Max(),
+                 r.frames, r.estimates, r.invalid);
+    std::fprintf(f, "     \"poses\": [\n");
+    for (size_t p = 0; p < r.rows.size(); ++p) {
+      const PoseRow& w = r.rows[p];
+      std::fprintf(f, "       {\"pose\": %d, \"off_mm\": %.6f, \"on_mm\": %.6f, \"off_rot_mdeg\": %.3f, "
+                      "\"on_rot_mdeg\": %.3f, \"vision_error_mm\": %.6f, \"settle_s\": %.3f, "
+                      "\"iterations\": %d, \"views\": %d, \"converged\": %s}%s\n",
+                   w.index, w.off_mm, w.on_mm, w.off_rot_mdeg, w.on_rot_mdeg, w.vision_err_mm,
+                   w.settle_s, w.iterations, w.views, w.converged ? "true" : "false",
+                   p + 1 < r.rows.size() ? "," : "");
+    }
+    std::fprintf(f, "     ]}%s\n", i + 1 < runs.size() ? "," : "");
+  }
+  std::fprintf(f, "  ]\n}\n");
+}
+
+bool ParseArgs(int argc, char** argv, Args* a) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string k = argv[i];
+    auto value = [&](const char* name) -> const char* {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "accuracy-bench: %s needs a value\n", name);
+        return nullptr;
+      }
+      return argv[++i];
+    };
+    const char* v = nullptr;
+    if (k == "--quick") {
+      a->quick = true;
+      continue;
+    }
+    if (k == "--json" || k == "--width" || k == "--height" || k == "--poses" || k == "--noise" ||
+        k == "--blur" || k == "--period-ms") {
+      if (!(v = value(k.c_str()))) return false;
+    } else {
+      std::fprintf(stderr, "accuracy-bench: unknown argument '%s'\n", k.c_str());
+      return false;
+    }
+    char* end = nullptr;
+    if (k == "--json") {
+      a->json = v;
+      continue;
+    }
+    const double x = std::strtod(v, &end);
+    if (end == v || *end != '\0' || !std::isfinite(x) || x < 0) {
+      std::fprintf(stderr, "accuracy-bench: %s: '%s' is not a non-negative number\n", k.c_str(), v);
+      return false;
+    }
+    if (k == "--width") a->width = static_cast<int>(x);
+    if (k == "--height") a->height = static_cast<int>(x);
+    if (k == "--poses") a->poses = static_cast<int>(x);
+    if (k == "--noise") a->noise = x;
+    if (k == "--blur") a->blur = x;
+    if (k == "--period-ms") a->period_ms = static_cast<int>(x);
+  }
+  if (a->width < 64 || a->width > 1280 || a->height < 64 || a->height > 1024) {
+    std::fprintf(stderr, "accuracy-bench: --width/--height must be within 64x64..1280x1024\n");
+    return false;
+  }
+  if (a->poses < 1 || a->poses > 24) {
+    std::fprintf(stderr, "accuracy-bench: --poses must be in 1..24\n");
+    return false;
+  }
+  if (a->period_ms < 1) {
+    std::fprintf(stderr, "accuracy-bench: --period-ms must be >= 1\n");
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Args args;
+  if (!ParseArgs(argc, argv, &args)) return 2;
+  struct Spec {
+    const char* name;
+    double payload;
+    std::vector<int> cams;
+    bool tool_calibrated;
+    bool per_pose;
+  };
+  std::vector<Spec> specs = {
+      {"payload-0", 0, {0, 1, 2, 3}, true, true},
+      {"payload-100", 100, {0, 1, 2, 3}, true, false},
+      {"payload-210", 210, {0, 1, 2, 3}, true, false},
+      {"blocked-1", 0, {1, 2, 3}, true, false},
+      {"blocked-2", 0, {2, 3}, true, false},
+      {"nominal-tool", 0, {0, 1, 2, 3}, false, false},
+  };
+  if (args.quick) specs.resize(1);
+  std::printf("arflex-accuracy-bench: %d poses, %dx%d, noise %.1f DN, blur %.1f px, vision "
+              "period %d ms (simulated time)\n",
+              args.poses, args.width, args.height, args.noise, args.blur, args.period_ms);
+  std::vector<RunResult> runs;
+  Bench bench(args);
+  for (const Spec& s : specs) {
+    RunResult r;
+    if (!bench.Run(s.name, s.payload, s.cams, s.tool_calibrated, &r)) return 1;
+    PrintRun(r, s.per_pose);
+    std::fflush(stdout);
+    runs.push_back(std::move(r));
+  }
+  FILE* f = std::fopen(args.json.c_str(), "w");
+  if (f == nullptr) {
+    std::fprintf(stderr, "accuracy-bench: cannot write %s\n", args.json.c_str());
+    return 1;
+  }
+  WriteJson(f, args, runs);
+  std::fclose(f);
+  std::printf("\nJSON: %s\n", args.json.c_str());
+  return 0;
+}
