@@ -14,7 +14,8 @@ PACKAGES=(
   libapriltag-dev libeigen3-dev          # fiducials (the apriltag-utils library is in it), linear algebra
   libopencv-core-dev libopencv-imgproc-dev libopencv-calib3d-dev
   rt-tests stress-ng                     # cyclictest reference and load for benchmarks
-  python3                                # benchmark reports
+  python3                                # benchmark reports, console password hash
+  chromium chromium-driver               # browser tests of the web console
 )
 
 # POSIX message queues are listed in /dev/mqueue only when that filesystem is mounted (some
