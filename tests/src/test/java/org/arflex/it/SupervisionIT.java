@@ -83,4 +83,43 @@ class SupervisionIT {
             CellIT.assertDataFlows(rt, 2.0);
         }
     }
+
+    @Test
+    void aRestartedMovingComponentDrivesNothingUntilTheOperatorResets() throws Exception {
+        java.nio.file.Path moving = Jars.withContract(CellIT.COUNTER,
+                java.nio.file.Files.createTempDirectory("arflex-it").resolve("moving.jar"),
+                xml -> xml.replace("movesHardware=\"false\"", "movesHardware=\"true\""));
+        try (Runtime rt = new Runtime("moving")) {
+            rt.installAndStart(moving);
+            rt.awaitState("ACTIVE", CellIT.T, "sample-counter");
+            assertEquals(Boolean.FALSE, rt.instance("sample-counter").get("awaitingReset"), "the first start needs no reset");
+            java.nio.file.Path port = rt.segment("sample-counter", "count");
+            rt.waitUntil("first samples", CellIT.T, () -> Ports.readState(port) != null && Ports.readState(port).seq() > 3);
+            long pid = rt.pid("sample-counter");
+            ProcessHandle.of(pid).ifPresent(ProcessHandle::destroyForcibly);
+            rt.waitUntil("sample-counter restarted", CellIT.T, () -> rt.activeWithNewPid("sample-counter", pid));
+            assertEquals(Boolean.TRUE, rt.instance("sample-counter").get("awaitingReset"));
+            // restarted but held in safe mode (hold): its output does not move
+            long newPid = rt.pid("sample-counter");
+            rt.waitUntil("the new RT half cycling", CellIT.T, () -> cycles(rt) > 20);
+            Ports.Sample held = Ports.readState(port);
+            long c0 = cycles(rt);
+            rt.waitUntil("20 more cycles", CellIT.T, () -> cycles(rt) > c0 + 20);
+            assertEquals(held, Ports.readState(port), "a component that moves hardware must hold after a restart");
+            assertTrue(rt.cmd("arflex:stats sample-counter").contains("rt RUNNING"));
+            String r = rt.cmd("arflex:reset sample-counter");
+            assertTrue(r.contains("reset"), r);
+            assertEquals(Boolean.FALSE, rt.instance("sample-counter").get("awaitingReset"));
+            rt.waitUntil("output moving again after the reset", CellIT.T, () -> {
+                Ports.Sample now = Ports.readState(port);
+                return now != null && !now.equals(held);
+            });
+            assertEquals(newPid, rt.pid("sample-counter"), "the reset does not restart the process");
+        }
+    }
+
+    private static long cycles(Runtime rt) {
+        Object st = rt.instance("sample-counter").get("stats");
+        return st instanceof java.util.Map<?, ?> m ? ((Number) m.get("cycles")).longValue() : 0;
+    }
 }
