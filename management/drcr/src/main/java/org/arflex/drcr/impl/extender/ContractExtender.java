@@ -53,6 +53,7 @@ public final class ContractExtender implements BundleTrackerCustomizer<List<Stri
             return null;
         }
         String label = label(bundle);
+        long t0 = System.nanoTime();
         ContractReader.Result r = reader.read(label, header, path -> {
             URL u = bundle.getEntry(path);
             return u == null ? null : u.openStream();
@@ -60,6 +61,8 @@ public final class ContractExtender implements BundleTrackerCustomizer<List<Stri
         for (String p : r.problems()) {
             cell.actor().submit(() -> cell.problem(p));
         }
+        long tParsed = System.nanoTime();
+        log.accept("arflex: " + label + ": contracts read in " + (tParsed - t0) / 1000 + " us");
         List<String> installed = new ArrayList<>();
         for (Contract c : r.contracts()) {
             Path exe;
@@ -75,7 +78,8 @@ public final class ContractExtender implements BundleTrackerCustomizer<List<Stri
                 installed.add(c.name());
             }
         }
-        log.accept("arflex: " + label + " started: components " + installed);
+        log.accept("arflex: " + label + " started: components " + installed + " in "
+                + (System.nanoTime() - t0) / 1000 + " us");
         return installed;
     }
 

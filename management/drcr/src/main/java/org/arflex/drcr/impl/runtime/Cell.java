@@ -344,12 +344,15 @@ public final class Cell {
     private void startHalf(Instance inst, int cpu, List<Wire> wires) {
         Contract c = inst.contract;
         RtHalf half = null;
+        long t0 = cfg.monotonicNs().getAsLong();
+        long tLaunched = t0;
         try {
             ensureOutputs(inst);
             boolean resetRequired = c.movesHardware() && inst.everStarted;
             half = launcher.launch(new RtLauncher.Spec(cfg.runtimeId(), inst.name, inst.executable,
                     controlConfig(c, cpu, cfg.noMlock()), controlParams(c, inst.params), resetRequired,
                     cfg.readyTimeoutMs()));
+            tLaunched = cfg.monotonicNs().getAsLong();
             inst.bound.clear();
             for (Wire w : wires) {
                 String seg = segmentOf(w.provider(), w.outPort());
@@ -375,7 +378,9 @@ public final class Cell {
         RtHalf h = half;
         half.exit().thenAccept(ex -> actor.submit(() -> onExit(inst, h, ex)));
         monitor.watch(inst.name, half, c.fault().heartbeatTimeoutMs(), cfg.monotonicNs().getAsLong());
-        log.accept("arflex: " + inst.name + " ACTIVE (pid " + half.pid() + ", cpu " + cpu + ", inputs " + inst.bound + ")");
+        long t1 = cfg.monotonicNs().getAsLong();
+        log.accept("arflex: " + inst.name + " ACTIVE (pid " + half.pid() + ", cpu " + cpu + ", inputs " + inst.bound
+                + "; spawn to READY " + (tLaunched - t0) / 1000 + " us, bind+start " + (t1 - tLaunched) / 1000 + " us)");
     }
 
     private void stopHalf(Instance inst, String why) {
