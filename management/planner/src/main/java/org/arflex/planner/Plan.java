@@ -212,18 +212,23 @@ public final class Plan {
      * The text the Gogo {@code plan} command prints. The layout is stable (tests compare it):
      *
      * <pre>
-     * plan: install sample-scaler 1.0.0
+     * plan: install sampler 1.0.0
      * actions:
-     *   START    sample-scaler  new; cpu 1, R=0.3 ms &lt;= D=1 ms
+     *   START    sample-scaler  now satisfied (x &lt;- sampler.out); cpu 1: hyperbolic bound holds (U=0.20)
+     *   START    sampler        installed; cpu 0: hyperbolic bound holds (U=0.30)
      * stop order: (none)
-     * start order: sample-scaler
+     * start order: sampler, sample-scaler
      * wiring:
      *   sample-scaler.x &lt;- sampler.out
      * cpus:
-     *   cpu 0  U=0.20/0.90  hyperbolic bound  sampler
-     * memory: 12 MiB of 512 MiB; network: 0 B/s of 10 MB/s
+     *   cpu 0  U=0.30/0.90  hyperbolic bound  sampler
+     *   cpu 1  U=0.20/0.90  hyperbolic bound  sample-scaler
+     * memory: 65 MiB of 512 MiB; network: 0 B/s of 10 MB/s
      * not active:
-     *   foo  input 'x' of 'foo': no provider of arflex.Sample 1.x (state)
+     *   foo  input 'x' of 'foo': no provider of arflex.Pose 1.x (state)
+     * </pre>
+     *
+     * Sections {@code cycles:}, {@code not active:} and {@code notes:} appear only when not empty.
      * </pre>
      */
     public String toText() {

@@ -71,6 +71,10 @@ public final class Resolver {
         final String filterError;
         final TreeSet<Out> candidates = new TreeSet<>();
         Wire wire;
+        /** The node of {@link #wire}'s provider (refreshed by every rewire), null without wire. */
+        Node providerNode;
+        /** The node that owns this input. */
+        Node owner;
         /** The index set this input is registered in, if any. */
         Set<In> home;
 
@@ -119,7 +123,9 @@ public final class Resolver {
             this.contract = contract;
             for (PortSpec p : contract.ports()) {
                 if (p.direction() == PortSpec.Direction.IN) {
-                    inputs.add(new In(contract.name(), p));
+                    In in = new In(contract.name(), p);
+                    in.owner = this;
+                    inputs.add(in);
                 }
             }
         }
@@ -395,12 +401,15 @@ public final class Resolver {
         return in.filter == null || in.filter.matches(provider.attributes());
     }
 
-    private static void rewire(In in, Change ch) {
+    private void rewire(In in, Change ch) {
         Wire w = null;
+        Node pn = null;
         if (in.candidates.size() == 1) {
             Out o = in.candidates.first();
             w = new Wire(in.consumer, in.spec.name(), o.component(), o.spec().name());
+            pn = nodes.get(o.component());
         }
+        in.providerNode = pn;
         if (w == null ? in.wire != null : !w.equals(in.wire)) {
             if (in.wire != null) {
                 ch.wireGone(in.wire);
@@ -428,7 +437,7 @@ public final class Resolver {
         }
         for (In in : n.inputs) {
             if (in.required()) {
-                Node p = nodes.get(in.wire.provider());
+                Node p = in.providerNode;
                 if (p == null || !p.satisfied) {
                     return false;
                 }
@@ -445,11 +454,9 @@ public final class Resolver {
         }
         List<Node> out = new ArrayList<>();
         for (In in : fed) {
-            if (in.required() && in.wire != null && in.wire.provider().equals(provider)) {
-                Node c = nodes.get(in.consumer);
-                if (c != null) {
-                    out.add(c);
-                }
+            if (in.required() && in.wire != null && in.wire.provider().equals(provider)
+                    && nodes.get(in.consumer) == in.owner) {
+                out.add(in.owner);
             }
         }
         return out;
