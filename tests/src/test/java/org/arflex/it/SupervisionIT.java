@@ -71,12 +71,14 @@ class SupervisionIT {
 
     @Test
     void felixUpdateGivesTheSameResultAsOurs() throws Exception {
+        // a bare "update <id>" as users type it; Gogo resolves it to arflex:update, which hands
+        // bundle ids to Felix
         try (Runtime rt = new Runtime("felix-update")) {
             rt.installAndStart(CellIT.COUNTER);
             long id = rt.installAndStart(CellIT.SCALER);
             rt.awaitState("ACTIVE", CellIT.T, "sample-counter", "sample-scaler");
             long pid = rt.pid("sample-scaler");
-            assertEquals("", rt.cmd("felix:update " + id));
+            assertEquals("", rt.cmd("update " + id));
             rt.waitUntil("sample-scaler back after Felix's update", CellIT.T,
                     () -> rt.activeWithNewPid("sample-scaler", pid));
             assertNotEquals(0L, rt.pid("sample-scaler"));

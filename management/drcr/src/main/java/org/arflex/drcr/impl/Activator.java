@@ -97,7 +97,8 @@ public final class Activator implements BundleActivator {
         shell.put("osgi.command.scope", Commands.SCOPE);
         shell.put("osgi.command.function", Commands.FUNCTIONS);
         // The shell finds management services in the registry, as any other client does.
-        regs.add(ctx.registerService(Commands.class, new Commands(services, rm[0], services, name -> lookup(ctx, name)), shell));
+        regs.add(ctx.registerService(Commands.class, new Commands(services, rm[0], services, name -> lookup(ctx, name),
+                (id, location) -> felixUpdate(ctx, id, location)), shell));
         ticker = new ScheduledThreadPoolExecutor(1, r -> {
             Thread t = new Thread(r, "arflex-drcr-heartbeat");
             t.setDaemon(true);
@@ -136,6 +137,25 @@ public final class Activator implements BundleActivator {
             return java.util.Optional.empty();
         }
         return java.util.Optional.empty();
+    }
+
+    private static String felixUpdate(BundleContext ctx, long id, String location) {
+        Bundle b = ctx.getBundle(id);
+        if (b == null) {
+            throw new IllegalArgumentException("no bundle " + id);
+        }
+        try {
+            if (location == null) {
+                b.update();
+            } else {
+                try (java.io.InputStream in = java.net.URI.create(location).toURL().openStream()) {
+                    b.update(in);
+                }
+            }
+        } catch (org.osgi.framework.BundleException | java.io.IOException | IllegalArgumentException e) {
+            throw new IllegalStateException("update of bundle " + id + " failed: " + e.getMessage());
+        }
+        return "";
     }
 
     private static List<Integer> allCpus() {

@@ -33,13 +33,21 @@ public final class Commands {
     private final ResourceManager resources;
     private final UpdateService updates;
     private final Function<String, Optional<ComponentManagement>> management;
+    private final BundleUpdater bundles;
+
+    /** Felix's own bundle update, for {@code update <bundle-id> [url]} typed without a scope. */
+    public interface BundleUpdater {
+        /** Updates bundle {@code id} (from {@code location} when not null); returns a report. */
+        String update(long id, String location);
+    }
 
     public Commands(DrcrService drcr, ResourceManager resources, UpdateService updates,
-                    Function<String, Optional<ComponentManagement>> management) {
+                    Function<String, Optional<ComponentManagement>> management, BundleUpdater bundles) {
         this.drcr = drcr;
         this.resources = resources;
         this.updates = updates;
         this.management = management;
+        this.bundles = bundles;
     }
 
     /** One line per instance: name, state, pid, cpu, reason. */
@@ -142,9 +150,21 @@ public final class Commands {
         });
     }
 
-    /** Pulls the update of a component from its contract's update URL. */
-    public String update(String name) {
-        return guard(() -> updates.update(name));
+    /**
+     * Pulls the update of a component from its contract's update URL. A number is a bundle id
+     * (component names start with a letter): Gogo resolves a bare {@code update} to this scope,
+     * so {@code update <id> [url]} is handed to Felix and behaves as {@code felix:update}.
+     */
+    public String update(String... args) {
+        return guard(() -> {
+            if (args.length >= 1 && args.length <= 2 && args[0].matches("\\d{1,18}")) {
+                return bundles.update(Long.parseLong(args[0]), args.length == 2 ? args[1] : null);
+            }
+            if (args.length != 1) {
+                return "usage: update <component> | update <bundle-id> [url]";
+            }
+            return updates.update(args[0]);
+        });
     }
 
     /** {@code resources} prints capacities; {@code resources set cpus 0,1 memory 512m network 10m} changes them. */

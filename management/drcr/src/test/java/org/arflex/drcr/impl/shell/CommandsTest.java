@@ -166,7 +166,19 @@ class CommandsTest {
         }
     };
 
-    private final Commands cmd = new Commands(drcr, rm, upd, n -> n.equals("cons") ? Optional.of(cm) : Optional.empty());
+    private final Commands cmd = new Commands(drcr, rm, upd, n -> n.equals("cons") ? Optional.of(cm) : Optional.empty(),
+            (id, loc) -> {
+                calls.add("felix update " + id + " " + loc);
+                return "";
+            });
+
+    @Test
+    void updateOfABundleIdIsFelixsUpdate() {
+        assertEquals("", cmd.update("27"));
+        assertEquals("", cmd.update("27", "file:/x.jar"));
+        assertEquals(List.of("felix update 27 null", "felix update 27 file:/x.jar"), calls);
+        assertTrue(cmd.update().startsWith("usage:"));
+    }
 
     @Test
     void listShowsStateReasonAndProblems() {
