@@ -493,6 +493,13 @@ public final class Admission {
                 if (wcet > declared) {
                     notes.put(n, "measured WCET " + Text.duration(wcet) + " > declared " + Text.duration(declared));
                 }
+                if (t.periodNs() <= 0) {
+                    return "timing: period " + t.periodNs() + " ns is not positive";
+                }
+                if (t.deadlineNs() <= 0 || t.deadlineNs() > t.periodNs()) {
+                    return "timing: deadline " + Text.duration(t.deadlineNs()) + " is not in (0, period "
+                            + Text.duration(t.periodNs()) + "]";
+                }
                 Schedulability.Task task;
                 try {
                     task = new Schedulability.Task(n, t.periodNs(), t.deadlineNs(), wcet, t.priority());

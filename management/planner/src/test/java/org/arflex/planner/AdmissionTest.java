@@ -193,4 +193,12 @@ class AdmissionTest {
         assertEquals(10 * MS, a.decisions().get("t3").responseTimeNs());
         assertFalse(a.refused().containsKey("t1"));
     }
+
+    @Test
+    void impossibleTimingIsRefusedWithItsReason() {
+        AdmissionResult a = admit(ONE_CPU, C.of("odd").timing(10, 12, 1, 5).build());
+        assertEquals("timing: deadline 12 ms is not in (0, period 10 ms]", a.refused().get("odd"));
+        AdmissionResult b = admit(ONE_CPU, C.of("slow").timing(10, 5, 6, 5).build());
+        assertEquals("timing: WCET 6 ms exceeds deadline 5 ms", b.refused().get("slow"));
+    }
 }

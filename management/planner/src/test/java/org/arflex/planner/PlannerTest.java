@@ -302,4 +302,17 @@ class PlannerTest {
         assertEquals("update sampler 1.0.0 -> 1.2.0", plan.title());
         assertFalse(plan.isEmpty());
     }
+
+    @Test
+    void measuredWcetCanBeClearedAgain() {
+        Planner p = cell();
+        p.apply(Change.measuredWcet("sample-scaler", 950_000));
+        assertEquals(Set.of("sampler"), p.active());
+        assertEquals(Map.of("sample-scaler", 950_000L), p.measuredWcetNs());
+        Plan back = p.apply(Change.measuredWcet("sample-scaler", 0));
+        assertEquals(List.of("sample-scaler"), back.startOrder());
+        assertTrue(back.action("sample-scaler").get().reason().startsWith("admitted now (was refused: cpu 1: utilisation 0.95"),
+                back.action("sample-scaler").get().reason());
+        assertEquals(Map.of(), p.measuredWcetNs());
+    }
 }
