@@ -38,6 +38,10 @@ class UpdateIT {
             rt.awaitState("ACTIVE", CellIT.T, "sample-counter", "sample-scaler");
             long counterPid = rt.pid("sample-counter");
             long scalerPid = rt.pid("sample-scaler");
+            String plan = rt.cmd("arflex:plan update sample-scaler");
+            assertTrue(plan.lines().anyMatch(l -> l.contains("RESTART") && l.contains("sample-scaler")), plan);
+            assertTrue(plan.lines().noneMatch(l -> l.contains("sample-counter") && (l.contains("RESTART") || l.contains("STOP"))), plan);
+            assertEquals("1.0.0", version(rt), "a dry run installs nothing");
             String r = rt.cmd("arflex:update sample-scaler");
             assertTrue(r.contains("updated to 1.1.0"), r + "\n" + rt.tail());
             rt.awaitState("ACTIVE", CellIT.T, "sample-scaler");
@@ -64,6 +68,7 @@ class UpdateIT {
             long scalerPid = rt.pid("sample-scaler");
             String r = rt.cmd("arflex:update sample-scaler");
             assertTrue(r.startsWith("error:") && r.contains("SHA-256") && r.contains("old version keeps running"), r);
+            assertTrue(rt.cmd("arflex:plan update sample-scaler").startsWith("error:"), "the dry run checks the hash too");
             assertEquals("1.0.0", version(rt));
             assertEquals(scalerPid, rt.pid("sample-scaler"));
             // now a contract that pins the broken jar's own hash

@@ -25,6 +25,12 @@ public interface DrcrService {
     /** What installing the bundle at {@code location} would start, stop and restart, and why. */
     String planInstall(String location);
 
+    /**
+     * What {@code update name} would do: downloads from the contract's update URL, checks the
+     * pinned SHA-256 and the new contracts, and plans their replacement (nothing is installed).
+     */
+    String planUpdate(String name);
+
     /** What uninstalling the bundle carrying component {@code name} would stop, and why. */
     String planUninstall(String name);
 

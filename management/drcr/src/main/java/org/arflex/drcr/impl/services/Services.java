@@ -155,6 +155,15 @@ public final class Services implements DrcrService, UpdateService {
     }
 
     @Override
+    public String planUpdate(String name) {
+        Fetched f = fetchUpdate(name);
+        Change.Builder b = Change.builder();
+        f.result().contracts().forEach(b::put);
+        return "update of " + name + " from " + f.url() + " (sha256 verified)\n"
+                + cell.actor().call(() -> cell.dryRun(b.build()).toText(), CALL_MS);
+    }
+
+    @Override
     public String planUninstall(String name) {
         return cell.actor().call(() -> {
             Long bundle = cell.instance(name).map(i -> i.bundleId).orElseThrow(
@@ -173,8 +182,12 @@ public final class Services implements DrcrService, UpdateService {
 
     // ---- UpdateService -----------------------------------------------------------------------
 
-    @Override
-    public String update(String name) {
+    /** A downloaded, hash-checked and readable update. */
+    private record Fetched(long bundleId, String url, byte[] jar, String sha, ContractReader.Result result) {
+    }
+
+    /** Download, pinned hash, contracts: every check before anything is installed. */
+    private Fetched fetchUpdate(String name) {
         record Target(UpdateSpec spec, long bundleId) {
         }
         Target t = cell.actor().call(() -> {
@@ -200,18 +213,25 @@ public final class Services implements DrcrService, UpdateService {
             throw new IllegalStateException(name + ": update not installed, the old version keeps running: the new bundle "
                     + (r.problems().isEmpty() ? "has no contract for " + name : "is broken:\n" + String.join("\n", r.problems())));
         }
-        Bundle b = context.getBundle(t.bundleId());
+        return new Fetched(t.bundleId(), t.spec().url().toString(), jar, got, r);
+    }
+
+    @Override
+    public String update(String name) {
+        Fetched f = fetchUpdate(name);
+        Bundle b = context.getBundle(f.bundleId());
         if (b == null) {
-            throw new IllegalStateException(name + ": bundle " + t.bundleId() + " is gone");
+            throw new IllegalStateException(name + ": bundle " + f.bundleId() + " is gone");
         }
         try {
-            b.update(new ByteArrayInputStream(jar));
+            b.update(new ByteArrayInputStream(f.jar()));
         } catch (BundleException e) {
             throw new IllegalStateException(name + ": bundle update failed, the old version keeps running: " + e.getMessage());
         }
-        String v = r.contracts().stream().filter(c -> c.name().equals(name)).map(Contract::version).findFirst().orElse("?");
-        log.accept("arflex: updated bundle " + t.bundleId() + " from " + t.spec().url() + " (sha256 " + got + ")");
-        return name + ": updated to " + v + " from " + t.spec().url() + " (sha256 verified)";
+        String v = f.result().contracts().stream().filter(c -> c.name().equals(name)).map(Contract::version).findFirst()
+                .orElse("?");
+        log.accept("arflex: updated bundle " + f.bundleId() + " from " + f.url() + " (sha256 " + f.sha() + ")");
+        return name + ": updated to " + v + " from " + f.url() + " (sha256 verified)";
     }
 
     static String sha256(byte[] data) {

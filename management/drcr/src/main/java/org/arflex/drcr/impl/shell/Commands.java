@@ -132,11 +132,17 @@ public final class Commands {
         return guard(() -> name + "." + param + " = " + cm(name).set(param, value));
     }
 
-    /** Dry runs: {@code plan install <url>}, {@code plan uninstall <name>}, {@code plan cpus 0,1 [memory m] [network n]}. */
+    /**
+     * Dry runs: {@code plan install <url>}, {@code plan update <name>}, {@code plan uninstall <name>},
+     * {@code plan cpus 0,1 [memory m] [network n]}.
+     */
     public String plan(String... args) {
         return guard(() -> {
             if (args.length == 2 && args[0].equals("install")) {
                 return drcr.planInstall(args[1]);
+            }
+            if (args.length == 2 && args[0].equals("update")) {
+                return drcr.planUpdate(args[1]);
             }
             if (args.length == 2 && args[0].equals("uninstall")) {
                 return drcr.planUninstall(args[1]);
@@ -146,7 +152,7 @@ public final class Commands {
                 Caps caps = parseCaps(args, r);
                 return drcr.planCapacity(caps.cpus, caps.memory, caps.network);
             }
-            return "usage: plan install <jar-url> | plan uninstall <name> | plan [cpus <list>] [memory <bytes>] [network <B/s>]";
+            return "usage: plan install <jar-url> | plan update <name> | plan uninstall <name> | plan [cpus <list>] [memory <bytes>] [network <B/s>]";
         });
     }
 

@@ -90,6 +90,11 @@ class CommandsTest {
         }
 
         @Override
+        public String planUpdate(String name) {
+            return "plan update " + name;
+        }
+
+        @Override
         public String planUninstall(String name) {
             return "plan uninstall " + name;
         }
@@ -203,6 +208,7 @@ class CommandsTest {
     void bindingsAndPlan() {
         assertEquals("cons.x <- prov.y", cmd.bindings());
         assertEquals("plan install file:/x.jar", cmd.plan("install", "file:/x.jar"));
+        assertEquals("plan update cons", cmd.plan("update", "cons"));
         assertEquals("plan cpus [0] memory 1073741824 network 1000", cmd.plan("cpus", "0"));
         assertTrue(cmd.plan("bogus").startsWith("usage:"));
     }
