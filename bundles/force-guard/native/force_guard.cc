@@ -141,9 +141,7 @@ int Update(struct arflex_component* c, void*, uint64_t release_ns) {
   if (g.have_w) {
     const Eigen::Vector3d f(g.w.force[0], g.w.force[1], g.w.force[2]);
     if (g.have_js) {
-      Eigen::Vector3d f0, t0;
-      g.model.ToolWeightWrench(q, payload, &f0, &t0);
-      g.force_norm = (f - f0).norm();
+      g.force_norm = g.model.ContactForceWorld(q, f, payload).norm();
     } else {
       // No joint angles: the tool's weight direction is unknown; the contact force is at
       // least | |F| - weight |.

@@ -205,12 +205,8 @@ int Update(struct arflex_component* c, void*, uint64_t release_ns) {
     if (g.have_w && g.have_js) {
       Q qm;
       for (int j = 0; j < 6; ++j) qm[j] = g.js.q[j];
-      Eigen::Vector3d f0, t0;
-      g.model.ToolWeightWrench(qm, arflex_param_f64(c, g.p_payload), &f0, &t0);
       const Eigen::Vector3d f(g.w.force[0], g.w.force[1], g.w.force[2]);
-      // The sensor reads what the arm exerts on the tool: a hand force shows with the
-      // opposite sign, on top of the tool's weight.
-      f_hand = -(g.model.Flange(qm).linear() * (f - f0));
+      f_hand = g.model.ContactForceWorld(qm, f, arflex_param_f64(c, g.p_payload));
       const double db = arflex_param_f64(c, g.p_deadband), n = f_hand.norm();
       if (n > db)
         f_hand *= 1.0 - db / n;

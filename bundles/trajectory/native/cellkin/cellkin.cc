@@ -101,6 +101,15 @@ void Model::ToolWeightWrench(const Q& q, double payload_kg, Eigen::Vector3d* f,
   *tq = V3(arm_.tool_com).cross(ft) + V3(arm_.payload_com).cross(fp);
 }
 
+Eigen::Vector3d Model::ContactForceWorld(const Q& q, const Eigen::Vector3d& f_sensor,
+                                         double payload_kg) const {
+  Eigen::Vector3d f0, t0;
+  ToolWeightWrench(q, payload_kg, &f0, &t0);
+  // Tool at rest: F_arm + F_contact + m g = 0 and F_arm(no contact) = -m g, so
+  // F_contact = -(F_arm - F_arm(no contact)).
+  return -(Flange(q).linear() * (f_sensor - f0));
+}
+
 // ---- programs -----------------------------------------------------------------------------
 
 namespace {

@@ -49,6 +49,12 @@ class Model {
   void ToolWeightWrench(const Q& q, double payload_kg, Eigen::Vector3d* f,
                         Eigen::Vector3d* t) const;
 
+  // Force (N, world frame) that something other than gravity and the arm exerts on the tool:
+  // the wrist sensor force `f_sensor` (flange frame, what the arm exerts on the tool, as the
+  // simulator's sensor reports it) minus the tool weight, rotated to the world, sign flipped.
+  Eigen::Vector3d ContactForceWorld(const Q& q, const Eigen::Vector3d& f_sensor,
+                                    double payload_kg) const;
+
   const sim::ArmParams& arm() const { return arm_; }
   double lower(int j) const { return arm_.links[j].lower; }
   double upper(int j) const { return arm_.links[j].upper; }
