@@ -44,11 +44,15 @@ echo "arflex: web console at http://127.0.0.1:${port:-8480}/system/console (user
 commands() {
   # Give the framework a moment to start the DRCR's shell commands; Gogo queues the input,
   # so this only orders the echo of the commands with the framework's own output.
-  echo "echo 'ARFLEX runtime $(basename "$RUNTIME_DIR") up; installing the cell'"
+  echo "echo 'ARFLEX runtime up; installing the cell from $RUNTIME_DIR/cell'"
   shopt -s nullglob
+  # Felix's start installs a bundle from its URL and starts it; the DRCR's extender then reads
+  # its contract, plans, and starts its RT half once its inputs are satisfied.
   for jar in cell/*.jar; do
-    echo "install -s file:$RUNTIME_DIR/$jar"
+    echo "start file:$RUNTIME_DIR/$jar"
   done
+  # Only orders the first listing after the DRCR's start-up messages.
+  sleep 3
   echo "arflex:list"
   if [ -n "$HEADLESS" ]; then
     local end=$((SECONDS + HEADLESS))
