@@ -19,7 +19,7 @@ import org.junit.jupiter.params.provider.ValueSource;
 class PlannerPropertyTest {
 
     @ParameterizedTest
-    @ValueSource(longs = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20})
+    @ValueSource(longs = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10})
     void dryRunEqualsRealRunAndConverges(long seed) {
         Random rnd = new Random(seed);
         int pool = 3 + rnd.nextInt(15);
