@@ -18,12 +18,18 @@
 
 #include <cmath>
 #include <cstring>
+#include <array>
 #include <functional>
+#include <map>
+#include <memory>
 #include <set>
 #include <string>
 #include <vector>
 
+#include "arflex_sim/cell.h"
 #include "arflex_sim/ground_truth.h"
+#include "arflex_sim/params.h"
+#include "arflex_sim/render.h"
 
 namespace {
 
@@ -547,14 +553,23 @@ class TagDetector {
     apriltag_detector_destroy(det_);
     tag36h11_destroy(family_);
   }
-  std::set<int> Detect(uint8_t* gray, int w, int h, int stride) {
+  // Ids found; the corners of each (pixel-centre convention: AprilTag's +0.5 removed) into
+  // *corners when not null.
+  std::set<int> Detect(uint8_t* gray, int w, int h, int stride,
+                       std::map<int, std::array<std::array<double, 2>, 4>>* corners = nullptr) {
     image_u8_t im = {w, h, stride, gray};
     zarray_t* dets = apriltag_detector_detect(det_, &im);
     std::set<int> ids;
     for (int i = 0; i < zarray_size(dets); ++i) {
       apriltag_detection_t* d;
       zarray_get(dets, i, &d);
-      if (d->hamming == 0) ids.insert(d->id);
+      if (d->hamming != 0) continue;
+      ids.insert(d->id);
+      if (corners) {
+        for (int k = 0; k < 4; ++k) {
+          (*corners)[d->id][k] = {d->p[k][0] - 0.5, d->p[k][1] - 0.5};
+        }
+      }
     }
     apriltag_detections_destroy(dets);
     return ids;
@@ -619,6 +634,106 @@ TEST_F(SimComponents, CameraRendersArmFromJointStateAndTagsAreFound) {
   EXPECT_TRUE(ids.count(10)) << "tool tag 10";
   EXPECT_TRUE(ids.count(11)) << "tool tag 11";
   EXPECT_TRUE(ids.count(0) && ids.count(1) && ids.count(3)) << "reference board tags";
+
+  EXPECT_EQ(arflex_host_stop(&camera_, kCall), 0);
+  EXPECT_EQ(arflex_host_stop(&robot_, kCall), 0);
+  arflex_port_close(&frames);
+  arflex_port_close(&js_port);
+  Shutdown(&camera_);
+  Shutdown(&robot_);
+}
+
+// The pose a frame shows is the pose of the joint state whose t_ns it carries: the arm swings
+// joint 1, and the tool tag's detected corners match the projection of the
+// true corners at the stamped joint state, while the joint state of one camera period earlier
+// would be off by several pixels.
+TEST_F(SimComponents, CameraFrameShowsTheStampedJointState) {
+  CreateRobot(1 * kMs, 1, false);
+  CreateCamera(40 * kMs, 0, 800, 600, 1.0);
+  CreateReference();
+  arflex_port frames, js_port;
+  OpenReader(&camera_, "frames", ARFLEX_PORT_FRAME, &kFrameType, &frames);
+  OpenReader(&robot_, "joint_state", ARFLEX_PORT_STATE, &kJointStateType, &js_port);
+  ASSERT_EQ(arflex_host_start(&robot_, kCall), 0);
+  ASSERT_EQ(arflex_host_bind(&robot_, "joint_ref", ref_name_.c_str(), kCall), 0);
+  ASSERT_EQ(arflex_host_bind(&camera_, "joint_state",
+                             arflex_host_output_name(&robot_, "joint_state"), kCall), 0);
+  ASSERT_EQ(arflex_host_start(&camera_, kCall), 0);
+
+  // The test's own model of the cell (same seed and payload as the components) to project
+  // the true tag corners at a given joint state.
+  std::string error;
+  auto cell = arflex::sim::Cell::Create(arflex::sim::DefaultCellConfig(),
+                                        {0.0, 0.5, 0.3, 0.0, 0.8, 0.0}, &error);
+  ASSERT_TRUE(cell) << error;
+  auto renderer = arflex::sim::Renderer::Create(cell->model(), 800, 600, &error);
+  ASSERT_TRUE(renderer) << error;
+  auto corner_error = [&](const double q[6], const std::array<std::array<double, 2>, 4>& det) {
+    arflex::sim::JointVector jq;
+    for (int i = 0; i < 6; ++i) jq[i] = q[i];
+    cell->ResetTo(jq);
+    renderer->SetState(cell->qpos());
+    std::array<Eigen::Vector3d, 4> corners;
+    double worst = 0;
+    if (!renderer->TagCorners(10, &corners)) return 1e9;
+    for (int k = 0; k < 4; ++k) {
+      double u = -1e9, v = -1e9;
+      renderer->Project(0, corners[k], &u, &v);
+      worst = std::max(worst, std::hypot(det[k][0] - u, det[k][1] - v));
+    }
+    return worst;
+  };
+
+  TagDetector detector;
+  std::map<int64_t, std::array<double, 6>> history;  // joint states seen, by t_ns
+  const uint64_t t0 = Now();
+  int matched = 0, n_frames = 0, n_captured = 0, n_moving = 0, n_tag = 0;
+  double worst_stamped = 0, best_stale = 1e9;
+  arflex_joint_state js{};
+  bool hj = false;
+  const bool done = WaitFor([&] {
+    // Swing joint 1: q1 = 0.25 sin(2 pi 0.5 t).
+    const double t = (Now() - t0) * 1e-9;
+    double ref[6] = {0.25 * std::sin(M_PI * t), 0.5, 0.3, 0.0, 0.8, 0.0};
+    WriteReference(ref);
+    if (Latest(&js_port, &js, &hj)) {
+      std::array<double, 6> q;
+      for (int i = 0; i < 6; ++i) q[i] = js.q[i];
+      history[js.t_ns] = q;
+      while (history.size() > 4000) history.erase(history.begin());
+    }
+    arflex_frame_view v;
+    if (arflex_frame_acquire(&frames, &v) != 1) return false;
+    arflex_image_frame hdr;
+    std::memcpy(&hdr, v.data, sizeof(hdr));
+    const uint8_t* px = static_cast<const uint8_t*>(v.data) + ARFLEX_TYPE_IMAGE_FRAME_SIZE;
+    std::vector<uint8_t> copy(px, px + hdr.bytes);
+    if (!arflex_frame_valid(&v)) return false;
+    ++n_frames;
+    auto at = history.find(hdr.t_ns);
+    auto stale = history.upper_bound(hdr.t_ns - 40 * static_cast<int64_t>(kMs));
+    if (at == history.end() || stale == history.begin()) return false;  // not captured
+    --stale;  // the newest joint state at least one camera period older
+    ++n_captured;
+    // Moving enough that the older pose is visibly elsewhere (8 mrad = ~20 mm at the tool,
+    // ~4 px in this camera).
+    if (std::fabs(at->second[0] - stale->second[0]) < 0.008) return false;
+    ++n_moving;
+    std::map<int, std::array<std::array<double, 2>, 4>> corners;
+    detector.Detect(copy.data(), 800, 600, static_cast<int>(hdr.stride), &corners);
+    if (!corners.count(10)) return false;
+    ++n_tag;
+    worst_stamped = std::max(worst_stamped, corner_error(at->second.data(), corners[10]));
+    best_stale = std::min(best_stale, corner_error(stale->second.data(), corners[10]));
+    return ++matched >= 3;
+  });
+  EXPECT_TRUE(done) << "frames " << n_frames << ", stamp captured " << n_captured
+                    << ", moving " << n_moving << ", tag 10 found " << n_tag << ", q1 now "
+                    << js.q[0] << ", history " << history.size();
+  std::printf("tool tag 10: worst corner error at the stamped joint state %.2f px, best at the "
+              "joint state 40 ms older %.2f px (%d frames)\n", worst_stamped, best_stale, matched);
+  EXPECT_LT(worst_stamped, 1.5) << "tool tag corners vs the stamped joint state (px)";
+  EXPECT_GT(best_stale, worst_stamped + 1.5) << "a joint state 40 ms older would not fit";
 
   EXPECT_EQ(arflex_host_stop(&camera_, kCall), 0);
   EXPECT_EQ(arflex_host_stop(&robot_, kCall), 0);
