@@ -144,7 +144,6 @@ public final class ControlBlock implements AutoCloseable {
         }
         ShmSegment s = ShmSegment.create(name, SIZE);
         try {
-            s.putLong(OFF_MAGIC, MAGIC);
             s.buffer().putShort(OFF_ABI_MAJOR, (short) ABI_MAJOR);
             s.buffer().putShort(OFF_ABI_MINOR, (short) ABI_MINOR);
             s.putInt(OFF_HEADER_SIZE, OFF_STATS);
@@ -176,6 +175,8 @@ public final class ControlBlock implements AutoCloseable {
                 // control.h: before the spawn the manager may set RESET_REQUIRED.
                 s.putInt(OFF_FLAGS, FLAG_RESET_REQUIRED);
             }
+            // ABI.md 6.1: magic last (release), then the runtime heartbeat.
+            s.setLongRelease(OFF_MAGIC, MAGIC);
             s.setLongRelease(OFF_RUNTIME_HB, Posix.monotonicNs());
             return new ControlBlock(s);
         } catch (RuntimeException e) {

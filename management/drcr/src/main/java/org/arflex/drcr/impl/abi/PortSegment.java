@@ -85,7 +85,6 @@ public final class PortSegment implements AutoCloseable {
         }
         long size = segmentSize(method, elemSize, d);
         ShmSegment s = ShmSegment.create(name, size);
-        s.putLong(OFF_MAGIC, MAGIC);
         s.buffer().putShort(OFF_ABI_MAJOR, (short) ControlBlock.ABI_MAJOR);
         s.buffer().putShort(OFF_ABI_MINOR, (short) ControlBlock.ABI_MINOR);
         s.putInt(OFF_HEADER_SIZE, HDR_SIZE);
@@ -99,6 +98,7 @@ public final class PortSegment implements AutoCloseable {
         s.buffer().putShort(OFF_TYPE_MINOR, (short) typeMinor);
         s.putLong(OFF_TYPE_HASH, typeHash(typeName));
         s.putString(OFF_TYPE_NAME, TYPE_NAME_SIZE, typeName);
+        s.setLongRelease(OFF_MAGIC, MAGIC); // ABI.md 6.1: header magic last
         return new PortSegment(s);
     }
 

@@ -321,9 +321,14 @@ public final class ProcessLauncher implements RtLauncher {
                     // no answer: the deadline below and SIGKILL take over
                 }
                 try {
+                    // ABI.md 6.1: SHUTDOWN, then SIGTERM (the RT half stops and exits cleanly),
+                    // then SIGKILL, each after a deadline.
                     if (!process.waitFor(deadlineMs, TimeUnit.MILLISECONDS)) {
-                        process.destroyForcibly();
-                        process.waitFor(deadlineMs, TimeUnit.MILLISECONDS);
+                        process.destroy();
+                        if (!process.waitFor(deadlineMs, TimeUnit.MILLISECONDS)) {
+                            process.destroyForcibly();
+                            process.waitFor(deadlineMs, TimeUnit.MILLISECONDS);
+                        }
                     }
                 } catch (InterruptedException e) {
                     process.destroyForcibly();
