@@ -36,6 +36,7 @@ HIST_BIN_NS = 500
 HIST_NBINS = 200  # 0..100 us, then overflow
 
 children = []  # Popen objects in their own sessions, killed by group on exit
+WORK = []  # the work directory once made (removed on success and on interruption)
 
 
 class BenchError(Exception):
@@ -137,6 +138,31 @@ def patched_probe_jar(src, dst, cpu, priority):
                     raise BenchError(f"{src}: cannot set priority/cpus in {name}")
                 data = text.encode()
             zout.writestr(info, data)
+
+
+def cpu_times(cpu):
+    """(steal, irq+softirq, total) jiffies of one CPU from /proc/stat."""
+    try:
+        with open("/proc/stat") as f:
+            for line in f:
+                if line.startswith(f"cpu{cpu} "):
+                    v = [int(x) for x in line.split()[1:]]
+                    return v[7] if len(v) > 7 else 0, v[5] + v[6], sum(v)
+    except OSError:
+        pass
+    return 0, 0, 0
+
+
+def block(fn, cpu, *args):
+    """Runs one contender's block and records the bench CPU's steal and interrupt time in it
+    (hypervisor steal explains the multi-millisecond outliers on a VM)."""
+    s0, i0, t0 = cpu_times(cpu)
+    w0 = time.monotonic()
+    r = fn(*args)
+    s1, i1, t1 = cpu_times(cpu)
+    r["cpu_time"] = {"seconds": round(time.monotonic() - w0, 2), "steal_jiffies": s1 - s0,
+                     "irq_jiffies": i1 - i0, "total_jiffies": t1 - t0}
+    return r
 
 
 def run_probe(rt, jar, reader, n, cpu_other, work, tag):
@@ -313,11 +339,12 @@ def summarise(res, obs):
                                        "p99_9": dl["p99_9"]}},
                 "overruns": long_["overruns"],
                 "note": "separate runs of 4000 (Table 1) and of the long length (exact, from the tool's JSON)",
+                "cpu_time": {"table1": short.get("cpu_time"), "long": long_.get("cpu_time")},
             }
         else:
             out[c] = {"wakeup": {"table1": stats.table1(r["lat"][:obs]), "long": stats.long_run(r["lat"])},
                       "deviation": {"table1": stats.table1(r["dev"][:obs - 1]), "long": stats.long_run(r["dev"])},
-                      "overruns": r["overruns"]}
+                      "overruns": r["overruns"], "cpu_time": r.get("cpu_time")}
             if c == "probe":
                 out[c]["overruns_from_samples"] = r["overruns_from_samples"]
                 out[c]["control_block"] = (r["reader"].get("ctl") or {})
@@ -349,6 +376,23 @@ def print_table(summary, modes, obs, dur):
                 print(f"{label:<28}{fmt(t['average']):>10}{fmt(t['avedev']):>10}{fmt(t['min']):>10}"
                       f"{fmt(t['max']):>11}  |{fmt(lg['p50']):>9}{fmt(lg['p99']):>10}{fmt(lg['p99_9']):>10}"
                       f"{fmt(lg['max']):>11}{fmt(s['overruns']):>9}")
+
+
+def print_cpu_time(summary, modes, cpu):
+    hz = os.sysconf("SC_CLK_TCK") or 100
+    print()
+    print(f"CPU {cpu} time stolen by the hypervisor / spent in interrupts during each long block (ms)")
+    for mode in modes:
+        parts = []
+        for c in CONTENDERS:
+            ct = (summary[mode].get(c) or {}).get("cpu_time")
+            if isinstance(ct, dict) and "long" in ct:
+                ct = ct["long"]
+            if ct:
+                parts.append(f"{c}: {ct['steal_jiffies'] * 1000 // hz} / {ct['irq_jiffies'] * 1000 // hz}"
+                             f" in {ct['seconds']:.0f} s")
+        la = summary[mode].get("load_average_at_end")
+        print(f"  {mode:<16}" + ";  ".join(parts) + (f"  (load average {la[0]:.1f})" if la else ""))
 
 
 def targets(summary, modes):
@@ -450,6 +494,7 @@ def main():
     work = os.path.join(a.out, f"latency-work-{a.rid}")
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(work)
+    WORK.append(work)
     info = machine_info(a.cpu)
     if not info["root"]:
         log("not root: SCHED_FIFO and mlockall will be refused; the figures are SCHED_OTHER figures")
@@ -475,17 +520,20 @@ def main():
                 time.sleep(2)
             elif mode == "reconfiguration":
                 reconf = Reconfiguration(rt, dummy_jar, update_jar)
+                reconf_t0 = time.monotonic()
                 reconf.start()
                 time.sleep(2)
             try:
                 res = {}
                 log(f"  probe ({n_long} cycles)")
-                res["probe"] = run_probe(rt, probe_jar, reader, n_long, cpu_other, work, mode)
+                res["probe"] = block(run_probe, a.cpu, rt, probe_jar, reader, n_long, cpu_other, work, mode)
                 log(f"  pure C ({a.observations} + {n_long} cycles)")
-                res["pure C"] = {"short": run_baseline(baseline, a.observations, a.cpu, a.priority, work, mode),
-                                 "long": run_baseline(baseline, n_long, a.cpu, a.priority, work, mode)}
+                res["pure C"] = {"short": block(run_baseline, a.cpu, baseline, a.observations, a.cpu, a.priority,
+                                                work, mode),
+                                 "long": block(run_baseline, a.cpu, baseline, n_long, a.cpu, a.priority, work, mode)}
                 log(f"  cyclictest ({n_long} cycles)")
-                res["cyclictest"] = run_cyclictest(n_long, a.cpu, a.priority, cpu_other, work, mode)
+                res["cyclictest"] = block(run_cyclictest, a.cpu, n_long, a.cpu, a.priority, cpu_other, work, mode)
+                res["load_average"] = os.getloadavg()
                 results[mode] = res
             finally:
                 if load is not None:
@@ -493,13 +541,19 @@ def main():
                     children.remove(load)
                 if reconf is not None:
                     reconf.finish()
-                    reconf_counts = dict(reconf.counts, first_error=reconf.first_error)
+                    reconf_counts = dict(reconf.counts, first_error=reconf.first_error,
+                                         seconds=round(time.monotonic() - reconf_t0, 1))
     finally:
         if rt is not None:
             rt.close()
 
-    summary = {m: summarise(results[m], a.observations) for m in modes}
+    summary = {}
+    for m in modes:
+        la = results[m].pop("load_average")
+        summary[m] = summarise(results[m], a.observations)
+        summary[m]["load_average_at_end"] = la
     print_table(summary, modes, a.observations, a.duration)
+    print_cpu_time(summary, modes, a.cpu)
     rows = targets(summary, modes)
     print_targets(rows)
     if reconf_counts:
@@ -520,6 +574,7 @@ def main():
            "machine": info, "seed": a.seed,
            "options": {"cpu": a.cpu, "priority": a.priority, "period_ns": PERIOD_NS, "duration_s": a.duration,
                        "observations": a.observations, "modes": modes, "quick": a.quick, "runtime_id": a.rid,
+                       "native_dir": a.native_dir, "runtime_dir": a.runtime_dir,
                        "stress_ng": stress_args("T", a.seed, "<work>") if "stress" in modes else None,
                        "schedule": "interleaved per mode: probe, pure C (4000 then long), cyclictest",
                        "cyclictest": f"cyclictest -m -p {a.priority} -a {a.cpu} -t 1 -d 0 -i 1000 -l N -v -N"},
@@ -557,10 +612,14 @@ if __name__ == "__main__":
     except KeyboardInterrupt:
         log("interrupted: cleaning up")
         cleanup_children()
+        for w in WORK:
+            shutil.rmtree(w, ignore_errors=True)
         sys.exit(130)
     except (BenchError, RuntimeError_) as e:
         cleanup_children()
         log(f"error: {e}")
+        if WORK:
+            log(f"work files kept for diagnosis in {WORK[0]} (runtime.log, raw samples)")
         sys.exit(1)
     finally:
         cleanup_children()
