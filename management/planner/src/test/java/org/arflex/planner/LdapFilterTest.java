@@ -25,7 +25,9 @@ class LdapFilterTest {
         assertTrue(m("(vendor=ABB Robotics)"), "keys are case-insensitive");
         assertTrue(m("(&(role=robot)(payload>=4))"));
         assertFalse(m("(payload<=4.5)"));
-        assertTrue(m("(payload=5)"), "numbers compare as numbers");
+        assertFalse(m("(payload=5)"), "= compares text exactly (spec 6.6)");
+        assertTrue(m("(payload=5.0)"));
+        assertTrue(m("(payload>=5)"), ">= compares numbers as numbers");
         assertTrue(m("(|(role=camera)(role=robot))"));
         assertTrue(m("(!(role=camera))"));
         assertTrue(m("(vendor=*)"));
@@ -45,7 +47,8 @@ class LdapFilterTest {
         assertEquals(Optional.empty(), LdapFilter.parse("(|(role=robot)(role=camera))").equalityHint());
         assertEquals(Optional.empty(), LdapFilter.parse("(!(role=robot))").equalityHint());
         assertEquals(Optional.empty(), LdapFilter.parse("(&(!(role=robot)))").equalityHint());
-        assertEquals(Optional.empty(), LdapFilter.parse("(payload=5)").equalityHint(), "numeric: 5 equals 5.0");
+        assertEquals(Optional.of("payload=5"), LdapFilter.parse("(payload=5)").equalityHint());
+        assertEquals(Optional.empty(), LdapFilter.parse("(name=cam*)").equalityHint());
     }
 
     @Test

@@ -105,18 +105,15 @@ public final class LdapFilter {
         return actual.compareTo(wanted);
     }
 
+    /** {@code =} compares text exactly, as the contract spec says (section 6.6). */
     private static boolean equalValue(String actual, String wanted) {
-        if (actual.equals(wanted)) {
-            return true;
-        }
-        return numeric(actual) && numeric(wanted)
-                && Double.parseDouble(actual.trim()) == Double.parseDouble(wanted.trim());
+        return actual.equals(wanted);
     }
 
     /**
      * An equality every matching attribute set must satisfy, as {@code lower-case-key=value},
      * for indexing: the filter itself or an operand of a top-level {@code &} of the form
-     * {@code (key=value)} with a non-numeric value and no wildcard. Empty when there is none.
+     * {@code (key=value)} without wildcard. Empty when there is none.
      */
     public java.util.Optional<String> equalityHint() {
         return java.util.Optional.ofNullable(hint);
@@ -241,7 +238,7 @@ public final class LdapFilter {
             List<String> pieces = value(true);
             if (pieces.size() == 1) {
                 String v = pieces.get(0);
-                if (necessary && hint == null && !numeric(v)) {
+                if (necessary && hint == null) {
                     hint = attr.toLowerCase(Locale.ROOT) + "=" + v;
                 }
                 return a -> {

@@ -251,6 +251,8 @@ public final class PlannerBench {
         long touchedAdd = 0;
         long touchedReplace = 0;
         long touchedRemoveMid = 0;
+        long maxTouchedRemoveMid = 0;
+        long maxDownRemoveMid = 0;
         for (int k = 0; k < incReps; k++) {
             Contract leaf = leaf("leaf" + k, rnd.nextInt(n));
             add.start();
@@ -273,6 +275,8 @@ public final class PlannerBench {
             d = r.remove(bumped.name());
             removeMid.stop();
             touchedRemoveMid += d.touched();
+            maxTouchedRemoveMid = Math.max(maxTouchedRemoveMid, d.touched());
+            maxDownRemoveMid = Math.max(maxDownRemoveMid, d.becameUnsatisfied().size());
             putBack.start();
             r.put(old);
             putBack.stop();
@@ -280,8 +284,8 @@ public final class PlannerBench {
         rows.add(row(n, "add one (leaf)", add, Map.of("meanTouched", touchedAdd / (double) incReps)));
         rows.add(row(n, "remove one (leaf)", remove, Map.of()));
         rows.add(row(n, "replace one (middle)", replace, Map.of("meanTouched", touchedReplace / (double) incReps)));
-        rows.add(row(n, "remove one (middle)", removeMid,
-                Map.of("meanTouched", touchedRemoveMid / (double) incReps)));
+        rows.add(row(n, "remove one (middle)", removeMid, Map.of("meanTouched", touchedRemoveMid / (double) incReps,
+                "maxTouched", maxTouchedRemoveMid, "maxBecameUnsatisfied", maxDownRemoveMid)));
         rows.add(row(n, "put it back (middle)", putBack, Map.of()));
 
         // A whole plan of one change (dry run): resolver change, admission of all, plan, undo.
