@@ -67,6 +67,11 @@ final class Runtime implements AutoCloseable {
 
     /** A runtime with a given runtime id (null: a fresh unique one). */
     Runtime(String name, String fixedRid) throws IOException, InterruptedException {
+        this(name, fixedRid, true);
+    }
+
+    /** @param waitForDrcr false: do not wait for the DRCR (a test that expects it to refuse to start) */
+    Runtime(String name, String fixedRid, boolean waitForDrcr) throws IOException, InterruptedException {
         Path assembly = Path.of(System.getProperty("arflex.it.runtime"));
         if (!Files.isRegularFile(assembly.resolve("bin/felix.jar"))) {
             fail("runtime assembly not found at " + assembly + " (build management/runtime first)");
@@ -89,8 +94,11 @@ final class Runtime implements AutoCloseable {
         stdin = new OutputStreamWriter(process.getOutputStream(), StandardCharsets.UTF_8);
         pump(new BufferedReader(new InputStreamReader(process.getInputStream(), StandardCharsets.UTF_8)), true);
         pump(new BufferedReader(new InputStreamReader(process.getErrorStream(), StandardCharsets.UTF_8)), false);
+        this.expectDrcr = waitForDrcr;
         // The DRCR is ready when arflex:dto answers with JSON.
-        waitUntil("the DRCR to start", 60_000, () -> cmd("arflex:dto").startsWith("{"));
+        if (waitForDrcr) {
+            waitUntil("the DRCR to start", 60_000, () -> cmd("arflex:dto").startsWith("{"));
+        }
     }
 
     private void pump(BufferedReader r, boolean stdout) {
@@ -285,6 +293,7 @@ final class Runtime implements AutoCloseable {
     }
 
     private boolean crashed;
+    private boolean expectDrcr = true;
 
     /** Kills the runtime's JVM with SIGKILL (its RT halves stay behind, as after a real crash). */
     void crash() throws InterruptedException {
@@ -324,6 +333,10 @@ final class Runtime implements AutoCloseable {
             process.descendants().forEach(ProcessHandle::destroyForcibly);
         }
         synchronized (log) {
+            if (!expectDrcr) {
+                deleteTree(dir);
+                return; // a runtime whose DRCR was expected to refuse to start
+            }
             List<String> thrown = log.stream().filter(l -> l.contains("at org.arflex.drcr")).toList();
             assertTrue(thrown.isEmpty(), "stack traces of the DRCR in the runtime log:\n" + tail());
         }

@@ -124,4 +124,21 @@ class SupervisionIT {
         Object st = rt.instance("sample-counter").get("stats");
         return st instanceof java.util.Map<?, ?> m ? ((Number) m.get("cycles")).longValue() : 0;
     }
+
+    @Test
+    void aSecondRuntimeWithTheSameIdRefusesAndTouchesNothing() throws Exception {
+        String rid = "itdup" + ProcessHandle.current().pid();
+        try (Runtime first = new Runtime("dup-a", rid)) {
+            first.installAndStart(CellIT.COUNTER);
+            first.awaitState("ACTIVE", CellIT.T, "sample-counter");
+            long pid = first.pid("sample-counter");
+            try (Runtime second = new Runtime("dup-b", rid, false)) {
+                second.waitUntil("the second DRCR to refuse", CellIT.T,
+                        () -> second.logContains("is in use by the live runtime"));
+            }
+            assertEquals("ACTIVE", first.state("sample-counter"));
+            assertEquals(pid, first.pid("sample-counter"), "the first runtime's RT half must be untouched");
+            assertFalse(first.shmObjects().isEmpty());
+        }
+    }
 }

@@ -41,8 +41,20 @@ final class Sweeper {
         return m.matches() && !Files.exists(Path.of("/proc", m.group(1)));
     }
 
-    /** Sweeps; returns the names removed. */
+    /**
+     * Sweeps; returns the names removed.
+     *
+     * @throws IllegalStateException when a live runtime uses our runtime id (nothing is touched)
+     */
     static List<String> sweep(String ownRid, Consumer<String> log) {
+        // First pass: refuse before touching anything when the id belongs to a live runtime.
+        try (DirectoryStream<Path> ds = Files.newDirectoryStream(Path.of("/dev/shm"), "arflex." + ownRid + ".*.ctl")) {
+            for (Path p : ds) {
+                checkOwner(p, ownRid);
+            }
+        } catch (IOException e) {
+            log.accept("arflex: cannot list /dev/shm: " + e.getMessage());
+        }
         List<String> removed = new ArrayList<>();
         List<String[]> instances = new ArrayList<>();
         try (DirectoryStream<Path> ds = Files.newDirectoryStream(Path.of("/dev/shm"), "arflex.*")) {
@@ -89,6 +101,52 @@ final class Sweeper {
         return removed;
     }
 
+    /** Another live runtime uses our runtime id. */
+    static final class IdInUse extends IllegalStateException {
+        private static final long serialVersionUID = 1L;
+
+        IdInUse(String m) {
+            super(m);
+        }
+    }
+
+    private static void checkOwner(Path ctl, String rid) throws IOException {
+        try (FileChannel ch = FileChannel.open(ctl, StandardOpenOption.READ)) {
+            ByteBuffer b = ByteBuffer.allocate(64).order(ByteOrder.LITTLE_ENDIAN);
+            ch.read(b, 0);
+            int pid = b.getInt(ControlBlock.OFF_PID);
+            Path cmdline = Path.of("/proc", Integer.toString(pid), "cmdline");
+            if (pid <= 1 || !Files.exists(cmdline)) {
+                return;
+            }
+            String cl = new String(Files.readAllBytes(cmdline), StandardCharsets.UTF_8).replace('\0', ' ');
+            long parent = parentOf(pid);
+            if (cl.contains("--runtime " + rid + " ") && parent > 1 && parent != ProcessHandle.current().pid()
+                    && isJava(parent)) {
+                throw new IdInUse("runtime id '" + rid + "' is in use by the live runtime pid " + parent
+                        + " (its RT half pid " + pid + "); set another arflex.runtime.id");
+            }
+        }
+    }
+
+    private static long parentOf(int pid) throws IOException {
+        for (String line : Files.readAllLines(Path.of("/proc", Integer.toString(pid), "status"))) {
+            if (line.startsWith("PPid:")) {
+                return Long.parseLong(line.substring(5).trim());
+            }
+        }
+        return 0;
+    }
+
+    private static boolean isJava(long pid) {
+        try {
+            String exe = Files.readSymbolicLink(Path.of("/proc", Long.toString(pid), "exe")).getFileName().toString();
+            return exe.equals("java");
+        } catch (IOException | RuntimeException e) {
+            return false;
+        }
+    }
+
     private static void killOrphan(Path ctl, String rid, Consumer<String> log) {
         try (FileChannel ch = FileChannel.open(ctl, StandardOpenOption.READ)) {
             ByteBuffer b = ByteBuffer.allocate(64).order(ByteOrder.LITTLE_ENDIAN);
@@ -106,9 +164,17 @@ final class Sweeper {
             }
             String cl = new String(Files.readAllBytes(cmdline), StandardCharsets.UTF_8).replace('\0', ' ');
             if (cl.contains("--runtime " + rid + " ")) {
+                long parent = parentOf(pid);
+                if (parent > 1 && parent != ProcessHandle.current().pid() && isJava(parent)) {
+                    // its runtime is alive: this id is in use, and nothing of it may be touched
+                    throw new IdInUse("runtime id '" + rid + "' is in use by the live runtime pid " + parent
+                            + " (its RT half pid " + pid + " runs " + cl.trim() + "); set another arflex.runtime.id");
+                }
                 Posix.LIBC.kill(pid, Posix.SIGKILL);
                 log.accept("arflex: killed orphaned RT half pid " + pid + " (" + cl.trim() + ")");
             }
+        } catch (IdInUse e) {
+            throw e;
         } catch (IOException | RuntimeException e) {
             log.accept("arflex: cannot inspect " + ctl + ": " + e.getMessage());
         }
