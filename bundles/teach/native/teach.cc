@@ -1,7 +1,8 @@
 // teach - RT half of the teach component (README.md): in teach mode the arm yields to a
 // guiding hand (Cartesian admittance M a + D v = F_ext on the TCP position, orientation held,
 // the tool's weight compensated with the nominal model) and the path is recorded; a rising
-// edge of `save` writes it as a program file that trajectory replays.
+// edge of `save` writes it as a program file that trajectory replays (start, via points, ptp:
+// one smooth motion through every recorded point).
 //
 // Ports: in joint_state (arflex.JointState), in wrench (arflex.Wrench), out joint_ref
 // (arflex.JointRef). Recording: a preallocated buffer of kMaxPoints joint waypoints, a new one
@@ -73,7 +74,8 @@ void* Writer(void*) {
     }
     for (size_t i = 1; i < n; ++i) {
       arflex::cellkin::Motion m{};
-      m.kind = arflex::cellkin::Motion::kPtp;
+      // One smooth motion through every recorded point, ending (at rest) on the last one.
+      m.kind = i + 1 < n ? arflex::cellkin::Motion::kVia : arflex::cellkin::Motion::kPtp;
       for (int j = 0; j < 6; ++j) m.v[j] = g.points[i][j];
       m.speed = 1.0;
       p.motions.push_back(m);

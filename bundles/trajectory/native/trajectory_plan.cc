@@ -9,6 +9,7 @@ namespace traj {
 namespace {
 constexpr double kQuinticV = 1.875;               // peak s' * T
 constexpr double kQuinticA = 5.773502691896258;   // peak s'' * T^2 (10 / sqrt(3))
+constexpr double kCornerRad = 30.0 * 3.14159265358979323846 / 180.0;
 }  // namespace
 
 Limits DefaultLimits() {
@@ -80,12 +81,97 @@ void Player::Init(const Q& q0) {
   initialized_ = true;
 }
 
+Q Player::PathPoint(size_t i) const {
+  if (i == 0) return q0_;
+  const cellkin::Motion& m = prog_->motions[run_begin_ + i - 1];
+  Q q;
+  for (int j = 0; j < 6; ++j) q[j] = m.v[j];
+  return q;
+}
+
+Q Player::Tangent(size_t i) const {
+  const size_t n = run_n_;  // points 0..n
+  if (i == 0) return (PathPoint(1) - PathPoint(0)) / std::max(Chord(0), 1e-12);
+  if (i == n) return (PathPoint(n) - PathPoint(n - 1)) / std::max(Chord(n - 1), 1e-12);
+  return (PathPoint(i + 1) - PathPoint(i - 1)) / std::max(Chord(i - 1) + Chord(i), 1e-12);
+}
+
+void Player::Hermite(size_t i, double u, Q* q, Q* d1, Q* d2) const {
+  const Q a = PathPoint(i), b = PathPoint(i + 1);
+  const double l = std::max(Chord(i), 1e-12);
+  const Q ma = Tangent(i) * l, mb = Tangent(i + 1) * l;
+  const double u2 = u * u, u3 = u2 * u;
+  if (q)
+    *q = (2 * u3 - 3 * u2 + 1) * a + (u3 - 2 * u2 + u) * ma + (-2 * u3 + 3 * u2) * b +
+         (u3 - u2) * mb;
+  if (d1)
+    *d1 = ((6 * u2 - 6 * u) * a + (3 * u2 - 4 * u + 1) * ma + (-6 * u2 + 6 * u) * b +
+           (3 * u2 - 2 * u) * mb) / l;
+  if (d2)
+    *d2 = ((12 * u - 6) * a + (6 * u - 4) * ma + (-12 * u + 6) * b + (6 * u - 2) * mb) / (l * l);
+}
+
 bool Player::StartSegment(const Limits& lim) {
   const size_t n = prog_->motions.size();
   for (size_t tries = 0; tries <= n; ++tries) {
     if (idx_ >= n) return false;
     const cellkin::Motion& m = prog_->motions[idx_];
     tau_ = 0;
+    path_ = false;
+    if (m.kind == cellkin::Motion::kVia) {
+      // The run: via points up to and including the closing ptp (the parser guarantees it).
+      run_begin_ = idx_;
+      size_t k = idx_;
+      q0_ = q_plan_;
+      // The run ends at the closing ptp, or earlier at a sharp corner (a via point where the
+      // path turns by more than kCornerRad): the arm stops there, and the straight stretches
+      // are not slowed down by the corner's curvature.
+      run_n_ = 1;
+      while (prog_->motions[k].kind == cellkin::Motion::kVia) {
+        run_n_ = k - idx_ + 1;
+        const Q in = PathPoint(run_n_) - PathPoint(run_n_ - 1);
+        Q out;
+        for (int j = 0; j < 6; ++j) out[j] = prog_->motions[k + 1].v[j] - prog_->motions[k].v[j];
+        const double c = in.norm() * out.norm();
+        if (c > 0 && in.dot(out) < std::cos(kCornerRad) * c) break;
+        ++k;
+      }
+      run_n_ = k - idx_ + 1;
+      path_len_ = 0;
+      double speed = 1.0;
+      Q dmax = Q::Zero(), kmax = Q::Zero();
+      for (size_t i = 0; i < run_n_; ++i) {
+        path_len_ += Chord(i);
+        speed = std::min(speed, prog_->motions[run_begin_ + i].speed);
+        if (Chord(i) <= 0) continue;
+        for (int s = 0; s <= 8; ++s) {
+          Q d1, d2;
+          Hermite(i, s / 8.0, nullptr, &d1, &d2);
+          dmax = dmax.cwiseMax(d1.cwiseAbs());
+          kmax = kmax.cwiseMax(d2.cwiseAbs());  // linear in u: the ends bound it exactly
+        }
+      }
+      // |q'| sigma' <= v_j and |q''| sigma'^2 + |q'| sigma'' <= a_j (half each); 5 % margin
+      // on the sampled first derivative.
+      double sd_max = 1e9, sdd_max = 1e9;
+      for (int j = 0; j < 6; ++j) {
+        const double d = dmax[j] * 1.05, kk = kmax[j];
+        if (d > 0) sd_max = std::min(sd_max, lim.vmax[j] * lim.speed * speed / d);
+        if (kk > 0) sd_max = std::min(sd_max, std::sqrt(0.5 * lim.accel / kk));
+        if (d > 0) sdd_max = std::min(sdd_max, 0.5 * lim.accel / d);
+      }
+      shape_ = path_len_ > 0 ? PlanShape(lim.profile, path_len_ / sd_max, path_len_ / sdd_max)
+                             : Shape();
+      path_ = true;
+      cursor_ = 0;
+      cursor_sigma_ = 0;
+      if (shape_.T <= 0) {
+        idx_ = run_begin_ + run_n_;  // already at every point
+        continue;
+      }
+      active_ = true;
+      return true;
+    }
     if (m.kind == cellkin::Motion::kPtp) {
       double rv = 0, ra = 0;
       q0_ = q_plan_;
@@ -126,6 +212,22 @@ bool Player::StartSegment(const Limits& lim) {
 void Player::Evaluate() {
   const cellkin::Motion& m = prog_->motions[idx_];
   const double s = shape_.Eval(tau_);
+  if (path_) {
+    if (tau_ >= shape_.T) {
+      q_plan_ = PathPoint(run_n_);  // exactly on the end
+      return;
+    }
+    const double sigma = s * path_len_;
+    // sigma only grows within a motion: move the cursor forward.
+    while (cursor_ + 1 < run_n_ && sigma > cursor_sigma_ + Chord(cursor_)) {
+      cursor_sigma_ += Chord(cursor_);
+      ++cursor_;
+    }
+    const double l = Chord(cursor_);
+    const double u = l > 0 ? std::min(1.0, std::max(0.0, (sigma - cursor_sigma_) / l)) : 1.0;
+    Hermite(cursor_, u, &q_plan_, nullptr, nullptr);
+    return;
+  }
   if (m.kind == cellkin::Motion::kPtp) {
     q_plan_ = q0_ + s * dq_;
     if (tau_ >= shape_.T)
@@ -172,7 +274,8 @@ void Player::Step(const Limits& lim, double target_rate, bool loop) {
       Evaluate();
       if (tau_ >= shape_.T) {
         active_ = false;
-        ++idx_;
+        idx_ = path_ ? run_begin_ + run_n_ : idx_ + 1;
+        path_ = false;
       }
     }
   }

@@ -8,6 +8,13 @@
 //  - lin: the TCP moves on a straight line (orientation by slerp) with the same profile,
 //    duration from lin_speed / lin_accel (and 1 rad/s, 2 rad/s^2 for the rotation); joint
 //    angles from damped least-squares IK seeded with the previous cycle's solution.
+//  - via ... ptp: one smooth motion through every via point to the ptp target: a C1 cubic
+//    Hermite spline in joint space over the chord length sigma (Catmull-Rom-like tangents),
+//    passing exactly through each point, traversed as sigma = L s(tau); the speed and
+//    acceleration caps on sigma come from bounds of |dq/dsigma| and |d2q/dsigma2| computed when
+//    the motion begins (no storage: the points are read from the program). A via point where
+//    the path turns by more than 30 degrees ends the smooth stretch (the arm stops there), so
+//    one sharp corner does not slow the whole path down.
 //  - wait: holds.
 // Pausing and safety stops scale the time of the profile (tau += rate * dt, the rate ramps
 // to its target within stop_time), so a stop decelerates along the path instead of leaving
@@ -78,6 +85,12 @@ class Player {
 
  private:
   bool StartSegment(const Limits& lim);
+  // Path mode (a run of via points ending with a ptp): point i of the path, 0 = start.
+  Q PathPoint(size_t i) const;
+  double Chord(size_t i) const { return (PathPoint(i + 1) - PathPoint(i)).norm(); }
+  Q Tangent(size_t i) const;
+  // Position, first and second derivative (by sigma) on segment i at u in [0, 1].
+  void Hermite(size_t i, double u, Q* q, Q* d1, Q* d2) const;
   void Evaluate();
   void Limit(const Limits& lim);
 
@@ -95,6 +108,10 @@ class Player {
   Eigen::Vector3d p0_ = Eigen::Vector3d::Zero(), p1_ = Eigen::Vector3d::Zero();  // lin
   Eigen::Quaterniond r0_ = Eigen::Quaterniond::Identity(), r1_ = Eigen::Quaterniond::Identity();
   Q ik_q_ = Q::Zero();
+  bool path_ = false;
+  size_t run_begin_ = 0, run_n_ = 0;  // motions [run_begin_, run_begin_ + run_n_) ; last = ptp
+  double path_len_ = 0, cursor_sigma_ = 0;
+  size_t cursor_ = 0;
   Q q_plan_ = Q::Zero(), q_plan_prev_ = Q::Zero(), q_out_ = Q::Zero(), v_out_ = Q::Zero();
   uint64_t ik_warnings_ = 0, limited_cycles_ = 0, completed_ = 0;
 };

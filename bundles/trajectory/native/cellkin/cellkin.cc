@@ -176,7 +176,7 @@ bool ParseProgram(const std::string& text, const std::string& origin, const Mode
       return Fail(err, origin, line, "more than " + std::to_string(kMaxMotions) + " motions");
     Motion m{};
     m.line = line;
-    if (kw == "start" || kw == "ptp") {
+    if (kw == "start" || kw == "ptp" || kw == "via") {
       if (num.size() != 6)
         return Fail(err, origin, line, kw + " needs 6 joint angles (rad), got " +
                                            std::to_string(num.size()));
@@ -195,8 +195,8 @@ bool ParseProgram(const std::string& text, const std::string& origin, const Mode
         continue;
       }
       if (has_speed && !(speed > 0 && speed <= 1))
-        return Fail(err, origin, line, "ptp speed must be in (0, 1]");
-      m.kind = Motion::kPtp;
+        return Fail(err, origin, line, kw + " speed must be in (0, 1]");
+      m.kind = kw == "via" ? Motion::kVia : Motion::kPtp;
       for (int j = 0; j < 6; ++j) m.v[j] = num[j];
       m.speed = has_speed ? speed : 1.0;
     } else if (kw == "lin") {
@@ -221,12 +221,21 @@ bool ParseProgram(const std::string& text, const std::string& origin, const Mode
       m.v[0] = num[0];
     } else {
       return Fail(err, origin, line, "unknown statement '" + kw +
-                                         "' (expected start, ptp, lin or wait)");
+                                         "' (expected start, ptp, via, lin or wait)");
     }
     out->motions.push_back(m);
   }
   if (!header) return Fail(err, origin, line, "empty program (no 'arflex-program 1' header)");
   if (out->motions.empty()) return Fail(err, origin, line, "program has no motion");
+  for (size_t i = 0; i < out->motions.size(); ++i) {
+    if (out->motions[i].kind != Motion::kVia) continue;
+    size_t k = i;
+    while (k < out->motions.size() && out->motions[k].kind == Motion::kVia) ++k;
+    if (k == out->motions.size() || out->motions[k].kind != Motion::kPtp)
+      return Fail(err, origin, out->motions[i].line,
+                  "via points must be followed by a ptp (the end of the path)");
+    i = k;
+  }
   return true;
 }
 
@@ -258,7 +267,8 @@ bool WriteProgramFile(const std::string& path, const Program& p, std::string* er
   for (const Motion& m : p.motions) {
     switch (m.kind) {
       case Motion::kPtp:
-        s << "ptp";
+      case Motion::kVia:
+        s << (m.kind == Motion::kVia ? "via" : "ptp");
         for (int j = 0; j < 6; ++j) s << ' ' << m.v[j];
         if (m.speed != 1.0) s << " speed " << m.speed;
         break;

@@ -71,6 +71,9 @@ class Model {
 //   start q1 .. q6                  initial reference when no joint_state is bound (rad; once)
 //   ptp q1 .. q6 [speed f]          joint motion to the joint target (rad); f in (0, 1] scales
 //                                   the joint velocity limits for this motion (default 1)
+//   via q1 .. q6 [speed f]          a joint-space point the path passes through without
+//                                   stopping; a run of via points ends with a ptp (the path's
+//                                   end), and the whole run is one smooth motion
 //   lin x y z qw qx qy qz [speed v] Cartesian straight line of the TCP to the pose (m, unit
 //                                   quaternion w x y z, normalised on load); v (m/s) caps the
 //                                   linear speed (default: the component's lin_speed)
@@ -79,9 +82,9 @@ class Model {
 // wrong.
 
 struct Motion {
-  enum Kind { kPtp, kLin, kWait } kind;
-  double v[7];   // ptp: q[6]; lin: x y z qw qx qy qz; wait: v[0] seconds
-  double speed;  // ptp: fraction (0, 1]; lin: m/s (0 = component default)
+  enum Kind { kPtp, kLin, kWait, kVia } kind;
+  double v[7];   // ptp, via: q[6]; lin: x y z qw qx qy qz; wait: v[0] seconds
+  double speed;  // ptp, via: fraction (0, 1]; lin: m/s (0 = component default)
   int line;      // source line
 };
 

@@ -1,10 +1,11 @@
 // test_cell_unit - CTest cell.unit.*: the nominal model (cellkin) and the trajectory player,
 // in process, every cycle checked.
-//   test_cell_unit <kinematics|program|trajectory_limits|trajectory_pause|builtin>
+//   test_cell_unit <kinematics|program|trajectory_limits|trajectory_pause|trajectory_via|builtin>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <string>
+#include <vector>
 #include <unistd.h>
 
 #include "cellkin.h"
@@ -187,6 +188,89 @@ static void TestTrajectoryLimits() {
   }
 }
 
+
+// Distance from point p to the segment [a, b] (joint space, Euclidean).
+static double SegDist(const Q& p, const Q& a, const Q& b) {
+  const Q ab = b - a;
+  const double l2 = ab.squaredNorm();
+  const double t = l2 > 0 ? std::min(1.0, std::max(0.0, (p - a).dot(ab) / l2)) : 0.0;
+  return (a + t * ab - p).norm();
+}
+
+static void TestTrajectoryVia() {
+  // 40 via points on a joint-space curve and the closing ptp: one smooth motion through every
+  // point, every cycle within the limits, faster than stopping at each point.
+  Model m;
+  std::string text = "arflex-program 1\nstart 0 0.2 0.5 0 0.6 0\n";
+  std::vector<Q> pts;
+  for (int i = 1; i <= 41; ++i) {
+    const double a = i * 0.05;
+    Q q;
+    q << 0.4 * std::sin(a), 0.2 + 0.15 * (1 - std::cos(a)), 0.5 + 0.1 * std::sin(2 * a), 0.3 * a / 2,
+        0.6 - 0.2 * std::sin(a), 0.1 * a;
+    pts.push_back(q);
+    char line[256];
+    snprintf(line, sizeof(line), "%s %.12f %.12f %.12f %.12f %.12f %.12f\n", i < 41 ? "via" : "ptp",
+             q[0], q[1], q[2], q[3], q[4], q[5]);
+    text += line;
+  }
+  Program p, chain;
+  std::string err;
+  CHECK(arflex::cellkin::ParseProgram(text, "via", m, &p, &err), "%s", err.c_str());
+  std::string ptext = text;
+  for (size_t k = 0; (k = ptext.find("via", k)) != std::string::npos;) ptext.replace(k, 3, "ptp");
+  CHECK(arflex::cellkin::ParseProgram(ptext, "chain", m, &chain, &err), "%s", err.c_str());
+  for (int prof = 0; prof < 2; ++prof) {
+    traj::Limits lim = traj::DefaultLimits();
+    lim.profile = prof ? traj::kTrapezoid : traj::kQuintic;
+    traj::Player pl;
+    pl.Begin(&m, &p, 0.001);
+    pl.Init(p.start);
+    RunStats st;
+    std::vector<Q> out;
+    Q prev = pl.q_out(), prev_v = Q::Zero();
+    while (!pl.done() && st.cycles < 100000) {
+      pl.Step(lim, 1.0, false);
+      const Q v = (pl.q_out() - prev) / 0.001;
+      for (int j = 0; j < 6; ++j) {
+        st.max_v_ratio = std::max(st.max_v_ratio, std::fabs(v[j]) / lim.vmax[j]);
+        st.max_a = std::max(st.max_a, std::fabs(v[j] - prev_v[j]) / 0.001);
+      }
+      prev = pl.q_out();
+      prev_v = v;
+      out.push_back(pl.q_out());
+      st.cycles++;
+    }
+    CHECK(pl.done(), "via path did not finish");
+    double worst = 0;
+    for (const Q& w : pts) {
+      double best = 1e9;
+      for (size_t i = 1; i < out.size(); ++i) best = std::min(best, SegDist(w, out[i - 1], out[i]));
+      worst = std::max(worst, best);
+    }
+    traj::Player pc;
+    pc.Begin(&m, &chain, 0.001);
+    pc.Init(chain.start);
+    RunStats sc;
+    Run(&pc, lim, 200000, &sc);
+    printf("via (%s): %llu cycles (ptp chain %llu), through every point within %.2e rad, "
+           "max speed %.3f of vmax, max accel %.3f\n",
+           prof ? "trapezoid" : "quintic", (unsigned long long)st.cycles,
+           (unsigned long long)sc.cycles, worst, st.max_v_ratio, st.max_a);
+    CHECK(worst < 1e-6, "missed a via point by %g rad", worst);
+    CHECK(st.max_v_ratio <= 1 + 1e-9, "speed %g", st.max_v_ratio);
+    CHECK(st.max_a <= lim.accel * 1.05, "accel %g > %g", st.max_a, lim.accel);
+    CHECK(pl.limited_cycles() == 0, "limiter acted %llu times", (unsigned long long)pl.limited_cycles());
+    CHECK(st.cycles * 2 < sc.cycles, "via path not faster than stopping at each point");
+    CHECK((pl.q_out() - pts.back()).norm() < 1e-12, "end");
+  }
+  // A via run must be closed by a ptp.
+  CHECK(!arflex::cellkin::ParseProgram("arflex-program 1\nvia 0 0 0 0 0 0\nwait 1\n", "v", m, &p,
+                                       &err) &&
+            err.rfind("v:2: via points must be followed by a ptp", 0) == 0,
+        "unclosed via accepted or bad message: %s", err.c_str());
+}
+
 static double PauseRate(uint64_t k) { return (k > 700 && k < 2500) ? 0.0 : 1.0; }
 
 static void TestTrajectoryPause() {
@@ -254,7 +338,7 @@ static void TestBuiltin() {
 
 int main(int argc, char** argv) {
   if (argc != 2) {
-    fprintf(stderr, "usage: %s <kinematics|program|trajectory_limits|trajectory_pause|builtin>\n",
+    fprintf(stderr, "usage: %s <kinematics|program|trajectory_limits|trajectory_pause|trajectory_via|builtin>\n",
             argv[0]);
     return 2;
   }
@@ -263,6 +347,7 @@ int main(int argc, char** argv) {
   else if (c == "program") TestProgram();
   else if (c == "trajectory_limits") TestTrajectoryLimits();
   else if (c == "trajectory_pause") TestTrajectoryPause();
+  else if (c == "trajectory_via") TestTrajectoryVia();
   else if (c == "builtin") TestBuiltin();
   else {
     fprintf(stderr, "unknown case '%s'\n", argv[1]);
