@@ -490,12 +490,10 @@ public final class Resolver {
         // Down: what can no longer be satisfied, propagated to satisfied dependents. The
         // satisfied set left is a post-fixpoint, hence below the new greatest fixpoint.
         ArrayDeque<Node> work = new ArrayDeque<>(dirty);
-        List<Node> downgraded = new ArrayList<>();
         while (!work.isEmpty()) {
             Node n = work.poll();
             if (n.satisfied && !eval(n, ch)) {
                 setStatus(n, false, ch);
-                downgraded.add(n);
                 for (Node d : requiredDependents(n.name())) {
                     if (d.satisfied) {
                         work.add(d);
@@ -512,11 +510,9 @@ public final class Resolver {
                 grow.add(n);
             }
         }
-        for (Node n : downgraded) {
-            if (!n.satisfied && n.locallyOk && region.add(n)) {
-                grow.add(n);
-            }
-        }
+        // Nodes the down phase lowered need not be seeds: each went down because of a provider
+        // that is unsatisfied for good, or that comes up only if reachable from a dirty seed,
+        // and then the growth below reaches them too (they are unsatisfied and locally complete).
         while (!grow.isEmpty()) {
             Node n = grow.poll();
             for (Node d : requiredDependents(n.name())) {
