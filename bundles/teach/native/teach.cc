@@ -64,7 +64,11 @@ void* Writer(void*) {
   for (;;) {
     while (sem_wait(&g.sem) != 0 && errno == EINTR) {
     }
-    if (g.quit.load()) return nullptr;
+    // A save requested just before shutdown is still written; then quit.
+    if (!g.saving.load(std::memory_order_acquire)) {
+      if (g.quit.load()) return nullptr;
+      continue;
+    }
     const size_t n = g.save_count.load();
     arflex::cellkin::Program p;
     p.origin = "teach (" + std::to_string(n) + " recorded waypoints)";
@@ -97,6 +101,7 @@ void* Writer(void*) {
       g.saved++;
     }
     g.saving.store(false, std::memory_order_release);
+    if (g.quit.load()) return nullptr;
   }
 }
 
