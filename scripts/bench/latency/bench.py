@@ -98,9 +98,13 @@ def machine_info(cpu):
         v = platform.version()
         preempt = "PREEMPT_RT" if "PREEMPT_RT" in v else ("PREEMPT_DYNAMIC" if "PREEMPT_DYNAMIC" in v
                                                            else ("PREEMPT" if "PREEMPT" in v else "none"))
+    # only the boot options that bear on latency (the full line may carry unrelated settings)
+    keys = ("isolcpus", "nohz", "nohz_full", "rcu_nocbs", "preempt", "threadirqs", "idle", "processor.max_cstate",
+            "intel_idle.max_cstate", "cpuidle", "haltpoll", "mitigations", "irqaffinity", "skew_tick", "nosmt")
     try:
         with open("/proc/cmdline") as f:
-            cmdline = f.read().strip()
+            cmdline = " ".join(t for t in f.read().split() if t.split("=", 1)[0] in keys or
+                               any(t.startswith(k + ".") for k in keys))
     except OSError:
         cmdline = ""
     try:
@@ -113,7 +117,7 @@ def machine_info(cpu):
         stress_v = "missing"
     return {"kernel": f"{platform.system()} {platform.release()} {platform.version()}",
             "preemption": preempt, "cpu_model": model, "cpus_online": os.cpu_count(),
-            "bench_cpu": cpu, "kernel_cmdline": cmdline, "isolated": f"isolcpus" in cmdline,
+            "bench_cpu": cpu, "kernel_cmdline_latency_options": cmdline, "isolated": "isolcpus" in cmdline,
             "load_average_at_start": os.getloadavg(), "root": os.geteuid() == 0,
             "cyclictest": cyclictest_v, "stress_ng": stress_v, "python": platform.python_version(),
             "hostname": platform.node()}
@@ -197,8 +201,11 @@ def run_probe(rt, jar, reader, n, cpu_other, work, tag):
         raise BenchError(f"probe: samples missing (first seq {seqs[0]}, gaps {summ['seq_gaps']}): ring too small?")
     dev = [(rel[i] + lat[i]) - (rel[i - 1] + lat[i - 1]) - PERIOD_NS for i in range(1, n)]
     ctl = summ.get("ctl") or {}
-    return {"lat": lat, "dev": dev, "overruns": ctl.get("overruns"),
-            "overruns_from_samples": sum(1 for i in range(1, n) if rel[i] - rel[i - 1] > PERIOD_NS),
+    # Overruns over exactly these n cycles: a release more than one period after the previous
+    # one is a catch-up after an overrun (the control block's count, a few cycles later, is
+    # the cross-check).
+    return {"lat": lat, "dev": dev, "overruns": sum(1 for i in range(1, n) if rel[i] - rel[i - 1] > PERIOD_NS),
+            "overruns_control_block": ctl.get("overruns"),
             "reader": summ, "sched_fifo": ctl.get("sched_fifo"), "instance": inst}
 
 
@@ -346,7 +353,7 @@ def summarise(res, obs):
                       "deviation": {"table1": stats.table1(r["dev"][:obs - 1]), "long": stats.long_run(r["dev"])},
                       "overruns": r["overruns"], "cpu_time": r.get("cpu_time")}
             if c == "probe":
-                out[c]["overruns_from_samples"] = r["overruns_from_samples"]
+                out[c]["overruns_control_block"] = r["overruns_control_block"]
                 out[c]["control_block"] = (r["reader"].get("ctl") or {})
                 out[c]["stream"] = r["reader"]["stream"]
     return out
