@@ -1,6 +1,6 @@
 // test_cell_unit - CTest cell.unit.*: the nominal model (cellkin) and the trajectory player,
 // in process, every cycle checked.
-//   test_cell_unit <kinematics|program|trajectory_limits|trajectory_pause|trajectory_via|builtin>
+//   test_cell_unit <kinematics|program|trajectory_limits|trajectory_pause|trajectory_via|trajectory_loop|builtin>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -271,6 +271,39 @@ static void TestTrajectoryVia() {
         "unclosed via accepted or bad message: %s", err.c_str());
 }
 
+
+static void TestTrajectoryLoop() {
+  // loop: the program starts again from wherever it ended, without a jump.
+  Model m;
+  Program p;
+  std::string err;
+  CHECK(arflex::cellkin::ParseProgram(
+            "arflex-program 1\nstart 0 0 0 0 0 0\nptp 0.3 0.2 0.4 0 0.5 0\nptp -0.2 0.1 0.6 0.2 0.4 0.3\n",
+            "loop", m, &p, &err),
+        "%s", err.c_str());
+  traj::Limits lim = traj::DefaultLimits();
+  traj::Player pl;
+  pl.Begin(&m, &p, 0.001);
+  pl.Init(p.start);
+  Q prev = pl.q_out(), prev_v = Q::Zero();
+  double max_a = 0, max_v = 0;
+  uint64_t k = 0;
+  for (; k < 100000 && pl.completed() < 3; ++k) {
+    pl.Step(lim, 1.0, true);
+    const Q v = (pl.q_out() - prev) / 0.001;
+    for (int j = 0; j < 6; ++j) {
+      max_v = std::max(max_v, std::fabs(v[j]) / lim.vmax[j]);
+      max_a = std::max(max_a, std::fabs(v[j] - prev_v[j]) / 0.001);
+    }
+    prev = pl.q_out();
+    prev_v = v;
+  }
+  CHECK(pl.completed() == 3 && !pl.done(), "completed %llu done %d",
+        (unsigned long long)pl.completed(), pl.done());
+  CHECK(max_v <= 1 + 1e-9 && max_a <= lim.accel * 1.02, "limits v %g a %g", max_v, max_a);
+  printf("loop: 3 passes in %llu cycles, max accel %.3f\n", (unsigned long long)k, max_a);
+}
+
 static double PauseRate(uint64_t k) { return (k > 700 && k < 2500) ? 0.0 : 1.0; }
 
 static void TestTrajectoryPause() {
@@ -338,7 +371,7 @@ static void TestBuiltin() {
 
 int main(int argc, char** argv) {
   if (argc != 2) {
-    fprintf(stderr, "usage: %s <kinematics|program|trajectory_limits|trajectory_pause|trajectory_via|builtin>\n",
+    fprintf(stderr, "usage: %s <kinematics|program|trajectory_limits|trajectory_pause|trajectory_via|trajectory_loop|builtin>\n",
             argv[0]);
     return 2;
   }
@@ -348,6 +381,7 @@ int main(int argc, char** argv) {
   else if (c == "trajectory_limits") TestTrajectoryLimits();
   else if (c == "trajectory_pause") TestTrajectoryPause();
   else if (c == "trajectory_via") TestTrajectoryVia();
+  else if (c == "trajectory_loop") TestTrajectoryLoop();
   else if (c == "builtin") TestBuiltin();
   else {
     fprintf(stderr, "unknown case '%s'\n", argv[1]);
