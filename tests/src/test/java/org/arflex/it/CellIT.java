@@ -44,7 +44,9 @@ class CellIT {
     @Test
     void consumerFirstThenProviderBothActiveAndDataFlows() throws Exception {
         try (Runtime rt = new Runtime("consumer-first")) {
-            rt.installAndStart(SCALER);
+            long scaler = rt.install(SCALER);
+            rt.awaitState("INSTALLED", T, "sample-scaler"); // picked up when installed, not started
+            assertEquals("", rt.cmd("start " + scaler));
             rt.awaitState("UNSATISFIED", T, "sample-scaler");
             String why = (String) rt.instance("sample-scaler").get("failureReason");
             assertTrue(why.contains("sample-counter"), why);
@@ -198,7 +200,8 @@ class CellIT {
             rt.awaitState("ACTIVE", T, "sample-counter");
             long pid = rt.pid("sample-counter");
             assertEquals("", rt.cmd("stop " + id));
-            rt.waitUntil("sample-counter destroyed", T, () -> rt.instance("sample-counter") == null);
+            rt.awaitState("INSTALLED", T, "sample-counter");
+            assertEquals(0L, rt.pid("sample-counter"));
             assertTrue(Runtime.rtProcesses(rt.rid).isEmpty());
             assertTrue(rt.shmObjects().isEmpty(), rt.shmObjects().toString());
             assertEquals("", rt.cmd("start " + id));

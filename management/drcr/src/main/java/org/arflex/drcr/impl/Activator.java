@@ -53,7 +53,7 @@ public final class Activator implements BundleActivator {
     private Cell cell;
     private Services services;
     private ScheduledExecutorService ticker;
-    private BundleTracker<List<String>> tracker;
+    private BundleTracker<ContractExtender.Tracked> tracker;
     private final List<ServiceRegistration<?>> regs = new ArrayList<>();
     private String rid;
     private final Consumer<String> log = line -> System.err.println(LocalTime.now() + " " + line);
@@ -113,7 +113,7 @@ public final class Activator implements BundleActivator {
         }, HEARTBEAT_MS, HEARTBEAT_MS, TimeUnit.MILLISECONDS);
         ticker.scheduleAtFixedRate(() -> actor.submit(() -> rm[0].overruns(cell.sample())), SAMPLE_MS, SAMPLE_MS,
                 TimeUnit.MILLISECONDS);
-        tracker = new BundleTracker<>(ctx, Bundle.ACTIVE, new ContractExtender(cell, reader, ctx, log));
+        tracker = new BundleTracker<>(ctx, ContractExtender.MASK, new ContractExtender(cell, reader, ctx, log));
         tracker.open();
         log.accept("arflex: DRCR started, runtime id " + rid + ", cpus " + cpus + ", memory " + memory + ", network "
                 + network);

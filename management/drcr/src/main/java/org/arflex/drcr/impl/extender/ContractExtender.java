@@ -19,16 +19,25 @@ import org.osgi.framework.BundleEvent;
 import org.osgi.util.tracker.BundleTrackerCustomizer;
 
 /**
- * The extender: tracks ACTIVE bundles whose manifest has {@code ARFLEX-Contract}. When such a
- * bundle starts (by our commands, Felix's {@code start}, {@code install -s} or {@code update})
- * its contracts are read, its executables extracted into its data area and its components
- * installed; when it stops (Felix's {@code stop}, {@code uninstall}, {@code update}) they are
- * destroyed before the bundle is gone. Callbacks come on the framework's thread and wait for
+ * The extender: tracks installed bundles whose manifest has {@code ARFLEX-Contract}. When such
+ * a bundle is installed its contracts are read (a bad one is reported and skipped) and its
+ * components show as INSTALLED; when it starts (by our commands, Felix's {@code start} or
+ * {@code update}) its executables are extracted into its data area and its components
+ * installed into the cell; when it stops (Felix's {@code stop}, {@code uninstall},
+ * {@code update}) they are destroyed before the bundle is gone and show as INSTALLED again;
+ * when it is uninstalled they disappear. Callbacks come on the framework's thread and wait for
  * the actor, so Felix's command returns only when the cell has followed.
  */
-public final class ContractExtender implements BundleTrackerCustomizer<List<String>> {
+public final class ContractExtender implements BundleTrackerCustomizer<ContractExtender.Tracked> {
 
     private static final long CALL_MS = 120_000;
+
+    /** What the extender knows of one bundle. */
+    public static final class Tracked {
+        List<Contract> contracts = List.of();
+        /** Names installed into the cell while the bundle is ACTIVE; null when not active. */
+        List<String> active;
+    }
 
     private final Cell cell;
     private final ContractReader reader;
@@ -42,29 +51,88 @@ public final class ContractExtender implements BundleTrackerCustomizer<List<Stri
         this.log = log;
     }
 
+    /** The bundle states the tracker follows. */
+    public static final int MASK = Bundle.INSTALLED | Bundle.RESOLVED | Bundle.STARTING | Bundle.ACTIVE | Bundle.STOPPING;
+
     static String label(Bundle b) {
         return "bundle " + b.getBundleId() + " (" + b.getSymbolicName() + " " + b.getVersion() + ")";
     }
 
     @Override
-    public List<String> addingBundle(Bundle bundle, BundleEvent event) {
-        String header = bundle.getHeaders().get(ContractReader.HEADER);
-        if (header == null) {
+    public Tracked addingBundle(Bundle bundle, BundleEvent event) {
+        if (bundle.getHeaders().get(ContractReader.HEADER) == null) {
             return null;
         }
+        Tracked t = new Tracked();
+        read(bundle, t);
+        follow(bundle, t);
+        return t;
+    }
+
+    @Override
+    public void modifiedBundle(Bundle bundle, BundleEvent event, Tracked t) {
+        if (event != null && event.getType() == BundleEvent.UPDATED) {
+            deactivate(bundle, t);
+            forget(bundle, t);
+            read(bundle, t);
+        }
+        follow(bundle, t);
+    }
+
+    @Override
+    public void removedBundle(Bundle bundle, BundleEvent event, Tracked t) {
+        deactivate(bundle, t);
+        forget(bundle, t);
+    }
+
+    /** Active bundle: components installed; any other state: not. */
+    private void follow(Bundle bundle, Tracked t) {
+        boolean wantActive = bundle.getState() == Bundle.ACTIVE;
+        if (wantActive && t.active == null) {
+            activate(bundle, t);
+        } else if (!wantActive && t.active != null) {
+            deactivate(bundle, t);
+        }
+    }
+
+    /** Reads the bundle's contracts (problems go to the cell) and registers them as INSTALLED. */
+    private void read(Bundle bundle, Tracked t) {
+        String header = bundle.getHeaders().get(ContractReader.HEADER);
         String label = label(bundle);
         long t0 = System.nanoTime();
         ContractReader.Result r = reader.read(label, header, path -> {
             URL u = bundle.getEntry(path);
             return u == null ? null : u.openStream();
         });
-        for (String p : r.problems()) {
-            cell.actor().submit(() -> cell.problem(p));
-        }
-        long tParsed = System.nanoTime();
-        log.accept("arflex: " + label + ": contracts read in " + (tParsed - t0) / 1000 + " us");
+        log.accept("arflex: " + label + ": contracts read in " + (System.nanoTime() - t0) / 1000 + " us");
+        t.contracts = r.contracts();
+        cell.actor().call(() -> {
+            for (String p : r.problems()) {
+                cell.problem(p);
+            }
+            for (Contract c : r.contracts()) {
+                cell.register(c, bundle.getBundleId());
+            }
+            return null;
+        }, CALL_MS);
+    }
+
+    private void forget(Bundle bundle, Tracked t) {
+        List<Contract> cs = t.contracts;
+        t.contracts = List.of();
+        cell.actor().call(() -> {
+            for (Contract c : cs) {
+                cell.unregister(c.name(), bundle.getBundleId());
+            }
+            return null;
+        }, CALL_MS);
+    }
+
+    private void activate(Bundle bundle, Tracked t) {
+        String label = label(bundle);
+        long t0 = System.nanoTime();
         List<String> installed = new ArrayList<>();
-        for (Contract c : r.contracts()) {
+        for (Contract c : t.contracts) {
             Path exe;
             try {
                 exe = extract(bundle, c.executable());
@@ -78,22 +146,28 @@ public final class ContractExtender implements BundleTrackerCustomizer<List<Stri
                 installed.add(c.name());
             }
         }
-        log.accept("arflex: " + label + " started: components " + installed + " in "
-                + (System.nanoTime() - t0) / 1000 + " us");
-        return installed;
+        t.active = installed;
+        log.accept("arflex: " + label + " started: components " + installed + " in " + (System.nanoTime() - t0) / 1000
+                + " us");
     }
 
-    @Override
-    public void modifiedBundle(Bundle bundle, BundleEvent event, List<String> names) {
-        // ACTIVE -> ACTIVE: nothing to do
-    }
-
-    @Override
-    public void removedBundle(Bundle bundle, BundleEvent event, List<String> names) {
+    private void deactivate(Bundle bundle, Tracked t) {
+        List<String> names = t.active;
+        if (names == null) {
+            return;
+        }
+        t.active = null;
         String why = label(bundle) + " stopped";
+        List<Contract> cs = t.contracts;
         cell.actor().call(() -> {
             for (String n : names) {
                 cell.uninstall(n, why);
+            }
+            // the bundle is still installed: its components show as INSTALLED again
+            for (Contract c : cs) {
+                if (names.contains(c.name())) {
+                    cell.register(c, bundle.getBundleId());
+                }
             }
             return null;
         }, CALL_MS);

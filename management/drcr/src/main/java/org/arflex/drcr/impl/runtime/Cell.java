@@ -136,8 +136,64 @@ public final class Cell {
     // ---- install / uninstall ---------------------------------------------------------------
 
     /**
-     * Installs (or, for the same bundle, replaces) a component. A name already used by another
-     * bundle is refused with a problem; nothing else changes.
+     * Registers the contract of an installed bundle that is not started: the instance shows as
+     * INSTALLED and is not planned. A name already used by another bundle is refused with a
+     * problem.
+     *
+     * @return false when refused
+     */
+    public boolean register(Contract c, long bundleId) {
+        actor.checkThread();
+        Instance existing = instances.get(c.name());
+        if (existing != null) {
+            if (existing.bundleId != bundleId) {
+                problem(c.source() + ": component '" + c.name() + "' is already installed by bundle " + existing.bundleId
+                        + "; the contract of bundle " + bundleId + " is skipped");
+                return false;
+            }
+            if (!existing.planned) {
+                existing.contract = c;
+                existing.policy = new RestartPolicy(c.fault(), actor.clock());
+                existing.params = Instance.defaults(c);
+                changed();
+            }
+            return true;
+        }
+        if (!validName(c, bundleId)) {
+            return false;
+        }
+        Instance inst = new Instance(c, bundleId, null, actor, log);
+        inst.life.target(State.INSTALLED);
+        inst.life.reason("bundle " + bundleId + " is not started");
+        instances.put(c.name(), inst);
+        changed();
+        return true;
+    }
+
+    /** Forgets an INSTALLED (not started) instance of that bundle; its bundle was uninstalled or updated. */
+    public void unregister(String name, long bundleId) {
+        actor.checkThread();
+        Instance inst = instances.get(name);
+        if (inst != null && inst.bundleId == bundleId && !inst.planned) {
+            inst.life.to(State.DESTROYED, "bundle " + bundleId + " uninstalled");
+            instances.remove(name);
+            changed();
+        }
+    }
+
+    private boolean validName(Contract c, long bundleId) {
+        if (c.name().length() > 40) {
+            problem(c.source() + ": component name '" + c.name() + "' is longer than 40 characters, the limit of "
+                    + "shared object names (rt-core ABI); skipped");
+            return false;
+        }
+        return true;
+    }
+
+    /**
+     * Installs a component whose bundle started (or, when it is planned already, replaces its
+     * contract). A name already used by another bundle is refused with a problem; nothing else
+     * changes.
      *
      * @return false when refused
      */
@@ -149,14 +205,13 @@ public final class Cell {
                     + "; the contract of bundle " + bundleId + " is skipped");
             return false;
         }
-        if (c.name().length() > 40) {
-            problem(c.source() + ": component name '" + c.name() + "' is longer than 40 characters, the limit of "
-                    + "shared object names (rt-core ABI); skipped");
+        if (existing == null && !validName(c, bundleId)) {
             return false;
         }
+        boolean replace = existing != null && existing.planned;
         Plan plan;
         try {
-            plan = planner.apply(existing != null ? Change.replace(c) : Change.install(c));
+            plan = planner.apply(replace ? Change.replace(c) : Change.install(c));
         } catch (RuntimeException e) {
             problem(c.source() + ": planner refused '" + c.name() + "': " + e.getMessage());
             return false;
@@ -170,8 +225,11 @@ public final class Cell {
             inst.executable = exe;
             inst.policy = new RestartPolicy(c.fault(), actor.clock());
             inst.params = Instance.defaults(c);
-            closeOutputs(inst);
+            if (replace) {
+                closeOutputs(inst);
+            }
         }
+        inst.planned = true;
         inst.life.target(State.ACTIVE);
         inst.life.to(State.UNSATISFIED, "resolving");
         log.accept("arflex: " + plan.title() + "\n" + plan.toText());
@@ -189,12 +247,12 @@ public final class Cell {
         }
         inst.life.target(State.DESTROYED);
         cancelRestart(inst);
-        Plan plan;
-        try {
-            plan = planner.apply(Change.uninstall(name));
-            execute(plan);
-        } catch (RuntimeException e) {
-            log.accept("arflex: planner failed on uninstall of " + name + ": " + e);
+        if (inst.planned) {
+            try {
+                execute(planner.apply(Change.uninstall(name)));
+            } catch (RuntimeException e) {
+                log.accept("arflex: planner failed on uninstall of " + name + ": " + e);
+            }
         }
         stopHalf(inst, why);
         closeOutputs(inst);

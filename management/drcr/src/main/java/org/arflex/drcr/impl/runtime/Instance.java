@@ -43,6 +43,8 @@ public final class Instance {
     volatile String hangReason;
     Actor.Cancellable restartTimer;
     volatile long measuredWcetNs;
+    /** Known to the planner (its bundle is started); false while only INSTALLED. */
+    volatile boolean planned;
 
     Instance(Contract c, long bundleId, Path exe, Actor actor, java.util.function.Consumer<String> log) {
         this.name = c.name();

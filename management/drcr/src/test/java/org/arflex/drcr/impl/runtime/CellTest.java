@@ -252,6 +252,28 @@ class CellTest {
     }
 
     @Test
+    void installedBundleShowsInstalledUntilStartedAndAfterStopped() throws Exception {
+        Contract c = parse(contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us"));
+        assertTrue(actor.call(() -> cell.register(c, 7), 0));
+        assertEquals(State.INSTALLED, state("prov"));
+        assertEquals("INSTALLED", Snapshots.instance(cell, "prov").orElseThrow().targetState);
+        assertTrue(launcher.running.isEmpty());
+        assertTrue(actor.call(() -> cell.install(c, 7, Path.of("/x/prov")), 0));
+        assertEquals(State.ACTIVE, state("prov"));
+        actor.call(() -> {
+            cell.uninstall("prov", "bundle 7 stopped");
+            return cell.register(c, 7);
+        }, 0);
+        assertEquals(State.INSTALLED, state("prov"));
+        assertTrue(launcher.running.isEmpty());
+        actor.call(() -> {
+            cell.unregister("prov", 7);
+            return null;
+        }, 0);
+        assertTrue(cell.instance("prov").isEmpty());
+    }
+
+    @Test
     void nameOwnedByAnotherBundleIsRefused() throws Exception {
         install(contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us"));
         Contract c = parse(contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us"));
