@@ -222,6 +222,18 @@ PoseEstimate EstimateObjectPose(const std::vector<Camera>& cameras,
     return est;
   }
   int kept = pb.n;
+  const double min_cos = std::cos(options.max_view_angle_deg * M_PI / 180.0);
+  for (int i = 0; i < pb.n; ++i) {
+    const TagModel& tag = tags[pb.obs[i]->tag];
+    const Eigen::Vector3d n = pose.linear() * tag.pose.linear().col(2);
+    const Eigen::Vector3d c = pose * tag.pose.translation();
+    const Eigen::Vector3d eye = cameras[pb.camera[i]].world_from_camera.translation();
+    if (n.dot((eye - c).normalized()) < min_cos && kept > std::max(1, options.min_tags)) {
+      pb.keep[i] = false;
+      --kept;
+      ++est.n_oblique;
+    }
+  }
   auto tag_rms = [](const Linearisation& l, int i) { return std::sqrt(l.obs_sse[i] / 4.0); };
   Linearisation lin = Refine(pb, &pose, options.max_iterations, &est.iterations);
   if (lin.ok && pb.n > 1) {
@@ -306,7 +318,11 @@ bool CalibrateCamera(Camera* camera, const std::vector<TagModel>& board,
   std::vector<Camera> solo(1);
   solo[0].k = camera->k;
   solo[0].calibrated = true;
-  const PoseEstimate est = EstimateObjectPose(solo, board, obs.data(), nobs, nullptr, options);
+  // The "object" origin is the cell origin, metres away from the board: its position
+  // uncertainty is not the measure of a good calibration; the reprojection residual is.
+  EstimatorOptions calibration = options;
+  calibration.max_position_sigma = 1.0;
+  const PoseEstimate est = EstimateObjectPose(solo, board, obs.data(), nobs, nullptr, calibration);
   if (estimate != nullptr) *estimate = est;
   if (!est.valid) {
     if (error) {

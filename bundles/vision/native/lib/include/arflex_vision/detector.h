@@ -44,6 +44,10 @@ struct DetectorOptions {
   int nthreads = 1;            // AprilTag's worker threads
   int max_hamming = 0;         // bits corrected; detections above are dropped
   float min_decision_margin = 20.0f;  // weaker decodes are dropped
+  // Re-fit each side of the tag's outer border at full resolution (grey-level gradient
+  // centroid across the edge at every pixel along it, then a line fit) and intersect the
+  // lines for the corners. AprilTag's own quad fit is biased by up to a few tenths of a pixel.
+  bool refine_corners = true;
 };
 
 // Counters of the last Detect() call.

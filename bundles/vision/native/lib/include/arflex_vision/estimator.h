@@ -47,9 +47,12 @@ struct EstimatorOptions {
   double outlier_ratio = 4.0;      // ...and this multiple of the median tag residual
   int max_rejections = 4;
   double max_rms_px = 1.0;         // estimates with a larger RMS residual are invalid
-  double max_position_sigma = 2e-3;  // m; larger standard deviation: invalid
+  double max_position_sigma = 5e-3;  // m; larger standard deviation: invalid
   double pixel_sigma_floor = 0.05; // px; lower bound of the residual sigma in the covariance
   int min_tags = 1;
+  // Tags seen more obliquely than this (angle between the tag normal and the line of sight
+  // at the initial pose) are not used: their corners are the least accurate.
+  double max_view_angle_deg = 70.0;
 };
 
 using Matrix6d = Eigen::Matrix<double, 6, 6>;
@@ -66,6 +69,7 @@ struct PoseEstimate {
   int n_views = 0;       // distinct cameras among the observations kept
   int n_tags = 0;        // observations kept
   int n_rejected = 0;    // observations rejected as outliers
+  int n_oblique = 0;     // observations not used because the tag was seen too obliquely
   int iterations = 0;
 };
 

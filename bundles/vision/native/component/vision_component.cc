@@ -1,0 +1,305 @@
+// RT half of the `vision` component: tool pose from up to four cameras.
+//
+// Ports: inputs cam0..cam3 (frame, arflex.ImageFrame: GRAY8 or RGB8), joint_state (state,
+// arflex.JointState, for the ROI prediction); output tcp_pose (state, arflex.Pose).
+// Parameters (all optional in the contract; defaults below when absent): fovy_deg (pinhole
+// intrinsics of the cell cameras: fy = fx = (H/2)/tan(fovy/2), principal point at the image
+// centre), tcp_x/tcp_y/tcp_z (TCP in the flange/marker frame, m), roi_margin_px, calibrate
+// (int64: each change re-runs the extrinsic calibration of every camera from the board).
+//
+// Threads: detection allocates (libapriltag), so it runs on a worker thread created in
+// configure. update() (RT thread) never allocates, blocks or prints: when the worker is idle
+// it publishes the worker's last result, copies the newest frame of every camera into
+// buffers preallocated in configure (frames larger than those buffers are counted and
+// skipped), reads the joint state and hands the job over with sem_post. The worker detects
+// (full frame for the board calibration, an ROI around the tags predicted from the nominal
+// forward kinematics of the joint state, or around the last pose, otherwise the full frame),
+// estimates the multi-view pose and leaves the result for the next update.
+#include <semaphore.h>
+
+#include <array>
+#include <atomic>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <thread>
+#include <vector>
+
+extern "C" {
+#include "arflex/component.h"
+}
+#include "arflex_sim/kinematics.h"
+#include "arflex_types/image_frame.h"
+#include "arflex_types/joint_state.h"
+#include "arflex_types/pose.h"
+#include "arflex_vision/cell_layout.h"
+#include "arflex_vision/detector.h"
+#include "arflex_vision/estimator.h"
+
+namespace {
+
+namespace vision = arflex::vision;
+
+constexpr int kCameras = 4;
+constexpr int kMaxWidth = 1280;
+constexpr int kMaxHeight = 1024;
+constexpr size_t kMaxPixels = static_cast<size_t>(kMaxWidth) * kMaxHeight * 3;
+
+struct FrameSlot {
+  std::unique_ptr<uint8_t[]> pixels;  // kMaxPixels, allocated in configure
+  arflex_image_frame header{};
+  bool present = false;
+};
+
+struct Vision {
+  arflex_input* cam[kCameras] = {};
+  arflex_input* joints = nullptr;
+  arflex_port* out = nullptr;
+  int p_fovy = -1, p_tcp[3] = {-1, -1, -1}, p_margin = -1, p_calibrate = -1;
+
+  // Job (owned by the RT thread while busy == 0, by the worker while busy == 1).
+  FrameSlot frames[kCameras];
+  arflex_joint_state joint_state{};
+  bool have_joints = false;
+  double fovy_deg = 50.0, margin = 30.0;
+  Eigen::Vector3d tcp{0.30, 0.0, 0.0};
+  bool recalibrate = false;
+  int64_t calibrate_seen = 0;
+
+  // Result (written by the worker before it clears busy).
+  arflex_pose result{};
+  bool result_ready = false;
+  uint64_t out_seq = 0;
+  int waiting_cycles = 0;  // cycles since the first fresh frame of the pending job
+
+  std::atomic<int> busy{0};
+  std::atomic<bool> quit{false};
+  sem_t go;
+  bool sem_ok = false;
+  std::thread worker;
+
+  // Worker-only state.
+  std::unique_ptr<vision::TagDetector> detector;
+  std::vector<vision::Camera> cameras{kCameras};
+  std::vector<vision::TagModel> board = vision::CellBoardTags();
+  std::vector<vision::TagModel> tool = vision::CellToolTags();
+  arflex::sim::NominalKinematics kinematics{arflex::sim::DefaultArm()};
+  bool have_last = false;
+  Eigen::Isometry3d last_marker = Eigen::Isometry3d::Identity();
+  vision::EstimatorOptions options;
+};
+
+Vision g;
+
+double ParamF64(arflex_component* c, int idx, double def) {
+  return idx >= 0 ? arflex_param_f64(c, idx) : def;
+}
+
+const arflex_port_type kFrameType = {ARFLEX_TYPE_IMAGE_FRAME_NAME, 1, 0,
+                                     static_cast<uint32_t>(ARFLEX_TYPE_IMAGE_FRAME_SIZE + kMaxPixels)};
+const arflex_port_type kJointType = {ARFLEX_TYPE_JOINT_STATE_NAME, 1, 0, ARFLEX_TYPE_JOINT_STATE_SIZE};
+const arflex_port_type kPoseType = {ARFLEX_TYPE_POSE_NAME, 1, 0, ARFLEX_TYPE_POSE_SIZE};
+
+void Process() {
+  Vision& v = g;
+  std::array<vision::Observation, vision::kMaxObservations> obs;
+  std::array<vision::TagDetection, 16> dets;
+  int nobs = 0;
+  int64_t t_ns = 0;
+  Eigen::Isometry3d predicted;
+  bool have_prediction = false;
+  if (v.have_joints) {
+    arflex::sim::JointVector q;
+    for (int i = 0; i < 6; ++i) q[i] = v.joint_state.q[i];
+    predicted = v.kinematics.Flange(q);
+    have_prediction = true;
+  } else if (v.have_last) {
+    predicted = v.last_marker;
+    have_prediction = true;
+  }
+  for (int c = 0; c < kCameras; ++c) {
+    FrameSlot& f = v.frames[c];
+    if (!f.present) continue;
+    const arflex_image_frame& h = f.header;
+    vision::FrameView frame{f.pixels.get(), static_cast<int>(h.width), static_cast<int>(h.height),
+                            static_cast<int>(h.stride),
+                            h.format == ARFLEX_IMAGE_FRAME_FORMAT_RGB8 ? vision::PixelFormat::kRgb8
+                                                                       : vision::PixelFormat::kGray8};
+    vision::Camera& cam = v.cameras[c];
+    cam.k.width = frame.width;
+    cam.k.height = frame.height;
+    cam.k.fy = cam.k.fx = 0.5 * frame.height / std::tan(0.5 * v.fovy_deg * M_PI / 180.0);
+    cam.k.cx = 0.5 * (frame.width - 1);
+    cam.k.cy = 0.5 * (frame.height - 1);
+    if (!cam.calibrated || v.recalibrate) {
+      const int n = v.detector->Detect(frame, nullptr, 0, dets.data(), 16, nullptr);
+      std::string error;
+      vision::Camera fresh = cam;
+      fresh.calibrated = false;
+      if (n > 0 && vision::CalibrateCamera(&fresh, v.board, dets.data(), n, v.options, nullptr, &error)) {
+        cam = fresh;
+      }
+      if (!cam.calibrated) continue;
+      vision::CollectObservations(c, dets.data(), n, v.tool, obs.data(), &nobs);
+    } else {
+      vision::Roi roi;
+      if (have_prediction) roi = vision::PredictRoi(cam, predicted, v.tool, v.margin);
+      const int n = roi.empty() ? v.detector->Detect(frame, nullptr, 0, dets.data(), 16, nullptr)
+                                : v.detector->Detect(frame, &roi, 1, dets.data(), 16, nullptr);
+      if (n > 0) vision::CollectObservations(c, dets.data(), n, v.tool, obs.data(), &nobs);
+    }
+    if (t_ns == 0 || h.t_ns < t_ns) t_ns = h.t_ns;
+  }
+  v.recalibrate = false;
+  for (FrameSlot& f : v.frames) f.present = false;
+  vision::PoseEstimate est = vision::EstimateObjectPose(
+      v.cameras, v.tool, obs.data(), nobs, have_prediction ? &predicted : nullptr, v.options);
+  if (est.valid) {
+    v.last_marker = est.pose;
+    v.have_last = true;
+  }
+  Eigen::Isometry3d tcp = Eigen::Isometry3d::Identity();
+  tcp.translation() = v.tcp;
+  est = vision::TransformEstimate(est, tcp);
+  arflex_pose& r = v.result;
+  r.t_ns = t_ns;
+  const Eigen::Vector3d p = est.pose.translation();
+  const Eigen::Quaterniond q(est.pose.linear());
+  for (int i = 0; i < 3; ++i) r.p[i] = p(i);
+  r.quat[0] = q.w();
+  r.quat[1] = q.x();
+  r.quat[2] = q.y();
+  r.quat[3] = q.z();
+  for (int i = 0; i < 6; ++i) r.cov[i] = est.covariance(i, i);
+  r.valid = est.valid ? 1u : 0u;
+  r.n_views = static_cast<uint32_t>(est.valid ? est.n_views : 0);
+  v.result_ready = true;
+}
+
+void WorkerLoop() {
+  for (;;) {
+    while (sem_wait(&g.go) != 0 && errno == EINTR) {
+    }
+    if (g.quit.load(std::memory_order_acquire)) return;
+    Process();
+    g.busy.store(0, std::memory_order_release);
+  }
+}
+
+int Configure(arflex_component* c, void*) {
+  static const char* const names[kCameras] = {"cam0", "cam1", "cam2", "cam3"};
+  for (int i = 0; i < kCameras; ++i) {
+    int r = arflex_component_input(c, names[i], ARFLEX_PORT_FRAME, &kFrameType, &g.cam[i]);
+    if (r < 0) return r;
+  }
+  int r = arflex_component_input(c, "joint_state", ARFLEX_PORT_STATE, &kJointType, &g.joints);
+  if (r < 0) return r;
+  r = arflex_component_output(c, "tcp_pose", ARFLEX_PORT_STATE, &kPoseType, &g.out);
+  if (r < 0) return r;
+  g.p_fovy = arflex_component_param(c, "fovy_deg");
+  g.p_tcp[0] = arflex_component_param(c, "tcp_x");
+  g.p_tcp[1] = arflex_component_param(c, "tcp_y");
+  g.p_tcp[2] = arflex_component_param(c, "tcp_z");
+  g.p_margin = arflex_component_param(c, "roi_margin_px");
+  g.p_calibrate = arflex_component_param(c, "calibrate");
+  vision::DetectorOptions o;
+  o.max_width = kMaxWidth;
+  o.max_height = kMaxHeight;
+  std::string error;
+  g.detector = vision::TagDetector::Create(o, &error);
+  if (!g.detector) {
+    std::fprintf(stderr, "vision: %s\n", error.c_str());
+    return -EINVAL;
+  }
+  for (FrameSlot& f : g.frames) f.pixels.reset(new uint8_t[kMaxPixels]);
+  if (sem_init(&g.go, 0, 0) != 0) return -errno;
+  g.sem_ok = true;
+  try {
+    g.worker = std::thread(WorkerLoop);
+  } catch (const std::system_error& e) {
+    sem_destroy(&g.go);
+    g.sem_ok = false;
+    return -EAGAIN;
+  }
+  return 0;
+}
+
+int Update(arflex_component* c, void*, uint64_t) {
+  if (g.busy.load(std::memory_order_acquire) != 0) return 0;  // worker still on the last job
+  if (g.result_ready) {
+    g.result.seq = ++g.out_seq;
+    arflex_state_write(g.out, &g.result, sizeof(g.result));
+    g.result_ready = false;
+  }
+  // Collect the newest frame of every camera; the job goes when every bound camera has a
+  // fresh frame (one set of views), or three cycles after the first one arrived.
+  bool all = true, any = false;
+  for (int i = 0; i < kCameras; ++i) {
+    FrameSlot& f = g.frames[i];
+    arflex_frame_view view;
+    if (arflex_input_frame_acquire(g.cam[i], &view) == 1 && view.length >= ARFLEX_TYPE_IMAGE_FRAME_SIZE) {
+      arflex_image_frame h;
+      std::memcpy(&h, view.data, sizeof(h));
+      const uint32_t bpp = h.format == ARFLEX_IMAGE_FRAME_FORMAT_RGB8 ? 3u : 1u;
+      const bool format_ok =
+          h.format == ARFLEX_IMAGE_FRAME_FORMAT_RGB8 || h.format == ARFLEX_IMAGE_FRAME_FORMAT_GRAY8;
+      const uint64_t bytes = static_cast<uint64_t>(h.stride) * h.height;
+      // A malformed frame is ignored (the estimate uses the other cameras).
+      if (format_ok && h.width > 0 && h.height > 0 && h.width <= kMaxWidth && h.height <= kMaxHeight &&
+          h.stride >= h.width * bpp && bytes <= kMaxPixels && bytes + ARFLEX_TYPE_IMAGE_FRAME_SIZE <= view.length) {
+        f.present = false;  // the pixels of a pending frame are being replaced
+        std::memcpy(f.pixels.get(), static_cast<const uint8_t*>(view.data) + ARFLEX_TYPE_IMAGE_FRAME_SIZE,
+                    bytes);
+        if (arflex_frame_valid(&view)) {  // not overwritten while copying
+          f.header = h;
+          f.present = true;
+        }
+      }
+    }
+    any = any || f.present;
+    if (arflex_input_bound(g.cam[i]) && !f.present) all = false;
+  }
+  if (!any) return 0;
+  if (!all && ++g.waiting_cycles < 3) return 0;
+  g.waiting_cycles = 0;
+  g.have_joints = arflex_input_state_read(g.joints, &g.joint_state, sizeof(g.joint_state), nullptr) >= 0 &&
+                  g.joint_state.seq != 0;
+  g.fovy_deg = ParamF64(c, g.p_fovy, 50.0);
+  g.margin = ParamF64(c, g.p_margin, 30.0);
+  g.tcp = Eigen::Vector3d(ParamF64(c, g.p_tcp[0], 0.30), ParamF64(c, g.p_tcp[1], 0.0),
+                          ParamF64(c, g.p_tcp[2], 0.0));
+  if (g.p_calibrate >= 0) {
+    const int64_t want = arflex_param_i64(c, g.p_calibrate);
+    if (want != g.calibrate_seen) {
+      g.calibrate_seen = want;
+      g.recalibrate = true;
+    }
+  }
+  g.busy.store(1, std::memory_order_release);
+  sem_post(&g.go);
+  return 0;
+}
+
+void Cleanup(arflex_component*, void*) {
+  if (g.worker.joinable()) {
+    g.quit.store(true, std::memory_order_release);
+    sem_post(&g.go);
+    g.worker.join();
+  }
+  if (g.sem_ok) sem_destroy(&g.go);
+  g.detector.reset();
+  for (FrameSlot& f : g.frames) f.pixels.reset();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  arflex_component_ops ops{};
+  ops.name = "vision";
+  ops.configure = Configure;
+  ops.update = Update;
+  ops.cleanup = Cleanup;
+  return arflex_component_main(argc, argv, &ops);
+}

@@ -1,0 +1,327 @@
+// vision.comp.*: the vision RT half under the rt-core host API. The test is the cell around
+// it: it creates a "feeder" instance whose output segments (four frame ports and a joint
+// state) it writes itself, with synthetic frames of the board and the tool tags drawn through
+// the cell's camera model, spawns the vision component, binds it and reads tcp_pose.
+//
+//   vision_comp_test <case> <vision exe>      cases: pose, loss
+//
+// Every case ends by checking that no /dev/shm or /dev/mqueue object of its runtime id and no
+// child process is left. Waits are on conditions with deadlines; nothing asserts on timing.
+#include <dirent.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+extern "C" {
+#include "arflex/host.h"
+}
+#include "arflex_sim/kinematics.h"
+#include "arflex_types/image_frame.h"
+#include "arflex_types/joint_state.h"
+#include "arflex_types/pose.h"
+#include "arflex_vision/cell_layout.h"
+#include "synthetic_scene.h"
+
+namespace {
+
+namespace vision = arflex::vision;
+constexpr uint64_t kSec = 1000000000ull;
+constexpr uint64_t kMs = 1000000ull;
+constexpr int kW = 1280, kH = 1024;  // the cell cameras' resolution
+constexpr uint32_t kFrameBytes = ARFLEX_TYPE_IMAGE_FRAME_SIZE + kW * kH;
+// The component's frame inputs accept frames up to 1280x1024 RGB: the port type's elem_size
+// is that maximum, and a provider declares the same type.
+constexpr uint32_t kFrameElem = ARFLEX_TYPE_IMAGE_FRAME_SIZE + 1280u * 1024u * 3u;
+
+char rid[ARFLEX_ID_MAX + 1];
+int failures = 0;
+
+#define CHECK(cond, ...)                                                        \
+  do {                                                                          \
+    if (!(cond)) {                                                              \
+      std::fprintf(stderr, "FAIL %s:%d: %s: ", __FILE__, __LINE__, #cond);      \
+      std::fprintf(stderr, __VA_ARGS__);                                        \
+      std::fputc('\n', stderr);                                                 \
+      ++failures;                                                               \
+      goto out;                                                                 \
+    }                                                                           \
+  } while (0)
+
+arflex_param_slot ParamF64(const char* name, double def, double lo, double hi) {
+  arflex_param_slot s;
+  std::memset(&s, 0, sizeof(s));
+  std::snprintf(s.name, sizeof(s.name), "%s", name);
+  s.type = ARFLEX_PARAM_DOUBLE;
+  s.flags = ARFLEX_PARAM_MUTABLE;
+  s.min_bits = arflex_f64_bits(lo);
+  s.max_bits = arflex_f64_bits(hi);
+  s.default_bits = arflex_f64_bits(def);
+  return s;
+}
+
+arflex_param_slot ParamI64(const char* name, int64_t def) {
+  arflex_param_slot s;
+  std::memset(&s, 0, sizeof(s));
+  std::snprintf(s.name, sizeof(s.name), "%s", name);
+  s.type = ARFLEX_PARAM_INT64;
+  s.flags = ARFLEX_PARAM_MUTABLE;
+  s.min_bits = static_cast<uint64_t>(INT64_C(0));
+  s.max_bits = static_cast<uint64_t>(INT64_C(1000000));
+  s.default_bits = static_cast<uint64_t>(def);
+  return s;
+}
+
+arflex_ctl_config Config(uint64_t period_ns) {
+  arflex_ctl_config c;
+  std::memset(&c, 0, sizeof(c));
+  c.period_ns = period_ns;
+  c.priority = 0;
+  c.safe_mode = ARFLEX_SAFE_HOLD;
+  c.cfg_flags = ARFLEX_CFG_NO_MLOCK | ARFLEX_CFG_NO_DMA_LATENCY;
+  return c;
+}
+
+bool Leaked() {
+  static const char* const dirs[] = {"/dev/shm", "/dev/mqueue"};
+  const std::string prefix = std::string("arflex.") + rid + ".";
+  bool any = false;
+  for (const char* dir : dirs) {
+    DIR* d = opendir(dir);
+    if (!d) continue;
+    while (dirent* e = readdir(d)) {
+      if (std::strncmp(e->d_name, prefix.c_str(), prefix.size()) == 0) {
+        std::fprintf(stderr, "leak: %s/%s\n", dir, e->d_name);
+        any = true;
+      }
+    }
+    closedir(d);
+  }
+  if (waitpid(-1, nullptr, WNOHANG) != -1 || errno != ECHILD) {
+    std::fprintf(stderr, "leak: a child process is left\n");
+    any = true;
+  }
+  return any;
+}
+
+const arflex::sim::JointVector kQ = {0.1, 0.45, 0.35, 0.2, 0.7, 0.3};
+
+// The expected TCP: nominal flange at kQ and the TCP 0.3 m along the flange x axis.
+Eigen::Isometry3d TrueTcp() {
+  arflex::sim::NominalKinematics kin(arflex::sim::DefaultArm());
+  Eigen::Isometry3d t = kin.Flange(kQ);
+  t.translate(Eigen::Vector3d(0.3, 0, 0));
+  return t;
+}
+
+class Feeder {
+ public:
+  int Create() {
+    const char* names[] = {"cam0", "cam1", "cam2", "cam3", "joint_state"};
+    struct arflex_host_output outs[5];
+    std::memset(outs, 0, sizeof(outs));
+    for (int i = 0; i < 4; ++i) {
+      outs[i].port = names[i];
+      outs[i].spec.method = ARFLEX_PORT_FRAME;
+      outs[i].spec.type = {ARFLEX_TYPE_IMAGE_FRAME_NAME, 1, 0, kFrameElem};
+      outs[i].spec.depth = 2;
+    }
+    outs[4].port = names[4];
+    outs[4].spec.method = ARFLEX_PORT_STATE;
+    outs[4].spec.type = {ARFLEX_TYPE_JOINT_STATE_NAME, 1, 0, ARFLEX_TYPE_JOINT_STATE_SIZE};
+    outs[4].spec.depth = 1;
+    arflex_host_opts o;
+    std::memset(&o, 0, sizeof(o));
+    o.runtime = rid;
+    o.instance = "feeder";
+    o.config = Config(10 * kMs);
+    o.outputs = outs;
+    o.noutputs = 5;
+    const int r = arflex_host_create(&host_, &o);
+    created_ = r == 0;
+    return r;
+  }
+  ~Feeder() {
+    if (created_) arflex_host_destroy(&host_);
+  }
+  arflex_host* host() { return &host_; }
+
+  // Draws the frames of the scene once (it is static): with and without the tags.
+  void Draw() {
+    const auto cams = vision::testing::CellCameras(kW, kH);
+    arflex::sim::NominalKinematics kin(arflex::sim::DefaultArm());
+    const Eigen::Isometry3d flange = kin.Flange(kQ);
+    for (int c = 0; c < 4; ++c) {
+      blank_[c] = cv::Mat(kH, kW, CV_8UC1, cv::Scalar(140));
+      tagged_[c] = blank_[c].clone();
+      for (const auto& t : vision::CellBoardTags()) drawer_.Draw(cams[c], t, Eigen::Isometry3d::Identity(), &tagged_[c]);
+      for (const auto& t : vision::CellToolTags()) drawer_.Draw(cams[c], t, flange, &tagged_[c]);
+    }
+  }
+
+  // Publishes one frame per camera (a synchronised set) and the joint state; with `tags`
+  // false the frames show no tag (vision loss).
+  void Publish(bool tags, uint64_t seq) {
+    static const char* const names[] = {"cam0", "cam1", "cam2", "cam3"};
+    for (int c = 0; c < 4; ++c) {
+      const cv::Mat& img = tags ? tagged_[c] : blank_[c];
+      arflex_port* p = arflex_host_output(&host_, names[c]);
+      auto* slot = static_cast<uint8_t*>(arflex_frame_begin(p));
+      arflex_image_frame h;
+      std::memset(&h, 0, sizeof(h));
+      h.t_ns = static_cast<int64_t>(arflex_sys_now_ns());
+      h.seq = seq;
+      h.camera = c;
+      h.width = kW;
+      h.height = kH;
+      h.stride = kW;
+      h.format = ARFLEX_IMAGE_FRAME_FORMAT_GRAY8;
+      h.bytes = kW * kH;
+      std::memcpy(slot, &h, sizeof(h));
+      std::memcpy(slot + ARFLEX_TYPE_IMAGE_FRAME_SIZE, img.data, kW * kH);
+      arflex_frame_commit(p, kFrameBytes);
+    }
+    arflex_joint_state js;
+    std::memset(&js, 0, sizeof(js));
+    js.t_ns = static_cast<int64_t>(arflex_sys_now_ns());
+    js.seq = seq;
+    for (int i = 0; i < 6; ++i) js.q[i] = kQ[i];
+    arflex_state_write(arflex_host_output(&host_, "joint_state"), &js, sizeof(js));
+  }
+
+ private:
+  arflex_host host_{};
+  bool created_ = false;
+  vision::testing::SceneDrawer drawer_;
+  cv::Mat blank_[4], tagged_[4];
+};
+
+int MakeVision(arflex_host* h, const char* exe) {
+  arflex_param_slot p[6] = {ParamF64("fovy_deg", 50.0, 1.0, 170.0), ParamF64("tcp_x", 0.3, -1, 1),
+                            ParamF64("tcp_y", 0.0, -1, 1),         ParamF64("tcp_z", 0.0, -1, 1),
+                            ParamF64("roi_margin_px", 30.0, 0, 500), ParamI64("calibrate", 0)};
+  struct arflex_host_output out;
+  std::memset(&out, 0, sizeof(out));
+  out.port = "tcp_pose";
+  out.spec.method = ARFLEX_PORT_STATE;
+  out.spec.type = {ARFLEX_TYPE_POSE_NAME, 1, 0, ARFLEX_TYPE_POSE_SIZE};
+  out.spec.depth = 1;
+  arflex_host_opts o;
+  std::memset(&o, 0, sizeof(o));
+  o.runtime = rid;
+  o.instance = "vision";
+  o.config = Config(20 * kMs);
+  o.params = p;
+  o.nparams = 6;
+  o.outputs = &out;
+  o.noutputs = 1;
+  int r = arflex_host_create(h, &o);
+  if (r < 0) return r;
+  return arflex_host_spawn(h, exe, nullptr, nullptr);
+}
+
+// Publishes frames (with or without tags) until a tcp_pose with `want_valid` arrives or the
+// deadline passes. Returns true and the pose in *got.
+bool WaitPose(Feeder* feeder, arflex_port* reader, bool tags, bool want_valid, arflex_pose* got) {
+  const uint64_t deadline = arflex_sys_now_ns() + 30 * kSec;
+  uint64_t seq = 1;
+  uint64_t last_publish = 0;
+  while (arflex_sys_now_ns() < deadline) {
+    // A new frame set every 100 ms (the test's camera rate).
+    if (arflex_sys_now_ns() - last_publish > 100 * kMs) {
+      feeder->Publish(tags, seq++);
+      last_publish = arflex_sys_now_ns();
+    }
+    arflex_pose p;
+    if (arflex_state_read(reader, &p, sizeof(p), nullptr) == 1) {
+      *got = p;
+      // A valid pose counts once it uses at least three of the four views.
+      if (want_valid ? (p.valid != 0 && p.n_views >= 3) : p.valid == 0) return true;
+    }
+    usleep(1000);  // polling interval of the reader, not a wait for a condition
+  }
+  return false;
+}
+
+int RunCase(const std::string& name, const char* exe) {
+  Feeder feeder;
+  arflex_host vis;
+  std::memset(&vis, 0, sizeof(vis));
+  arflex_port reader;
+  bool reader_open = false;
+  arflex_pose pose;
+  const Eigen::Isometry3d truth = TrueTcp();
+  static const char* const ports[] = {"cam0", "cam1", "cam2", "cam3", "joint_state"};
+  CHECK(feeder.Create() == 0, "feeder create");
+  feeder.Draw();
+  CHECK(MakeVision(&vis, exe) == 0, "vision create/spawn");
+  CHECK(arflex_host_wait_state(&vis, ARFLEX_STATE_READY, 20 * kSec) == 0, "vision READY");
+  for (const char* port : ports) {
+    CHECK(arflex_host_bind(&vis, port, arflex_host_output_name(feeder.host(), port), 2 * kSec) == 0,
+          "BIND %s", port);
+  }
+  {
+    const arflex_port_type t = {ARFLEX_TYPE_POSE_NAME, 1, 0, ARFLEX_TYPE_POSE_SIZE};
+    CHECK(arflex_port_open(&reader, arflex_host_output_name(&vis, "tcp_pose"), false, false,
+                           ARFLEX_PORT_STATE, &t) == 0, "open tcp_pose");
+    reader_open = true;
+  }
+  CHECK(arflex_host_start(&vis, 2 * kSec) == 0, "START");
+  // Calibration from the board, then the tool pose from all four views.
+  std::memset(&pose, 0, sizeof(pose));
+  CHECK(WaitPose(&feeder, &reader, true, true, &pose), "no valid tcp_pose (last: seq %llu valid %u views %u)",
+        static_cast<unsigned long long>(pose.seq), pose.valid, pose.n_views);
+  {
+    const Eigen::Vector3d p(pose.p[0], pose.p[1], pose.p[2]);
+    const double err = (p - truth.translation()).norm();
+    // Synthetic 1280x1024 frames, the cell cameras' resolution.
+    const double sigma = std::sqrt(pose.cov[0] + pose.cov[1] + pose.cov[2]);
+    CHECK(err < 1.0e-3 && err < 4 * sigma + 0.2e-3, "tcp_pose %.6f %.6f %.6f is %.3f mm from the truth", p.x(), p.y(), p.z(), 1e3 * err);
+    CHECK(pose.n_views >= 3, "only %u views", pose.n_views);
+    CHECK(pose.cov[0] > 0 && pose.cov[0] < 25e-6, "variance x %g", pose.cov[0]);
+    const Eigen::Quaterniond q(pose.quat[0], pose.quat[1], pose.quat[2], pose.quat[3]);
+    CHECK(q.angularDistance(Eigen::Quaterniond(truth.linear())) < 5e-3, "orientation off");
+  }
+  if (name == "loss") {
+    // Vision drops out (the tags are covered): the pose turns invalid, it never keeps
+    // reporting the stale one as valid; then it recovers.
+    CHECK(WaitPose(&feeder, &reader, false, false, &pose), "no invalid tcp_pose after the loss");
+    CHECK(pose.n_views == 0, "n_views %u while invalid", pose.n_views);
+    CHECK(WaitPose(&feeder, &reader, true, true, &pose), "no recovery");
+    // Recalibration on request keeps it valid.
+    CHECK(arflex_host_set_param(&vis, "calibrate", 1, nullptr, 2 * kSec) == 0, "SET_PARAM calibrate");
+    CHECK(WaitPose(&feeder, &reader, true, true, &pose), "not valid after recalibration");
+  }
+  CHECK(arflex_host_shutdown(&vis, 5 * kSec) == 0, "SHUTDOWN");
+  CHECK(arflex_host_wait_exit(&vis, 10 * kSec) == 0, "exit");
+  CHECK(WIFEXITED(arflex_host_exit_status(&vis)) && WEXITSTATUS(arflex_host_exit_status(&vis)) == 0,
+        "exit status %d", arflex_host_exit_status(&vis));
+out:
+  if (reader_open) arflex_port_close(&reader);
+  arflex_host_destroy(&vis);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 3) {
+    std::fprintf(stderr, "usage: vision_comp_test <pose|loss> <vision exe>\n");
+    return 2;
+  }
+  std::snprintf(rid, sizeof(rid), "vct%d", static_cast<int>(getpid()));
+  const std::string name = argv[1];
+  if (name != "pose" && name != "loss") {
+    std::fprintf(stderr, "vision_comp_test: unknown case '%s'\n", argv[1]);
+    return 2;
+  }
+  RunCase(name, argv[2]);
+  if (Leaked()) ++failures;
+  std::printf("vision.comp.%s: %s\n", name.c_str(), failures ? "FAIL" : "ok");
+  return failures ? 1 : 0;
+}
