@@ -14,7 +14,7 @@ total=0 failed=0 skipped=0
 for f in "${reports[@]}"; do
   # Each report has one or more <testsuite ...> start tags carrying the counts; nested
   # <testsuites> wrappers are ignored so nothing is counted twice.
-  read -r t fl sk < <(tr '\n' ' ' < "$f" | grep -o '<testsuite [^>]*>' | awk '
+  read -r t fl sk < <(tr '\n\t\r' '   ' < "$f" | grep -o '<testsuite [^>]*>' | awk '
     function attr(s, name,   m) {
       if (match(s, " " name "=\"[0-9]+\"")) { m = substr(s, RSTART, RLENGTH); gsub(/[^0-9]/, "", m); return m + 0 }
       return 0
