@@ -1,0 +1,137 @@
+// RT half of the `tcp-correction` component: the outer loop of the paper.
+//
+// Ports: inputs reference (state, arflex.JointRef: the trajectory's joint reference) and
+// tcp_pose (state, arflex.Pose: the vision measurement); output corrected (state,
+// arflex.JointRef) = reference + correction. Parameters (defaults when absent from the
+// contract): gain, max_step (rad per measurement), max_rate (rad/s), max_correction (rad),
+// enable (bool), orientation (bool).
+//
+// Every cycle: read the reference (nothing is written until one arrived); on a new tcp_pose
+// (its seq changed) update the correction law with the nominal Jacobian and the nominal TCP
+// pose of the reference (the desired pose) against the measured pose: an invalid
+// measurement holds the correction; then ramp the applied correction towards its target at
+// max_rate and write reference + correction with the reference's time and a fresh seq.
+// Disabling ramps the correction out. Fixed-size Eigen only: update() does not allocate.
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+
+extern "C" {
+#include "arflex/component.h"
+}
+#include "arflex_sim/kinematics.h"
+#include "arflex_tcpcorr/correction.h"
+#include "arflex_types/joint_ref.h"
+#include "arflex_types/pose.h"
+
+namespace {
+
+using arflex::tcpcorr::CorrectionLaw;
+using arflex::tcpcorr::CorrectionOptions;
+
+struct TcpCorrection {
+  arflex_input* reference = nullptr;
+  arflex_input* pose = nullptr;
+  arflex_port* out = nullptr;
+  int p_gain = -1, p_step = -1, p_rate = -1, p_max = -1, p_enable = -1, p_orientation = -1;
+  arflex::sim::NominalKinematics kinematics{arflex::sim::DefaultArm()};
+  CorrectionLaw law{CorrectionOptions{}};
+  arflex_joint_ref ref{};
+  bool have_ref = false;
+  uint64_t pose_seq = 0;
+  uint64_t out_seq = 0;
+  double dt = 0.001;
+};
+
+TcpCorrection g;
+
+const arflex_port_type kRefType = {ARFLEX_TYPE_JOINT_REF_NAME, 1, 0, ARFLEX_TYPE_JOINT_REF_SIZE};
+const arflex_port_type kPoseType = {ARFLEX_TYPE_POSE_NAME, 1, 0, ARFLEX_TYPE_POSE_SIZE};
+
+double F64(arflex_component* c, int idx, double def) { return idx >= 0 ? arflex_param_f64(c, idx) : def; }
+bool Bool(arflex_component* c, int idx, bool def) { return idx >= 0 ? arflex_param_bool(c, idx) : def; }
+
+// Reads the parameters in force into the law (between cycles they cannot change).
+void ApplyParams(arflex_component* c) {
+  CorrectionOptions o = g.law.options();
+  o.gain = F64(c, g.p_gain, 0.6);
+  o.max_step = F64(c, g.p_step, 2e-3);
+  o.max_rate = F64(c, g.p_rate, 1e-2);
+  o.max_correction = F64(c, g.p_max, 2e-2);
+  o.orientation = Bool(c, g.p_orientation, true);
+  g.law.SetOptions(o);  // invalid values (outside the contract's ranges) keep the old ones
+  const bool enable = Bool(c, g.p_enable, true);
+  if (enable != g.law.enabled()) g.law.SetEnabled(enable);
+}
+
+int Configure(arflex_component* c, void*) {
+  int r = arflex_component_input(c, "reference", ARFLEX_PORT_STATE, &kRefType, &g.reference);
+  if (r == 0) r = arflex_component_input(c, "tcp_pose", ARFLEX_PORT_STATE, &kPoseType, &g.pose);
+  if (r == 0) r = arflex_component_output(c, "corrected", ARFLEX_PORT_STATE, &kRefType, &g.out);
+  if (r < 0) return r;
+  g.p_gain = arflex_component_param(c, "gain");
+  g.p_step = arflex_component_param(c, "max_step");
+  g.p_rate = arflex_component_param(c, "max_rate");
+  g.p_max = arflex_component_param(c, "max_correction");
+  g.p_enable = arflex_component_param(c, "enable");
+  g.p_orientation = arflex_component_param(c, "orientation");
+  const uint64_t period = arflex_component_ctl(c)->config.period_ns;
+  g.dt = period > 0 ? period * 1e-9 : 0.001;
+  ApplyParams(c);
+  const char* what = nullptr;
+  if (!arflex::tcpcorr::ValidateOptions(g.law.options(), &what)) {
+    fprintf(stderr, "tcp-correction: parameter default: %s\n", what);
+    return -EINVAL;
+  }
+  return 0;
+}
+
+int Start(arflex_component* c, void*) {
+  // A fresh run starts without a correction (the arm may have moved meanwhile).
+  g.law = CorrectionLaw(g.law.options());
+  ApplyParams(c);
+  g.have_ref = false;
+  return 0;
+}
+
+int Update(arflex_component* c, void*, uint64_t) {
+  ApplyParams(c);
+  arflex_joint_ref ref;
+  if (arflex_input_state_read(g.reference, &ref, sizeof(ref), nullptr) >= 0 && ref.seq != 0) {
+    g.ref = ref;
+    g.have_ref = true;
+  }
+  if (!g.have_ref) return 0;
+  arflex::sim::JointVector q;
+  for (int i = 0; i < 6; ++i) q[i] = g.ref.q[i];
+  arflex_pose m;
+  uint64_t seq = 0;
+  if (arflex_input_state_read(g.pose, &m, sizeof(m), &seq) >= 0 && m.seq != 0 && m.seq != g.pose_seq) {
+    g.pose_seq = m.seq;
+    Eigen::Isometry3d measured = Eigen::Isometry3d::Identity();
+    measured.linear() = Eigen::Quaterniond(m.quat[0], m.quat[1], m.quat[2], m.quat[3]).normalized().toRotationMatrix();
+    measured.translation() = Eigen::Vector3d(m.p[0], m.p[1], m.p[2]);
+    g.law.Update(g.kinematics.TcpJacobian(q), g.kinematics.Tcp(q), measured, m.valid != 0);
+  }
+  const arflex::tcpcorr::Vector6d& dq = g.law.Tick(g.dt);
+  arflex_joint_ref out = g.ref;
+  for (int i = 0; i < 6; ++i) out.q[i] = g.ref.q[i] + dq(i);
+  out.seq = ++g.out_seq;
+  return arflex_state_write(g.out, &out, sizeof(out));
+}
+
+// Safe mode, either mode: the last output is held. Dropping the correction at once would make
+// the reference jump, which this component must never do.
+int Safe(arflex_component*, void*, enum arflex_safe_mode, bool) { return 0; }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  arflex_component_ops ops{};
+  ops.name = "tcp-correction";
+  ops.configure = Configure;
+  ops.start = Start;
+  ops.update = Update;
+  ops.safe = Safe;
+  return arflex_component_main(argc, argv, &ops);
+}

@@ -1,0 +1,291 @@
+// tcpcorr.comp.*: the tcp-correction RT half under the rt-core host API. The test plays the
+// rest of the cell: a "feeder" instance whose reference and tcp_pose segments it writes, and
+// the plant: the measured TCP is the nominal TCP of the corrected output, shifted by a fixed
+// error (what the true arm does differently from the nominal model).
+//
+//   tcpcorr_comp_test <case> <tcp-correction exe>     cases: converge, hold
+//
+// Every case ends by checking that no /dev/shm or /dev/mqueue object of its runtime id and no
+// child process is left. Waits are on conditions with deadlines; nothing asserts on timing.
+#include <dirent.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <string>
+
+extern "C" {
+#include "arflex/host.h"
+}
+#include "arflex_sim/kinematics.h"
+#include "arflex_types/joint_ref.h"
+#include "arflex_types/pose.h"
+
+namespace {
+
+constexpr uint64_t kSec = 1000000000ull;
+constexpr uint64_t kMs = 1000000ull;
+constexpr double kMaxRate = 0.02;  // rad/s, the parameter given below
+constexpr double kPeriod = 0.001;  // s
+
+char rid[ARFLEX_ID_MAX + 1];
+int failures = 0;
+
+#define CHECK(cond, ...)                                                   \
+  do {                                                                     \
+    if (!(cond)) {                                                         \
+      std::fprintf(stderr, "FAIL %s:%d: %s: ", __FILE__, __LINE__, #cond); \
+      std::fprintf(stderr, __VA_ARGS__);                                   \
+      std::fputc('\n', stderr);                                            \
+      ++failures;                                                          \
+      goto out;                                                            \
+    }                                                                      \
+  } while (0)
+
+arflex_param_slot Param(const char* name, uint32_t type, uint64_t def, uint64_t lo, uint64_t hi) {
+  arflex_param_slot s;
+  std::memset(&s, 0, sizeof(s));
+  std::snprintf(s.name, sizeof(s.name), "%s", name);
+  s.type = type;
+  s.flags = ARFLEX_PARAM_MUTABLE;
+  s.min_bits = lo;
+  s.max_bits = hi;
+  s.default_bits = def;
+  return s;
+}
+
+arflex_param_slot F64(const char* name, double def, double lo, double hi) {
+  return Param(name, ARFLEX_PARAM_DOUBLE, arflex_f64_bits(def), arflex_f64_bits(lo), arflex_f64_bits(hi));
+}
+
+arflex_ctl_config Config() {
+  arflex_ctl_config c;
+  std::memset(&c, 0, sizeof(c));
+  c.period_ns = 1 * kMs;
+  c.priority = 0;
+  c.safe_mode = ARFLEX_SAFE_HOLD;
+  c.cfg_flags = ARFLEX_CFG_NO_MLOCK | ARFLEX_CFG_NO_DMA_LATENCY;
+  return c;
+}
+
+bool Leaked() {
+  static const char* const dirs[] = {"/dev/shm", "/dev/mqueue"};
+  const std::string prefix = std::string("arflex.") + rid + ".";
+  bool any = false;
+  for (const char* dir : dirs) {
+    DIR* d = opendir(dir);
+    if (!d) continue;
+    while (dirent* e = readdir(d)) {
+      if (std::strncmp(e->d_name, prefix.c_str(), prefix.size()) == 0) {
+        std::fprintf(stderr, "leak: %s/%s\n", dir, e->d_name);
+        any = true;
+      }
+    }
+    closedir(d);
+  }
+  if (waitpid(-1, nullptr, WNOHANG) != -1 || errno != ECHILD) {
+    std::fprintf(stderr, "leak: a child process is left\n");
+    any = true;
+  }
+  return any;
+}
+
+const arflex::sim::JointVector kRef = {0.2, 0.5, 0.3, 0.1, 0.8, -0.2};
+const Eigen::Vector3d kPlantError(1.2e-3, -0.8e-3, 0.6e-3);  // true arm vs nominal, at the TCP
+
+struct Rig {
+  arflex_host feeder{}, corr{};
+  arflex_port out{};
+  bool out_open = false;
+  arflex::sim::NominalKinematics kin{arflex::sim::DefaultArm()};
+  arflex_joint_ref last{};
+  uint64_t pose_seq = 0;
+  double max_jump_excess = 0;  // largest step beyond max_rate * period * cycles
+
+  int Create(const char* exe) {
+    struct arflex_host_output fo[2];
+    std::memset(fo, 0, sizeof(fo));
+    fo[0].port = "reference";
+    fo[0].spec.method = ARFLEX_PORT_STATE;
+    fo[0].spec.type = {ARFLEX_TYPE_JOINT_REF_NAME, 1, 0, ARFLEX_TYPE_JOINT_REF_SIZE};
+    fo[0].spec.depth = 1;
+    fo[1].port = "tcp_pose";
+    fo[1].spec.method = ARFLEX_PORT_STATE;
+    fo[1].spec.type = {ARFLEX_TYPE_POSE_NAME, 1, 0, ARFLEX_TYPE_POSE_SIZE};
+    fo[1].spec.depth = 1;
+    arflex_host_opts o;
+    std::memset(&o, 0, sizeof(o));
+    o.runtime = rid;
+    o.instance = "feeder";
+    o.config = Config();
+    o.outputs = fo;
+    o.noutputs = 2;
+    int r = arflex_host_create(&feeder, &o);
+    if (r < 0) return r;
+    arflex_param_slot p[6] = {
+        F64("gain", 0.6, 0.01, 1.0), F64("max_step", 2e-3, 1e-6, 0.1), F64("max_rate", kMaxRate, 1e-6, 1.0),
+        F64("max_correction", 0.02, 1e-6, 0.2), Param("enable", ARFLEX_PARAM_BOOL, 1, 0, 1),
+        Param("orientation", ARFLEX_PARAM_BOOL, 1, 0, 1)};
+    struct arflex_host_output co;
+    std::memset(&co, 0, sizeof(co));
+    co.port = "corrected";
+    co.spec.method = ARFLEX_PORT_STATE;
+    co.spec.type = {ARFLEX_TYPE_JOINT_REF_NAME, 1, 0, ARFLEX_TYPE_JOINT_REF_SIZE};
+    co.spec.depth = 1;
+    o.instance = "corr";
+    o.params = p;
+    o.nparams = 6;
+    o.outputs = &co;
+    o.noutputs = 1;
+    r = arflex_host_create(&corr, &o);
+    if (r < 0) return r;
+    r = arflex_host_spawn(&corr, exe, nullptr, nullptr);
+    if (r < 0) return r;
+    r = arflex_host_wait_state(&corr, ARFLEX_STATE_READY, 10 * kSec);
+    if (r < 0) return r;
+    const arflex_port_type t = {ARFLEX_TYPE_JOINT_REF_NAME, 1, 0, ARFLEX_TYPE_JOINT_REF_SIZE};
+    r = arflex_port_open(&out, arflex_host_output_name(&corr, "corrected"), false, false, ARFLEX_PORT_STATE, &t);
+    if (r < 0) return r;
+    out_open = true;
+    arflex_joint_ref ref;
+    std::memset(&ref, 0, sizeof(ref));
+    ref.t_ns = 1;
+    ref.seq = 1;
+    for (int i = 0; i < 6; ++i) ref.q[i] = kRef[i];
+    arflex_state_write(arflex_host_output(&feeder, "reference"), &ref, sizeof(ref));
+    r = arflex_host_bind(&corr, "reference", arflex_host_output_name(&feeder, "reference"), 2 * kSec);
+    if (r == 0) r = arflex_host_bind(&corr, "tcp_pose", arflex_host_output_name(&feeder, "tcp_pose"), 2 * kSec);
+    if (r == 0) r = arflex_host_start(&corr, 2 * kSec);
+    return r;
+  }
+
+  ~Rig() {
+    if (out_open) arflex_port_close(&out);
+    arflex_host_destroy(&corr);
+    arflex_host_destroy(&feeder);
+  }
+
+  // Reads the newest output; checks that it never jumps. Returns true on a new value.
+  bool Read() {
+    arflex_joint_ref v;
+    if (arflex_state_read(&out, &v, sizeof(v), nullptr) != 1) return false;
+    if (last.seq != 0) {
+      const double cycles = static_cast<double>(v.seq - last.seq);
+      for (int i = 0; i < 6; ++i) {
+        const double excess = std::abs(v.q[i] - last.q[i]) - kMaxRate * kPeriod * cycles;
+        if (excess > max_jump_excess) max_jump_excess = excess;
+      }
+    }
+    last = v;
+    return true;
+  }
+
+  // The plant: the measurement of the corrected output (nominal TCP + the plant's error).
+  void Measure(bool valid, const Eigen::Vector3d& extra) {
+    arflex::sim::JointVector q;
+    for (int i = 0; i < 6; ++i) q[i] = last.q[i];
+    const Eigen::Isometry3d t = kin.Tcp(q);
+    arflex_pose p;
+    std::memset(&p, 0, sizeof(p));
+    p.seq = ++pose_seq;
+    const Eigen::Vector3d pos = t.translation() + kPlantError + extra;
+    const Eigen::Quaterniond quat(t.linear());
+    for (int i = 0; i < 3; ++i) p.p[i] = pos(i);
+    p.quat[0] = quat.w();
+    p.quat[1] = quat.x();
+    p.quat[2] = quat.y();
+    p.quat[3] = quat.z();
+    p.valid = valid ? 1 : 0;
+    p.n_views = valid ? 4 : 0;
+    arflex_state_write(arflex_host_output(&feeder, "tcp_pose"), &p, sizeof(p));
+  }
+
+  // Runs the loop (a measurement every 20 ms of wall time) until the true TCP error is
+  // below `tol` or the deadline passes. Returns the final error (m).
+  double Converge(double tol) {
+    const uint64_t deadline = arflex_sys_now_ns() + 30 * kSec;
+    uint64_t last_measure = 0;
+    double err = 1.0;
+    while (arflex_sys_now_ns() < deadline) {
+      if (!Read()) continue;
+      arflex::sim::JointVector q;
+      for (int i = 0; i < 6; ++i) q[i] = last.q[i];
+      err = (kin.Tcp(q).translation() + kPlantError - kin.Tcp(kRef).translation()).norm();
+      if (err < tol) break;
+      if (arflex_sys_now_ns() - last_measure > 20 * kMs) {
+        Measure(true, Eigen::Vector3d::Zero());
+        last_measure = arflex_sys_now_ns();
+      }
+    }
+    return err;
+  }
+
+  // Reads outputs for `ns` of wall time (to watch a hold or a ramp), measuring with `valid`.
+  void Watch(uint64_t ns, bool measure, bool valid, const Eigen::Vector3d& extra) {
+    const uint64_t end = arflex_sys_now_ns() + ns;
+    uint64_t last_measure = 0;
+    while (arflex_sys_now_ns() < end) {
+      Read();
+      if (measure && arflex_sys_now_ns() - last_measure > 20 * kMs) {
+        Measure(valid, extra);
+        last_measure = arflex_sys_now_ns();
+      }
+    }
+  }
+};
+
+int RunCase(const std::string& name, const char* exe) {
+  Rig rig;
+  double err = 0;
+  CHECK(rig.Create(exe) == 0, "create/spawn/bind/start");
+  err = rig.Converge(2e-6);
+  CHECK(err < 2e-6, "TCP error %.3f um after the loop (from %.3f um)", 1e6 * err, 1e6 * kPlantError.norm());
+  if (name == "hold") {
+    // Vision drops out: invalid measurements far off are held, the output does not move.
+    const arflex_joint_ref before = rig.last;
+    rig.Watch(300 * kMs, true, false, Eigen::Vector3d(0.01, 0, 0));
+    for (int i = 0; i < 6; ++i) {
+      CHECK(rig.last.q[i] == before.q[i], "joint %d moved from %.12f to %.12f while vision was out", i,
+            before.q[i], rig.last.q[i]);
+    }
+    // Disabled: the correction ramps out at max_rate, to exactly the reference.
+    CHECK(arflex_host_set_param(&rig.corr, "enable", 0, nullptr, 2 * kSec) == 0, "SET_PARAM enable");
+    {
+      const uint64_t deadline = arflex_sys_now_ns() + 20 * kSec;
+      bool at_ref = false;
+      while (!at_ref && arflex_sys_now_ns() < deadline) {
+        if (!rig.Read()) continue;
+        at_ref = true;
+        for (int i = 0; i < 6; ++i) at_ref = at_ref && rig.last.q[i] == kRef[i];
+      }
+      CHECK(at_ref, "the output did not return to the reference");
+    }
+  }
+  CHECK(rig.max_jump_excess < 1e-12, "output jumped %.3g rad beyond the rate limit", rig.max_jump_excess);
+  CHECK(arflex_host_shutdown(&rig.corr, 5 * kSec) == 0, "SHUTDOWN");
+  CHECK(arflex_host_wait_exit(&rig.corr, 10 * kSec) == 0, "exit");
+out:
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 3) {
+    std::fprintf(stderr, "usage: tcpcorr_comp_test <converge|hold> <tcp-correction exe>\n");
+    return 2;
+  }
+  std::snprintf(rid, sizeof(rid), "tcc%d", static_cast<int>(getpid()));
+  const std::string name = argv[1];
+  if (name != "converge" && name != "hold") {
+    std::fprintf(stderr, "tcpcorr_comp_test: unknown case '%s'\n", argv[1]);
+    return 2;
+  }
+  RunCase(name, argv[2]);
+  if (Leaked()) ++failures;
+  std::printf("tcpcorr.comp.%s: %s\n", name.c_str(), failures ? "FAIL" : "ok");
+  return failures ? 1 : 0;
+}
