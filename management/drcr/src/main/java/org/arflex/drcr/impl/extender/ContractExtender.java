@@ -194,6 +194,11 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
         Path d = dir.toPath();
         Files.createDirectories(d);
         Path target = d.resolve(exe);
+        // Same bundle revision started again: the copy from last time is still right.
+        if (Files.isRegularFile(target) && Files.getLastModifiedTime(target).toMillis() >= bundle.getLastModified()
+                && Files.isExecutable(target)) {
+            return target;
+        }
         Path tmp = Files.createTempFile(d, exe, ".tmp");
         try (InputStream in = u.openStream()) {
             Files.copy(in, tmp, StandardCopyOption.REPLACE_EXISTING);
