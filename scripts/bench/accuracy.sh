@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# ./arflex bench accuracy: the vision-corrected accuracy study (issue 7, bundles/vision/README.md):
+# 24 target poses, static TCP error against the simulator's ground truth with the outer
+# correction off and on; payload 0/100/210 kg, one and two cameras blocked, nominal tool
+# offset; vision frames and poses per second, frame-to-correction latency.
+#   scripts/bench/accuracy.sh [--quick] [--poses N] [--noise SIGMA] [--blur SIGMA]
+#                             [--period-ms P] [--width W --height H] [--no-refine]
+# Uses the Maven-built native tree (target/native) or ARFLEX_NATIVE_DIR; builds the benchmark
+# there if it is missing. JSON goes to target/bench/accuracy.json. Takes 10-30 minutes on a
+# loaded 2-core machine (software rendering dominates); --quick runs only payload 0.
+set -euo pipefail
+ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
+BUILD=${ARFLEX_NATIVE_DIR:-$ROOT/target/native}
+OUT=$ROOT/target/bench
+if [ ! -x "$BUILD/bin/arflex-accuracy-bench" ]; then
+  [ -f "$BUILD/build.ninja" ] || cmake -S "$ROOT" -B "$BUILD" -G Ninja >/dev/null
+  cmake --build "$BUILD" -j2 --target arflex-accuracy-bench
+fi
+mkdir -p "$OUT"
+exec "$BUILD/bin/arflex-accuracy-bench" --json "$OUT/accuracy.json" "$@"
