@@ -4,7 +4,8 @@
 // edge of `save` writes it as a program file that trajectory replays (start, via points, ptp:
 // one smooth motion through every recorded point).
 //
-// Ports: in joint_state (arflex.JointState), in wrench (arflex.Wrench), out joint_ref
+// Ports: in joint_state (arflex.JointState), in wrench (arflex.Wrench), in safety
+// (arflex.SafetyState, optional: a protective stop freezes the arm), out joint_ref
 // (arflex.JointRef). Recording: a preallocated buffer of kMaxPoints joint waypoints, a new one
 // whenever the reference moved more than record_step (rad, any joint) from the last one. The
 // file is written by a non-RT writer thread woken with sem_post (async-signal-safe, never
@@ -24,6 +25,7 @@
 #include "arflex/component.h"
 #include "arflex_types/joint_ref.h"
 #include "arflex_types/joint_state.h"
+#include "arflex_types/safety_state.h"
 #include "arflex_types/wrench.h"
 #include "cellkin.h"
 
@@ -37,6 +39,9 @@ struct State {
   struct arflex_port* out = nullptr;
   struct arflex_input* in_js = nullptr;
   struct arflex_input* in_w = nullptr;
+  struct arflex_input* in_safety = nullptr;
+  struct arflex_safety_state safety{};
+  bool have_safety = false;
   int p_teach, p_mass, p_damping, p_deadband, p_max_speed, p_payload, p_step, p_save, p_slot;
   struct arflex_joint_state js{};
   struct arflex_wrench w{};
@@ -112,13 +117,16 @@ int Configure(struct arflex_component* c, void*) {
                                               sizeof(struct arflex_wrench)};
   static const struct arflex_port_type ref_t = {ARFLEX_TYPE_JOINT_REF_NAME, 1, 0,
                                                 sizeof(struct arflex_joint_ref)};
+  static const struct arflex_port_type s_t = {ARFLEX_TYPE_SAFETY_STATE_NAME, 1, 0,
+                                              sizeof(struct arflex_safety_state)};
   int r = arflex_component_output(c, "joint_ref", ARFLEX_PORT_STATE, &ref_t, &g.out);
   if (r < 0) {
     fprintf(stderr, "teach: output joint_ref: %s\n", strerror(-r));
     return r;
   }
   if ((r = arflex_component_input(c, "joint_state", ARFLEX_PORT_STATE, &js_t, &g.in_js)) < 0 ||
-      (r = arflex_component_input(c, "wrench", ARFLEX_PORT_STATE, &w_t, &g.in_w)) < 0)
+      (r = arflex_component_input(c, "wrench", ARFLEX_PORT_STATE, &w_t, &g.in_w)) < 0 ||
+      (r = arflex_component_input(c, "safety", ARFLEX_PORT_STATE, &s_t, &g.in_safety)) < 0)
     return r;
   const char* names[] = {"teach", "mass", "damping", "deadband_n", "max_speed",
                          "payload_kg", "record_step", "save", "save_slot"};
@@ -193,6 +201,13 @@ int Update(struct arflex_component* c, void*, uint64_t release_ns) {
     for (int j = 0; j < 6; ++j) g.q_ref[j] = g.js.q[j];
     g.initialized = true;
   }
+  if (arflex_input_state_read(g.in_safety, &g.safety, sizeof(g.safety), nullptr) == 1)
+    g.have_safety = true;
+  if (!arflex_input_bound(g.in_safety)) g.have_safety = false;
+  // A protective stop (or a bound safety input that has not spoken yet) freezes the arm: it
+  // no longer yields to the hand until the guard is reset.
+  const bool stopped = arflex_input_bound(g.in_safety) &&
+                       (!g.have_safety || g.safety.mode == ARFLEX_SAFETY_STATE_MODE_PROTECTIVE_STOP);
   const double dt = arflex_component_ctl(c)->config.period_ns * 1e-9;
   const bool teach = arflex_param_bool(c, g.p_teach);
   if (teach && !g.teach_prev) {
@@ -207,7 +222,10 @@ int Update(struct arflex_component* c, void*, uint64_t release_ns) {
   if (!teach && g.teach_prev) Record(c, true);  // the end point
   g.teach_prev = teach;
 
-  if (teach) {
+  if (teach && stopped) {
+    g.v.setZero();
+    g.x = g.model.Tcp(g.q_ref).translation();
+  } else if (teach) {
     Eigen::Vector3d f_hand = Eigen::Vector3d::Zero();
     if (g.have_w && g.have_js) {
       Q qm;

@@ -508,8 +508,14 @@ void CaseTeachReplay() {
   CHECK(!dir.empty(), "mkdtemp");
   std::string env = "ARFLEX_DATA_DIR=" + dir;
   char* envp[] = {const_cast<char*>(env.c_str()), nullptr};
-  int r = Make(&script, "script", kMs, {{"joint_state", kJsT}, {"wrench", kWT}}, {}, nullptr);
+  int r = Make(&script, "script", kMs, {{"joint_state", kJsT}, {"wrench", kWT}, {"safety", kST}}, {},
+               nullptr);
   CHECK(r == 0, "script: %d", r);
+  struct arflex_safety_state safety;
+  memset(&safety, 0, sizeof(safety));
+  safety.mode = ARFLEX_SAFETY_STATE_MODE_NORMAL;
+  safety.power_scale = 1;
+  arflex_state_write(arflex_host_output(&script, "safety"), &safety, sizeof(safety));
   r = Make(&teach, "teach", kMs, {{"joint_ref", kRefT}},
            {PB("teach", false, true), PD("mass", 20, 0.1, 1000, true),
             PD("damping", 400, 1, 100000, true), PD("deadband_n", 5, 0, 1000, true),
@@ -525,6 +531,7 @@ void CaseTeachReplay() {
   WriteRobot(&script, m, q, Q::Zero(), Eigen::Vector3d::Zero(), &wseq);
   bool ok = arflex_host_bind(&teach, "joint_state", arflex_host_output_name(&script, "joint_state"), kCall) == 0 &&
             arflex_host_bind(&teach, "wrench", arflex_host_output_name(&script, "wrench"), kCall) == 0 &&
+            arflex_host_bind(&teach, "safety", arflex_host_output_name(&script, "safety"), kCall) == 0 &&
             SetI(&teach, "save_slot", 3) == 0 && arflex_host_start(&teach, kCall) == 0 &&
             arflex_host_set_param(&teach, "teach", 1, nullptr, kCall) == 0;
   if (!ok) RemoveDir(dir);
@@ -532,8 +539,10 @@ void CaseTeachReplay() {
   Reader tr;
   CHECK(tr.Open(&teach, "joint_ref", &kRefT) == 0, "open teach ref");
   // The test plays a perfect robot: the measured position is teach's reference; the hand
-  // pulls 60 N along +y for 1500 of teach's cycles, then along -z for 1000, then lets go.
-  std::vector<Q> taught;
+  // pulls 60 N along +y for 1500 of teach's cycles, then along -z for 1000, then lets go; at
+  // 3000 a protective stop comes and the hand pulls along +x for 400 cycles: the arm must not
+  // yield; at 3400 the stop ends and the hand is gone.
+  std::vector<Q> taught, frozen;
   uint64_t first = 0, seq = 0;
   const uint64_t dl = Now() + kWait;
   struct arflex_joint_ref ref;
@@ -550,14 +559,27 @@ void CaseTeachReplay() {
     Eigen::Vector3d hand = Eigen::Vector3d::Zero();
     if (k < 1500) hand = Eigen::Vector3d(0, 60, 0);
     else if (k < 2500) hand = Eigen::Vector3d(0, 0, -60);
-    else if (k > 3000) break;
+    else if (k >= 3000 && k < 3400) hand = Eigen::Vector3d(60, 0, 0);
+    else if (k >= 3600) break;
+    if (k >= 3010 && k < 3400) frozen.push_back(qr);
+    const uint32_t mode = k >= 3000 && k < 3400 ? ARFLEX_SAFETY_STATE_MODE_PROTECTIVE_STOP
+                                                : ARFLEX_SAFETY_STATE_MODE_NORMAL;
+    if (mode != safety.mode) {  // written before the force, read by teach after it
+      safety.mode = mode;
+      ++safety.seq;
+      arflex_state_write(arflex_host_output(&script, "safety"), &safety, sizeof(safety));
+    }
     WriteRobot(&script, m, qr, Q::Zero(), hand, &wseq);
   }
   const Eigen::Vector3d p0 = m.Tcp(q).translation(), p1 = m.Tcp(taught.back()).translation();
   printf("teach: TCP moved by (%.4f, %.4f, %.4f) m\n", p1.x() - p0.x(), p1.y() - p0.y(), p1.z() - p0.z());
   ok = p1.y() - p0.y() > 0.1 && p0.z() - p1.z() > 0.05 && std::fabs(p1.x() - p0.x()) < 0.01;
+  bool held = frozen.size() > 100;
+  for (const Q& f : frozen) held = held && (f - frozen.front()).norm() == 0;
+  ok = ok && held;
   if (!ok) RemoveDir(dir);
-  CHECK(ok, "the arm did not follow the hand");
+  CHECK(ok, "the arm did not follow the hand (or yielded during the protective stop: %zu "
+        "frozen samples, held %d)", frozen.size(), held);
   // Leave teach mode, save.
   const std::string path = arflex::cellkin::ProgramPath(dir, 3);
   ok = arflex_host_set_param(&teach, "teach", 0, nullptr, kCall) == 0 &&
