@@ -97,8 +97,10 @@ double ParamF64(arflex_component* c, int idx, double def) {
   return idx >= 0 ? arflex_param_f64(c, idx) : def;
 }
 
+// The type's largest slot (header + MAX_PAYLOAD), as every arflex.ImageFrame provider
+// declares it; frames above 1280x1024 RGB are counted out by the size check in update().
 const arflex_port_type kFrameType = {ARFLEX_TYPE_IMAGE_FRAME_NAME, 1, 0,
-                                     static_cast<uint32_t>(ARFLEX_TYPE_IMAGE_FRAME_SIZE + kMaxPixels)};
+                                     ARFLEX_TYPE_IMAGE_FRAME_SIZE + ARFLEX_TYPE_IMAGE_FRAME_MAX_PAYLOAD};
 const arflex_port_type kJointType = {ARFLEX_TYPE_JOINT_STATE_NAME, 1, 0, ARFLEX_TYPE_JOINT_STATE_SIZE};
 const arflex_port_type kPoseType = {ARFLEX_TYPE_POSE_NAME, 1, 0, ARFLEX_TYPE_POSE_SIZE};
 

@@ -35,9 +35,8 @@ constexpr uint64_t kSec = 1000000000ull;
 constexpr uint64_t kMs = 1000000ull;
 constexpr int kW = 1280, kH = 1024;  // the cell cameras' resolution
 constexpr uint32_t kFrameBytes = ARFLEX_TYPE_IMAGE_FRAME_SIZE + kW * kH;
-// The component's frame inputs accept frames up to 1280x1024 RGB: the port type's elem_size
-// is that maximum, and a provider declares the same type.
-constexpr uint32_t kFrameElem = ARFLEX_TYPE_IMAGE_FRAME_SIZE + 1280u * 1024u * 3u;
+// Frame providers declare the type's largest slot (as sim-camera does).
+constexpr uint32_t kFrameElem = ARFLEX_TYPE_IMAGE_FRAME_SIZE + ARFLEX_TYPE_IMAGE_FRAME_MAX_PAYLOAD;
 
 char rid[ARFLEX_ID_MAX + 1];
 int failures = 0;
