@@ -65,6 +65,22 @@ public final class Activator implements BundleActivator {
 
     @Override
     public void start(BundleContext ctx) throws Exception {
+        try {
+            doStart(ctx);
+        } catch (Exception | Error e) {
+            // Felix does not call stop() after a failed start: undo what was started here.
+            if (actor != null) {
+                try {
+                    stop(ctx);
+                } catch (Exception ignored) {
+                    // the original failure is the one to report
+                }
+            }
+            throw e;
+        }
+    }
+
+    private void doStart(BundleContext ctx) throws Exception {
         rid = prop(ctx, "arflex.runtime.id", "rt" + ProcessHandle.current().pid());
         if (!RID.matcher(rid).matches()) {
             throw new IllegalArgumentException("arflex.runtime.id '" + rid + "' must match [a-z0-9-]{1,40}");
