@@ -6,8 +6,10 @@ import static org.junit.jupiter.api.Assertions.assertTrue;
 import java.nio.file.Files;
 import java.nio.file.Path;
 import java.util.List;
+import java.util.Map;
 import org.arflex.contract.Contract;
 import org.arflex.contract.ContractParser;
+import org.arflex.contract.Filter;
 import org.arflex.contract.PortSpec;
 import org.junit.jupiter.api.Test;
 
@@ -53,5 +55,25 @@ class CellContractsTest {
         assertEquals(out.method(), in.method());
         assertTrue(in.optional());
         assertTrue(load("trajectory").movesHardware());
+    }
+
+    @Test
+    void inputFiltersSelectTheIntendedProviders() throws Exception {
+        Map<String, String> guard = load("force-guard").attributes();
+        Map<String, String> robot = Map.of("role", "robot", "simulated", "true", "axes", "6");
+        Map<String, String> sampleSource = Map.of("role", "source");
+        for (String n : List.of("trajectory", "teach")) {
+            assertTrue(filterOf(n, "safety").matches(guard), n + ".safety must bind the force guard");
+            assertTrue(filterOf(n, "joint_state").matches(robot), n + ".joint_state must bind the robot");
+        }
+        assertTrue(filterOf("force-guard", "wrench").matches(robot));
+        // A tool's optional command input must not pick up an unrelated arflex.Sample source.
+        assertTrue(!filterOf("tool-gripper", "command").matches(sampleSource));
+        assertTrue(!filterOf("tool-spindle", "command").matches(sampleSource));
+    }
+
+    private static Filter filterOf(String component, String port) throws Exception {
+        PortSpec in = load(component).port(port).orElseThrow();
+        return Filter.parse(in.binding().orElseThrow().filter().orElseThrow());
     }
 }
