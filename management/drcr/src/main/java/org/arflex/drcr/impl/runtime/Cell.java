@@ -313,7 +313,10 @@ public final class Cell {
         }
         for (String name : plan.startOrder()) {
             Instance inst = instances.get(name);
-            if (inst != null && inst.half == null && inst.life.state() != State.FAILED) {
+            // A start that failed earlier in this loop blocked its component, and the nested
+            // plan took its dependents out of the active set: ask the planner again.
+            if (inst != null && inst.half == null && inst.life.state() != State.FAILED
+                    && planner.active().contains(name)) {
                 startHalf(inst, plan.cpuAssignment().getOrDefault(name, -1), plan.wiringOf(name));
             }
         }

@@ -169,6 +169,19 @@ class CellTest {
     }
 
     @Test
+    void failedProviderStartDoesNotStartItsDependentsInTheSamePlan() throws Exception {
+        install(contract("cons", CONSUMER_PORTS, PERMANENT, false, 3, "50us"));
+        launcher.failLaunches.put("prov", 1);
+        install(contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us"));
+        assertEquals(State.UNSATISFIED, state("prov"));
+        assertEquals(State.UNSATISFIED, state("cons"), "a consumer must not start bound to a provider that failed");
+        assertFalse(launcher.running.containsKey("cons"));
+        actor.advance(100);
+        assertEquals(State.ACTIVE, state("prov"));
+        assertEquals(State.ACTIVE, state("cons"));
+    }
+
+    @Test
     void temporaryIsNotRestarted() throws Exception {
         install(contract("prov", PROVIDER_PORTS, "restart=\"temporary\" intensity=\"1\" window=\"1s\" backoff=\"10ms\"", false, 5, "50us"));
         launcher.running.get("prov").crash(1, "exited with status 1");
