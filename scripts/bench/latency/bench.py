@@ -169,6 +169,68 @@ def block(fn, cpu, *args):
     return r
 
 
+def merge_cpu_time(parts):
+    parts = [p for p in parts if p]
+    if not parts:
+        return None
+    return {k: round(sum(p[k] for p in parts), 2) for k in parts[0]}
+
+
+def merge_raw(rounds):
+    """Concatenates the rounds of a raw-sample contender (probe, cyclictest)."""
+    m = {"lat": [], "dev": [], "overruns": 0, "rounds": len(rounds)}
+    for r in rounds:
+        m["lat"] += r["lat"]
+        m["dev"] += r["dev"]  # within a round only: no deviation across a restart
+        m["overruns"] += r["overruns"]
+    m["cpu_time"] = merge_cpu_time([r.get("cpu_time") for r in rounds])
+    if "reader" in rounds[0]:
+        m["overruns_control_block"] = sum(r["overruns_control_block"] or 0 for r in rounds)
+        m["reader"] = [r["reader"] for r in rounds]
+    return m
+
+
+def merge_baseline(runs, key, bin_ns_key="histogram_bin_ns"):
+    """Long-run columns of the pure C task over several runs, from its JSON files (it keeps no
+    raw samples for us). count/average/min/max/overruns are exact. A percentile is exact to
+    the 100 ns bin from the merged histogram while it lies below the histogram's range
+    (200 us); beyond it, the largest of the runs' exact percentiles is given as an upper
+    bound (a percentile of a union never exceeds the largest per-run one) and flagged."""
+    ms = [r[key] for r in runs]
+    n = sum(m["count"] for m in ms)
+    out = {"count": n, "average": sum(m["avg"] * m["count"] for m in ms) / n,
+           "avedev": None, "min": min(m["min"] for m in ms), "max": max(m["max"] for m in ms),
+           "percentile_method": {}}
+    if len(runs) == 1:
+        m = ms[0]
+        out["avedev"] = m["avedev"]
+        for k in ("p50", "p99", "p99_9"):
+            out[k] = m.get(k + "_exact", m[k])
+            out["percentile_method"][k] = "exact"
+        return out
+    hist = None
+    if key == "wakeup_latency_ns":
+        hist = [sum(col) for col in zip(*[r["latency_histogram"] for r in runs])]
+        bin_ns = runs[0][bin_ns_key]
+    for k, p in (("p50", 50.0), ("p99", 99.0), ("p99_9", 99.9)):
+        v = None
+        if hist:
+            target = max(1, -(-p * n // 100))
+            acc = 0
+            for i, c in enumerate(hist):
+                acc += c
+                if acc >= target:
+                    v = None if i == len(hist) - 1 else (i + 1) * bin_ns
+                    break
+        if v is not None:
+            out[k] = v
+            out["percentile_method"][k] = f"merged {bin_ns} ns histogram (upper bin edge)"
+        else:
+            out[k] = max(m.get(k + "_exact", m[k]) for m in ms)
+            out["percentile_method"][k] = "upper bound: largest per-run exact percentile"
+    return out
+
+
 def run_probe(rt, jar, reader, n, cpu_other, work, tag):
     """Installs the probe bundle, reads n samples through the reader, uninstalls it."""
     samples = os.path.join(work, f"{tag}-probe.txt")
@@ -273,6 +335,7 @@ class Reconfiguration(threading.Thread):
         self.counts = {"ticks": 0, "late_ticks": 0, "dto_polls": 0, "installs": 0, "uninstalls": 0,
                        "updates": 0, "errors": 0}
         self.first_error = None
+        self.placements = {}
         self.dummy_id = None
         self.update_id = None
 
@@ -285,8 +348,12 @@ class Reconfiguration(threading.Thread):
         while not self.halt.is_set():
             self.counts["ticks"] += 1
             try:
-                self.rt.dto()
+                d = self.rt.dto()
                 self.counts["dto_polls"] += 1
+                for i in d.get("instances", []):  # where the admission put the churned components
+                    if i.get("name") != "latency-probe" and i.get("cpu") is not None:
+                        key = f"{i.get('name')}@cpu{i.get('cpu')}"
+                        self.placements[key] = self.placements.get(key, 0) + 1
                 if self.dummy_id is None:
                     self.dummy_id = self.rt.install(self.dummy_jar)
                     self.counts["installs"] += 1
@@ -330,23 +397,19 @@ def summarise(res, obs):
     out = {}
     for c, r in res.items():
         if c == "pure C":
-            short, long_ = r["short"], r["long"]
-            w4, wl = short["wakeup_latency_ns"], long_["wakeup_latency_ns"]
-            d4, dl = short["period_deviation_ns"], long_["period_deviation_ns"]
+            short, runs = r["short"], r["long"]
+            w4, d4 = short["wakeup_latency_ns"], short["period_deviation_ns"]
             out[c] = {
                 "wakeup": {"table1": {"count": w4["count"], "average": w4["avg"], "avedev": w4["avedev"],
                                       "min": w4["min"], "max": w4["max"]},
-                           "long": {"count": wl["count"], "average": wl["avg"], "avedev": wl["avedev"],
-                                    "min": wl["min"], "max": wl["max"], "p50": wl["p50_exact"],
-                                    "p99": wl["p99_exact"], "p99_9": wl["p99_9_exact"]}},
+                           "long": merge_baseline(runs, "wakeup_latency_ns")},
                 "deviation": {"table1": {"count": d4["count"], "average": d4["avg"], "avedev": d4["avedev"],
                                          "min": d4["min"], "max": d4["max"]},
-                              "long": {"count": dl["count"], "average": dl["avg"], "avedev": dl["avedev"],
-                                       "min": dl["min"], "max": dl["max"], "p50": dl["p50"], "p99": dl["p99"],
-                                       "p99_9": dl["p99_9"]}},
-                "overruns": long_["overruns"],
-                "note": "separate runs of 4000 (Table 1) and of the long length (exact, from the tool's JSON)",
-                "cpu_time": {"table1": short.get("cpu_time"), "long": long_.get("cpu_time")},
+                              "long": merge_baseline(runs, "period_deviation_ns")},
+                "overruns": sum(x["overruns"] for x in runs),
+                "note": "Table 1 from a separate run of exactly the observations; long run from the tool's JSON",
+                "cpu_time": {"table1": short.get("cpu_time"),
+                             "long": merge_cpu_time([x.get("cpu_time") for x in runs])},
             }
         else:
             out[c] = {"wakeup": {"table1": stats.table1(r["lat"][:obs]), "long": stats.long_run(r["lat"])},
@@ -354,8 +417,7 @@ def summarise(res, obs):
                       "overruns": r["overruns"], "cpu_time": r.get("cpu_time")}
             if c == "probe":
                 out[c]["overruns_control_block"] = r["overruns_control_block"]
-                out[c]["control_block"] = (r["reader"].get("ctl") or {})
-                out[c]["stream"] = r["reader"]["stream"]
+                out[c]["reader_per_round"] = r["reader"]
     return out
 
 
@@ -457,6 +519,9 @@ def main():
     ap.add_argument("--duration", type=int, default=30,
                     help="long run per contender and mode, seconds (default 30)")
     ap.add_argument("--observations", type=int, default=4000, help="Table 1 observations (default 4000)")
+    ap.add_argument("--rounds", type=int, default=3,
+                    help="split each contender's long run into this many blocks, the order rotating "
+                         "every round (default 3; fewer when a block would hold fewer than --observations)")
     ap.add_argument("--modes", default=",".join(MODES), help="comma list of light,stress,reconfiguration")
     ap.add_argument("--quick", action="store_true", help="fast check: --duration 5")
     ap.add_argument("--seed", type=int, default=20240601, help="seed of stress-ng (default 20240601)")
@@ -480,6 +545,9 @@ def main():
     n_long = a.duration * 1000
     if n_long < a.observations:
         ap.error(f"--duration {a.duration} s gives {n_long} cycles, fewer than --observations {a.observations}")
+    rounds = max(1, min(a.rounds, n_long // a.observations))
+    if rounds != a.rounds:
+        log(f"--rounds {a.rounds} -> {rounds}: a block must hold at least {a.observations} cycles")
     if not 1 <= a.priority <= 98:
         ap.error("--priority must be 1..98")
     ncpu = os.cpu_count() or 1
@@ -531,15 +599,27 @@ def main():
                 reconf.start()
                 time.sleep(2)
             try:
-                res = {}
-                log(f"  probe ({n_long} cycles)")
-                res["probe"] = block(run_probe, a.cpu, rt, probe_jar, reader, n_long, cpu_other, work, mode)
-                log(f"  pure C ({a.observations} + {n_long} cycles)")
-                res["pure C"] = {"short": block(run_baseline, a.cpu, baseline, a.observations, a.cpu, a.priority,
-                                                work, mode),
-                                 "long": block(run_baseline, a.cpu, baseline, n_long, a.cpu, a.priority, work, mode)}
-                log(f"  cyclictest ({n_long} cycles)")
-                res["cyclictest"] = block(run_cyclictest, a.cpu, n_long, a.cpu, a.priority, cpu_other, work, mode)
+                raw = {c: [] for c in CONTENDERS}
+                short = None
+                n_round = n_long // rounds
+                for r in range(rounds):
+                    order = CONTENDERS[r % 3:] + CONTENDERS[:r % 3]
+                    for c in order:
+                        log(f"  round {r + 1}/{rounds}: {c} ({n_round} cycles)")
+                        if c == "probe":
+                            raw[c].append(block(run_probe, a.cpu, rt, probe_jar, reader, n_round, cpu_other,
+                                                work, f"{mode}-{r}"))
+                        elif c == "pure C":
+                            if short is None:
+                                short = block(run_baseline, a.cpu, baseline, a.observations, a.cpu, a.priority,
+                                              work, f"{mode}-t1")
+                            raw[c].append(block(run_baseline, a.cpu, baseline, n_round, a.cpu, a.priority,
+                                                work, f"{mode}-{r}"))
+                        else:
+                            raw[c].append(block(run_cyclictest, a.cpu, n_round, a.cpu, a.priority, cpu_other,
+                                                work, f"{mode}-{r}"))
+                res = {"probe": merge_raw(raw["probe"]), "cyclictest": merge_raw(raw["cyclictest"]),
+                       "pure C": {"short": short, "long": raw["pure C"]}}
                 res["load_average"] = os.getloadavg()
                 results[mode] = res
             finally:
@@ -548,7 +628,7 @@ def main():
                     children.remove(load)
                 if reconf is not None:
                     reconf.finish()
-                    reconf_counts = dict(reconf.counts, first_error=reconf.first_error,
+                    reconf_counts = dict(reconf.counts, first_error=reconf.first_error, placements=reconf.placements,
                                          seconds=round(time.monotonic() - reconf_t0, 1))
     finally:
         if rt is not None:
@@ -570,8 +650,8 @@ def main():
         for c in CONTENDERS:
             r = results[m][c]
             if c == "pure C":
-                lh = r["long"]["latency_histogram"]
-                series.append((c, stats.rebin(lh, r["long"]["histogram_bin_ns"], HIST_BIN_NS, HIST_NBINS)))
+                lh = [sum(col) for col in zip(*[x["latency_histogram"] for x in r["long"]])]
+                series.append((c, stats.rebin(lh, r["long"][0]["histogram_bin_ns"], HIST_BIN_NS, HIST_NBINS)))
             else:
                 series.append((c, stats.histogram(r["lat"], HIST_BIN_NS, HIST_NBINS)))
         path = os.path.join(a.out, f"latency-{m}.svg")
@@ -580,10 +660,12 @@ def main():
     doc = {"benchmark": "latency", "issue": 5, "date": datetime.datetime.now(datetime.timezone.utc).isoformat(),
            "machine": info, "seed": a.seed,
            "options": {"cpu": a.cpu, "priority": a.priority, "period_ns": PERIOD_NS, "duration_s": a.duration,
-                       "observations": a.observations, "modes": modes, "quick": a.quick, "runtime_id": a.rid,
+                       "observations": a.observations, "rounds": rounds, "modes": modes, "quick": a.quick, "runtime_id": a.rid,
                        "native_dir": a.native_dir, "runtime_dir": a.runtime_dir,
                        "stress_ng": stress_args("T", a.seed, "<work>") if "stress" in modes else None,
-                       "schedule": "interleaved per mode: probe, pure C (4000 then long), cyclictest",
+                       "schedule": "interleaved per mode in rounds; round r runs the contenders in the order "
+                                   "probe, pure C, cyclictest rotated by r; pure C's Table-1 run of exactly "
+                                   "the observations comes before its first long block",
                        "cyclictest": f"cyclictest -m -p {a.priority} -a {a.cpu} -t 1 -d 0 -i 1000 -l N -v -N"},
            "elapsed_s": round(time.time() - t0, 1),
            "definitions": {"wakeup": "actual wake - planned release (ns, >= 0), as cyclictest",
