@@ -57,8 +57,10 @@ UpdateResult CorrectionLaw::Update(const Matrix6d& jacobian, const Eigen::Isomet
     step *= options_.max_step / biggest;  // keep the direction
     limited = true;
   }
+  // The measurement shows the arm with the correction applied so far, not the target the
+  // rate limit is still ramping to: the step is taken from there (no wind-up while ramping).
   for (int i = 0; i < kJoints; ++i) {
-    const double t = target_(i) + step(i);
+    const double t = applied_(i) + step(i);
     const double c = std::clamp(t, -options_.max_correction, options_.max_correction);
     limited = limited || c != t;
     target_(i) = c;

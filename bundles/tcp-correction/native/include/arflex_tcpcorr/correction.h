@@ -1,8 +1,12 @@
 // The outer loop of the paper: a joint correction from the measured and the desired tool
 // pose through the nominal model's Jacobian, added to the trajectory's reference.
 //
-//   target += gain * J_nominal^+ (desired - measured)        (once per valid measurement)
-//   applied -> target at no more than max_rate               (every servo tick)
+//   target = applied + gain * J_nominal^+ (desired - measured)  (once per valid measurement)
+//   applied -> target at no more than max_rate                  (every servo tick)
+//
+// The step starts from the applied correction (what the measured arm was doing), not from a
+// target the rate limit is still ramping to, so a measurement taken mid-ramp does not wind
+// the correction up.
 //
 // The target moves by at most `max_step` per joint per measurement and never beyond
 // `max_correction`; an invalid measurement, or one whose error exceeds `max_error`, holds
