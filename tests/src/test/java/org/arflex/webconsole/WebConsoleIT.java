@@ -406,9 +406,10 @@ class WebConsoleIT {
         assertTrue(why.contains("sample-counter") || why.contains("x"), "reason names the missing input: " + why);
 
         // Start it again from its page: both Active.
+        // A stopped bundle's component stays in the cell as INSTALLED, and its page says so.
         open("arflex-component?name=sample-counter");
-        await(By.id("arflex-component-status"));
-        browser.findElement(By.id("arflex-cmd-start")).click();
+        new WebDriverWait(browser, WAIT).until(d -> d.findElement(By.id("arflex-summary")).getText().contains("INSTALLED"));
+        await(By.id("arflex-cmd-start")).click();
         RuntimeUnderTest.awaitCondition("both Active", WAIT,
                 () -> "ACTIVE".equals(instanceState("sample-counter")) && "ACTIVE".equals(instanceState("sample-scaler")));
     }
