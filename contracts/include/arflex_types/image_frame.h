@@ -18,7 +18,7 @@
 #define ARFLEX_TYPE_IMAGE_FRAME_VERSION_MAJOR 1u
 #define ARFLEX_TYPE_IMAGE_FRAME_VERSION_MINOR 0u
 /* FNV-1a 64 of "arflex.ImageFrame@1" */
-#define ARFLEX_TYPE_IMAGE_FRAME_ID UINT64_C(0x82e13930f391b494)
+#define ARFLEX_TYPE_IMAGE_FRAME_ID UINT64_C(0x4e8fdb4ac31b43df)
 #define ARFLEX_TYPE_IMAGE_FRAME_SIZE 40u
 /* methods: frame (bit 0 state, bit 1 stream, bit 2 frame) */
 #define ARFLEX_TYPE_IMAGE_FRAME_METHODS 0x4u

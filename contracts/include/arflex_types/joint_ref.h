@@ -18,7 +18,7 @@
 #define ARFLEX_TYPE_JOINT_REF_VERSION_MAJOR 1u
 #define ARFLEX_TYPE_JOINT_REF_VERSION_MINOR 0u
 /* FNV-1a 64 of "arflex.JointRef@1" */
-#define ARFLEX_TYPE_JOINT_REF_ID UINT64_C(0xaa4e68a2b3005bc7)
+#define ARFLEX_TYPE_JOINT_REF_ID UINT64_C(0xb85a3e5bd8d457e4)
 #define ARFLEX_TYPE_JOINT_REF_SIZE 64u
 /* methods: state stream (bit 0 state, bit 1 stream, bit 2 frame) */
 #define ARFLEX_TYPE_JOINT_REF_METHODS 0x3u

@@ -18,7 +18,7 @@
 #define ARFLEX_TYPE_JOINT_STATE_VERSION_MAJOR 1u
 #define ARFLEX_TYPE_JOINT_STATE_VERSION_MINOR 0u
 /* FNV-1a 64 of "arflex.JointState@1" */
-#define ARFLEX_TYPE_JOINT_STATE_ID UINT64_C(0x544a91a68934ef9f)
+#define ARFLEX_TYPE_JOINT_STATE_ID UINT64_C(0x6277ebd142e7b01c)
 #define ARFLEX_TYPE_JOINT_STATE_SIZE 160u
 /* methods: state stream (bit 0 state, bit 1 stream, bit 2 frame) */
 #define ARFLEX_TYPE_JOINT_STATE_METHODS 0x3u

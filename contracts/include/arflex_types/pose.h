@@ -18,7 +18,7 @@
 #define ARFLEX_TYPE_POSE_VERSION_MAJOR 1u
 #define ARFLEX_TYPE_POSE_VERSION_MINOR 0u
 /* FNV-1a 64 of "arflex.Pose@1" */
-#define ARFLEX_TYPE_POSE_ID UINT64_C(0xf1fc7c31ca698dab)
+#define ARFLEX_TYPE_POSE_ID UINT64_C(0x68c9545ed1ee0bc8)
 #define ARFLEX_TYPE_POSE_SIZE 128u
 /* methods: state stream (bit 0 state, bit 1 stream, bit 2 frame) */
 #define ARFLEX_TYPE_POSE_METHODS 0x3u

@@ -18,7 +18,7 @@
 #define ARFLEX_TYPE_SAFETY_STATE_VERSION_MAJOR 1u
 #define ARFLEX_TYPE_SAFETY_STATE_VERSION_MINOR 0u
 /* FNV-1a 64 of "arflex.SafetyState@1" */
-#define ARFLEX_TYPE_SAFETY_STATE_ID UINT64_C(0xf23486f6db7374d7)
+#define ARFLEX_TYPE_SAFETY_STATE_ID UINT64_C(0x5fafcad366ec09d4)
 #define ARFLEX_TYPE_SAFETY_STATE_SIZE 48u
 /* methods: state (bit 0 state, bit 1 stream, bit 2 frame) */
 #define ARFLEX_TYPE_SAFETY_STATE_METHODS 0x1u

@@ -18,7 +18,7 @@
 #define ARFLEX_TYPE_SAMPLE_VERSION_MAJOR 1u
 #define ARFLEX_TYPE_SAMPLE_VERSION_MINOR 0u
 /* FNV-1a 64 of "arflex.Sample@1" */
-#define ARFLEX_TYPE_SAMPLE_ID UINT64_C(0x13c4490b990efbe8)
+#define ARFLEX_TYPE_SAMPLE_ID UINT64_C(0x2bd21e2231635053)
 #define ARFLEX_TYPE_SAMPLE_SIZE 24u
 /* methods: state stream (bit 0 state, bit 1 stream, bit 2 frame) */
 #define ARFLEX_TYPE_SAMPLE_METHODS 0x3u

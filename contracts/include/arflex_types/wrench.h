@@ -18,7 +18,7 @@
 #define ARFLEX_TYPE_WRENCH_VERSION_MAJOR 1u
 #define ARFLEX_TYPE_WRENCH_VERSION_MINOR 0u
 /* FNV-1a 64 of "arflex.Wrench@1" */
-#define ARFLEX_TYPE_WRENCH_ID UINT64_C(0xc80ba863e2171cd3)
+#define ARFLEX_TYPE_WRENCH_ID UINT64_C(0x2e0e3f33e8786e30)
 #define ARFLEX_TYPE_WRENCH_SIZE 64u
 /* methods: state stream (bit 0 state, bit 1 stream, bit 2 frame) */
 #define ARFLEX_TYPE_WRENCH_METHODS 0x3u

@@ -29,9 +29,12 @@ public record PortType(String name, TypeVersion version, Set<PortSpec.Method> me
         constants = List.copyOf(constants);
     }
 
-    /** The 64-bit type id shared by C and Java: FNV-1a 64 of {@code name@major} (spec §13.3). */
+    /**
+     * The 64-bit type id shared by C and Java: FNV-1a 64 of the name, as rt-core's
+     * {@code arflex_port_type_hash} (spec §13.3); the version travels beside it.
+     */
     public long id() {
-        return fnv1a64(name + "@" + version.major());
+        return fnv1a64(name);
     }
 
     /** The field of that name (pads excluded). */

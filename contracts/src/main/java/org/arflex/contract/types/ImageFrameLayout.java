@@ -24,7 +24,7 @@ public final class ImageFrameLayout {
     /** Minor version. */
     public static final int VERSION_MINOR = 0;
     /** Type id: FNV-1a 64 of {@code "arflex.ImageFrame@1"}. */
-    public static final long ID = 0x82e13930f391b494L;
+    public static final long ID = 0x4e8fdb4ac31b43dfL;
     /** Size of one value, bytes. */
     public static final int SIZE = 40;
     /** Allowed methods: frame (bit 0 state, bit 1 stream, bit 2 frame). */

@@ -24,7 +24,7 @@ public final class JointRefLayout {
     /** Minor version. */
     public static final int VERSION_MINOR = 0;
     /** Type id: FNV-1a 64 of {@code "arflex.JointRef@1"}. */
-    public static final long ID = 0xaa4e68a2b3005bc7L;
+    public static final long ID = 0xb85a3e5bd8d457e4L;
     /** Size of one value, bytes. */
     public static final int SIZE = 64;
     /** Allowed methods: state stream (bit 0 state, bit 1 stream, bit 2 frame). */

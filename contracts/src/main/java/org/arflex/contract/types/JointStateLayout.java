@@ -24,7 +24,7 @@ public final class JointStateLayout {
     /** Minor version. */
     public static final int VERSION_MINOR = 0;
     /** Type id: FNV-1a 64 of {@code "arflex.JointState@1"}. */
-    public static final long ID = 0x544a91a68934ef9fL;
+    public static final long ID = 0x6277ebd142e7b01cL;
     /** Size of one value, bytes. */
     public static final int SIZE = 160;
     /** Allowed methods: state stream (bit 0 state, bit 1 stream, bit 2 frame). */

@@ -24,7 +24,7 @@ public final class PoseLayout {
     /** Minor version. */
     public static final int VERSION_MINOR = 0;
     /** Type id: FNV-1a 64 of {@code "arflex.Pose@1"}. */
-    public static final long ID = 0xf1fc7c31ca698dabL;
+    public static final long ID = 0x68c9545ed1ee0bc8L;
     /** Size of one value, bytes. */
     public static final int SIZE = 128;
     /** Allowed methods: state stream (bit 0 state, bit 1 stream, bit 2 frame). */

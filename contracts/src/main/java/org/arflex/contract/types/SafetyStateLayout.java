@@ -24,7 +24,7 @@ public final class SafetyStateLayout {
     /** Minor version. */
     public static final int VERSION_MINOR = 0;
     /** Type id: FNV-1a 64 of {@code "arflex.SafetyState@1"}. */
-    public static final long ID = 0xf23486f6db7374d7L;
+    public static final long ID = 0x5fafcad366ec09d4L;
     /** Size of one value, bytes. */
     public static final int SIZE = 48;
     /** Allowed methods: state (bit 0 state, bit 1 stream, bit 2 frame). */

@@ -24,7 +24,7 @@ public final class SampleLayout {
     /** Minor version. */
     public static final int VERSION_MINOR = 0;
     /** Type id: FNV-1a 64 of {@code "arflex.Sample@1"}. */
-    public static final long ID = 0x13c4490b990efbe8L;
+    public static final long ID = 0x2bd21e2231635053L;
     /** Size of one value, bytes. */
     public static final int SIZE = 24;
     /** Allowed methods: state stream (bit 0 state, bit 1 stream, bit 2 frame). */

@@ -24,7 +24,7 @@ public final class ToolStateLayout {
     /** Minor version. */
     public static final int VERSION_MINOR = 0;
     /** Type id: FNV-1a 64 of {@code "arflex.ToolState@1"}. */
-    public static final long ID = 0x933b04258e13c01fL;
+    public static final long ID = 0x44951820b62e8c9cL;
     /** Size of one value, bytes. */
     public static final int SIZE = 120;
     /** Allowed methods: state (bit 0 state, bit 1 stream, bit 2 frame). */

@@ -24,7 +24,7 @@ public final class WrenchLayout {
     /** Minor version. */
     public static final int VERSION_MINOR = 0;
     /** Type id: FNV-1a 64 of {@code "arflex.Wrench@1"}. */
-    public static final long ID = 0xc80ba863e2171cd3L;
+    public static final long ID = 0x2e0e3f33e8786e30L;
     /** Size of one value, bytes. */
     public static final int SIZE = 64;
     /** Allowed methods: state stream (bit 0 state, bit 1 stream, bit 2 frame). */
