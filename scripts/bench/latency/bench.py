@@ -599,7 +599,10 @@ def main():
             load = reconf = None
             if mode == "stress":
                 secs = 3 * a.duration + a.observations // 1000 + 120
-                load = spawn(stress_args(secs, a.seed, work), stdout=subprocess.DEVNULL)
+                # its "finished prematurely" warnings when we end it go to the work dir's log
+                stress_log = open(os.path.join(work, "stress-ng.log"), "w")
+                load = spawn(stress_args(secs, a.seed, work), stdout=stress_log, stderr=subprocess.STDOUT)
+                stress_log.close()
                 time.sleep(2)
             elif mode == "reconfiguration":
                 reconf = Reconfiguration(rt, dummy_jar, update_jar)
