@@ -236,6 +236,7 @@ def run_probe(rt, jar, reader, n, cpu_other, work, tag):
     samples = os.path.join(work, f"{tag}-probe.txt")
     summary = os.path.join(work, f"{tag}-probe.json")
     bid = rt.install(jar)
+    done = False
     try:
         inst = rt.wait_instance("latency-probe", "ACTIVE", timeout=60)
         args = ([ "taskset", "-c", str(cpu_other)] if cpu_other is not None else []) + [
@@ -245,9 +246,14 @@ def run_probe(rt, jar, reader, n, cpu_other, work, tag):
         rc = reap(p, n / 1000.0 + 60)
         if rc != 0:
             raise BenchError(f"latency-probe-reader exited {rc} (summary {summary})")
+        done = True
     finally:
-        rt.uninstall(bid)
-        rt.wait_gone("latency-probe", timeout=60)
+        try:
+            rt.uninstall(bid)
+            rt.wait_gone("latency-probe", timeout=60)
+        except RuntimeError_:
+            if done:
+                raise  # otherwise the first error (already propagating) is the one to report
     with open(summary) as f:
         summ = json.load(f)
     seqs, rel, lat = [], [], []
