@@ -40,14 +40,18 @@ class Runtime:
         self.lock = threading.Lock()
         self.marker = 0
         threading.Thread(target=self._pump, daemon=True, name="runtime-out").start()
-        deadline = time.monotonic() + 90
-        while True:
-            r = self.cmd("arflex:dto", timeout=60)
-            if r.startswith("{"):
-                break
-            if time.monotonic() > deadline:
-                raise RuntimeError_(f"the DRCR did not start within 90 s (last reply: {r[:200]!r}; log {log_path})")
-            time.sleep(0.2)
+        try:
+            deadline = time.monotonic() + 90
+            while True:
+                r = self.cmd("arflex:dto", timeout=60)
+                if r.startswith("{"):
+                    break
+                if time.monotonic() > deadline:
+                    raise RuntimeError_(f"the DRCR did not start within 90 s (last reply: {r[:200]!r}; log {log_path})")
+                time.sleep(0.2)
+        except BaseException:  # the caller gets no object to close: stop the JVM here
+            self.close(timeout=5)
+            raise
 
     def _pump(self):
         for line in self.proc.stdout:
