@@ -662,6 +662,9 @@ def main():
     print_targets(rows)
     if reconf_counts:
         print(f"\nreconfiguration load: {reconf_counts}")
+    for m in MODES:  # a plot of a mode not run this time would be stale
+        if m not in modes and os.path.exists(os.path.join(a.out, f"latency-{m}.svg")):
+            os.remove(os.path.join(a.out, f"latency-{m}.svg"))
     for m in modes:
         series = []
         for c in CONTENDERS:
