@@ -13,7 +13,7 @@
 //
 // Usage: arflex-accuracy-bench [--json FILE] [--width W --height H] [--poses N]
 //                              [--noise SIGMA] [--blur SIGMA] [--period-ms P] [--quick]
-//                              [--no-refine] [--only INDEX] [--trace]
+//                              [--no-refine] [--only INDEX] [--trace] [--outlier-px PX]
 // --quick: only the payload-0 run; --no-refine: AprilTag's corners without the edge re-fit.
 #include <algorithm>
 #include <array>
@@ -60,6 +60,7 @@ struct Args {
   int period_ms = 100;
   bool quick = false;
   bool refine = true;
+  double outlier_px = vision::EstimatorOptions{}.outlier_px;
   int only = -1;       // run only this target (debugging)
   bool trace = false;  // print every measurement of the loop
 };
@@ -283,6 +284,7 @@ bool Bench::Run(const std::string& name, double payload, const std::vector<int>&
   dopt.max_width = args_.width;
   dopt.max_height = args_.height;
   dopt.refine_corners = args_.refine;
+  est_options_.outlier_px = args_.outlier_px;
   detector_ = vision::TagDetector::Create(dopt, &error);
   if (!detector_) {
     std::fprintf(stderr, "accuracy-bench: %s\n", error.c_str());
@@ -405,7 +407,7 @@ bool Bench::Run(const std::string& name, double payload, const std::vector<int>&
     const double e0 = row.off_mm;
     std::vector<double> trace;  // true error (mm) at every servo step
     int quiet = 0;
-    const int max_iterations = 20;
+    const int max_iterations = 30;
     int it = 0;
     for (; it < max_iterations; ++it) {
       const vision::PoseEstimate est = Measure(true, r, false);
@@ -508,8 +510,9 @@ void PrintRun(const RunResult& r, bool per_pose) {
 void WriteJson(FILE* f, const Args& a, const std::vector<RunResult>& runs) {
   std::fprintf(f, "{\n  \"benchmark\": \"arflex-accuracy-bench\",\n");
   std::fprintf(f, "  \"config\": {\"width\": %d, \"height\": %d, \"poses\": %d, \"noise_sigma\": %g, "
-                  "\"blur_sigma\": %g, \"vision_period_ms\": %d, \"corner_refit\": %s},\n",
-               a.width, a.height, a.poses, a.noise, a.blur, a.period_ms, a.refine ? "true" : "false");
+                  "\"blur_sigma\": %g, \"vision_period_ms\": %d, \"corner_refit\": %s, \"outlier_px\": %g},\n",
+               a.width, a.height, a.poses, a.noise, a.blur, a.period_ms, a.refine ? "true" : "false",
+               a.outlier_px);
   std::fprintf(f, "  \"runs\": [\n");
   for (size_t i = 0; i < runs.size(); ++i) {
     const RunResult& r = runs[i];
@@ -576,7 +579,7 @@ bool ParseArgs(int argc, char** argv, Args* a) {
       continue;
     }
     if (k == "--json" || k == "--width" || k == "--height" || k == "--poses" || k == "--noise" ||
-        k == "--blur" || k == "--period-ms" || k == "--only") {
+        k == "--blur" || k == "--period-ms" || k == "--only" || k == "--outlier-px") {
       if (!(v = value(k.c_str()))) return false;
     } else {
       std::fprintf(stderr, "accuracy-bench: unknown argument '%s'\n", k.c_str());
@@ -599,6 +602,7 @@ bool ParseArgs(int argc, char** argv, Args* a) {
     if (k == "--blur") a->blur = x;
     if (k == "--period-ms") a->period_ms = static_cast<int>(x);
     if (k == "--only") a->only = static_cast<int>(x);
+    if (k == "--outlier-px") a->outlier_px = x;
   }
   if (a->width < 64 || a->width > 1280 || a->height < 64 || a->height > 1024) {
     std::fprintf(stderr, "accuracy-bench: --width/--height must be within 64x64..1280x1024\n");
@@ -637,9 +641,9 @@ int main(int argc, char** argv) {
   };
   if (args.quick) specs.resize(1);
   std::printf("arflex-accuracy-bench: %d poses, %dx%d, noise %.1f DN, blur %.1f px, vision "
-              "period %d ms (simulated time), corner re-fit %s\n",
+              "period %d ms (simulated time), corner re-fit %s, outlier threshold %.2f px\n",
               args.poses, args.width, args.height, args.noise, args.blur, args.period_ms,
-              args.refine ? "on" : "off");
+              args.refine ? "on" : "off", args.outlier_px);
   std::vector<RunResult> runs;
   Bench bench(args);
   for (const Spec& s : specs) {

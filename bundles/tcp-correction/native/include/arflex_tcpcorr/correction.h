@@ -32,7 +32,7 @@ struct CorrectionOptions {
   double max_rate = 1e-2;        // rad/s: largest rate of change of an applied correction
   double max_correction = 2e-2;  // rad: largest |correction| of a joint
   double max_error = 0.02;       // m: a larger position error is not trusted (held)
-  double damping = 1e-4;         // lambda of the damped pseudo-inverse
+  double damping = 1e-2;         // lambda of the damped pseudo-inverse (tames wrist singularities)
   bool orientation = true;       // correct the orientation error too
 };
 
