@@ -119,6 +119,48 @@ public final class ControlBlock implements AutoCloseable {
                         long execMaxNs, long execCount, long execSumNs, long execOverWcet) {
     }
 
+    /**
+     * A consistent copy of one metric (struct arflex_metric): sample count, min (UINT64_MAX,
+     * i.e. -1 here, while empty), max, sum, and the histogram: {@code bins[i]} counts samples in
+     * [i*100 ns, (i+1)*100 ns) for i &lt; 2000, {@code bins[2000]} samples of 200 us or more.
+     */
+    public record Metric(long count, long minNs, long maxNs, long sumNs, long[] bins) {
+
+        /**
+         * Percentile {@code p} (0 &lt; p &lt; 100) in ns as arflex_metric_percentile() computes it:
+         * upper edge of the bin holding the ceil(total*p/100)-th sample, capped at the max; the
+         * max for the overflow bin; 0 when empty.
+         */
+        public long percentileNs(double p) {
+            long total = 0;
+            for (long b : bins) {
+                total += b;
+            }
+            if (total == 0) {
+                return 0;
+            }
+            long target = Math.max(1, (long) Math.ceil(total * p / 100.0));
+            long acc = 0;
+            for (int i = 0; i < HIST_BINS; i++) {
+                acc += bins[i];
+                if (acc >= target) {
+                    long edge = (long) (i + 1) * HIST_BIN_NS;
+                    return Long.compareUnsigned(edge, maxNs) < 0 ? edge : maxNs;
+                }
+            }
+            return maxNs;
+        }
+
+        /** Samples of 200 us or more (the overflow bin). */
+        public long overflow() {
+            return bins[HIST_BINS];
+        }
+    }
+
+    /** Counters and both metrics with their histograms, all from one seqlock read. */
+    public record Detail(Stats stats, Metric latency, Metric exec) {
+    }
+
     private final ShmSegment shm;
 
     private ControlBlock(ShmSegment shm) {
@@ -257,6 +299,50 @@ public final class ControlBlock implements AutoCloseable {
             }
         }
         return null;
+    }
+
+    /**
+     * As {@link #stats(long)} plus copies of the latency and execution-time metrics with their
+     * histograms, all under one seqlock read (ABI.md 3.1); null when no consistent copy was
+     * obtained in 1000 attempts.
+     */
+    public Detail detail(long wcetNs) {
+        long[] lat = new long[HIST_BINS + 1];
+        long[] ex = new long[HIST_BINS + 1];
+        int firstBin = (int) Math.min(HIST_BINS, Math.max(0, (wcetNs + HIST_BIN_NS - 1) / HIST_BIN_NS));
+        for (int attempt = 0; attempt < 1000; attempt++) {
+            long s1 = shm.getLongAcquire(OFF_STATS_SEQ);
+            if ((s1 & 1) != 0) {
+                Thread.onSpinWait();
+                continue;
+            }
+            long cycles = shm.getLong(OFF_STATS_CYCLES);
+            long overruns = shm.getLong(OFF_STATS_OVERRUNS);
+            long dl = shm.getLong(OFF_STATS_DEADLINE_MISSES);
+            long safe = shm.getLong(OFF_STATS_SAFE_CYCLES);
+            long[] lm = readMetricScalars(OFF_STATS_LATENCY);
+            long[] em = readMetricScalars(OFF_STATS_EXEC);
+            for (int b = 0; b <= HIST_BINS; b++) {
+                lat[b] = shm.getLong(OFF_STATS_LATENCY + METRIC_HIST + 8 * b);
+                ex[b] = shm.getLong(OFF_STATS_EXEC + METRIC_HIST + 8 * b);
+            }
+            VarHandleFence.acquire();
+            long s2 = shm.getLongAcquire(OFF_STATS_SEQ);
+            if (s1 == s2) {
+                long over = 0;
+                for (int b = firstBin; b <= HIST_BINS; b++) {
+                    over += ex[b];
+                }
+                Stats st = new Stats(cycles, overruns, dl, safe, lm[2], em[2], em[0], em[3], over);
+                return new Detail(st, new Metric(lm[0], lm[1], lm[2], lm[3], lat), new Metric(em[0], em[1], em[2], em[3], ex));
+            }
+        }
+        return null;
+    }
+
+    private long[] readMetricScalars(int off) {
+        return new long[] {shm.getLong(off + METRIC_COUNT), shm.getLong(off + METRIC_MIN), shm.getLong(off + METRIC_MAX),
+            shm.getLong(off + METRIC_SUM)};
     }
 
     /** Index of the named parameter, or -1. */

@@ -145,7 +145,8 @@ public final class Snapshots {
     }
 
     static StatsDTO stats(RtHalf half, long wcetNs, long nowNs) {
-        ControlBlock.Stats s = half.stats(wcetNs);
+        ControlBlock.Detail det = half.detail(wcetNs);
+        ControlBlock.Stats s = det != null ? det.stats() : null;
         StatsDTO d = new StatsDTO();
         d.rtState = ControlBlock.stateName(half.rtState());
         long hb = half.rtHeartbeatNs();
@@ -158,6 +159,37 @@ public final class Snapshots {
             d.maxExecNs = s.execMaxNs();
             d.meanExecNs = s.execCount() > 0 ? s.execSumNs() / s.execCount() : 0;
         }
+        if (det != null && det.latency() != null && det.exec() != null) {
+            histogram(d, det.latency(), det.exec());
+        }
         return d;
+    }
+
+    /** Percentiles of both metrics and the non-empty latency bins (compact). */
+    static void histogram(StatsDTO d, ControlBlock.Metric lat, ControlBlock.Metric exec) {
+        d.latencyCount = lat.count();
+        d.latencyP50Ns = lat.percentileNs(50.0);
+        d.latencyP99Ns = lat.percentileNs(99.0);
+        d.latencyP999Ns = lat.percentileNs(99.9);
+        d.execP50Ns = exec.percentileNs(50.0);
+        d.execP99Ns = exec.percentileNs(99.0);
+        d.execP999Ns = exec.percentileNs(99.9);
+        d.histBinNs = ControlBlock.HIST_BIN_NS;
+        long[] bins = lat.bins();
+        int n = 0;
+        for (int i = 0; i < ControlBlock.HIST_BINS; i++) {
+            if (bins[i] != 0) {
+                n++;
+            }
+        }
+        d.latencyHistBins = new int[n];
+        d.latencyHistCounts = new long[n];
+        for (int i = 0, k = 0; i < ControlBlock.HIST_BINS; i++) {
+            if (bins[i] != 0) {
+                d.latencyHistBins[k] = i;
+                d.latencyHistCounts[k++] = bins[i];
+            }
+        }
+        d.latencyHistOverflow = lat.overflow();
     }
 }

@@ -309,6 +309,14 @@ public final class ProcessLauncher implements RtLauncher {
         }
 
         @Override
+        public synchronized ControlBlock.Detail detail(long wcetNs) {
+            if (cleaned) {
+                return null;
+            }
+            return ctl.detail(wcetNs);
+        }
+
+        @Override
         public void shutdown(long deadlineMs) {
             stopping = true;
             if (process.isAlive()) {

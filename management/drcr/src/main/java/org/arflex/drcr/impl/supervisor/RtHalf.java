@@ -64,6 +64,15 @@ public interface RtHalf {
     ControlBlock.Stats stats(long wcetNs);
 
     /**
+     * Statistics with the latency and execution-time histograms, from one seqlock read, or null
+     * when it could not be read. A half without histograms returns null metrics.
+     */
+    default ControlBlock.Detail detail(long wcetNs) {
+        ControlBlock.Stats s = stats(wcetNs);
+        return s == null ? null : new ControlBlock.Detail(s, null, null);
+    }
+
+    /**
      * Orderly end: STOP, SHUTDOWN, wait for the exit until {@code deadlineMs}, SIGKILL if it is
      * still there, then remove the control block and queues. Never throws; idempotent.
      */

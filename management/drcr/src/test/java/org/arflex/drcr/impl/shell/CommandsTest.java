@@ -27,6 +27,7 @@ class CommandsTest {
 
     private final List<String> calls = new ArrayList<>();
     private final ResourcesDTO res = new ResourcesDTO();
+    private StatsDTO stats;
     private final CellDTO cell = new CellDTO();
 
     CommandsTest() {
@@ -162,7 +163,7 @@ class CommandsTest {
 
         @Override
         public StatsDTO stats() {
-            return null;
+            return stats;
         }
 
         @Override
@@ -202,6 +203,34 @@ class CommandsTest {
         assertEquals("error: no component 'nope'", cmd.get("nope", "gain"));
         assertEquals("error: cons: SHA-256 mismatch", cmd.update("cons"));
         assertEquals("cons: no RT half running", cmd.stats("cons"));
+    }
+
+    @Test
+    void statsShowPercentiles() {
+        StatsDTO s = new StatsDTO();
+        s.rtState = "RUNNING";
+        s.cycles = 1000;
+        s.maxLatencyNs = 250_000;
+        s.latencyCount = 1000;
+        s.latencyP50Ns = 400;
+        s.latencyP99Ns = 1300;
+        s.latencyP999Ns = 15_100;
+        s.execP50Ns = 2000;
+        s.execP99Ns = 2100;
+        s.execP999Ns = 2200;
+        s.histBinNs = 100;
+        s.latencyHistOverflow = 1;
+        s.latencyHistBins = new int[] {3, 12, 150};
+        s.latencyHistCounts = new long[] {900, 95, 4};
+        stats = s;
+        String[] lines = cmd.stats("cons").split("\n");
+        assertEquals(2, lines.length, String.join("|", lines));
+        assertTrue(lines[0].startsWith("cons: rt RUNNING, cycles 1000,"), lines[0]);
+        assertTrue(lines[0].contains("latency max 250000 ns"), lines[0]);
+        assertEquals("cons: latency p50 400 ns, p99 1300 ns, p99.9 15100 ns (1000 samples, 1 >= 200 us); exec p50 2000 ns,"
+                + " p99 2100 ns, p99.9 2200 ns", lines[1]);
+        s.latencyHistBins = null;
+        assertEquals(1, cmd.stats("cons").split("\n").length, "no percentile line when the RT half gave no histogram");
     }
 
     @Test
