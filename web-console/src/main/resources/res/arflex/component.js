@@ -1,6 +1,6 @@
 /* Component page: contract summary, bindings, parameters (editable where the contract allows,
  * with the value the RT half applied read back), start/stop/reset, live plots (server-sent
- * events, uPlot) and the execution-time histogram. */
+ * events, uPlot) and the RT half's wake-up latency histogram. */
 'use strict';
 (() => {
   const {app, el, get, post, fmtNs, fmtBytes, stateBadge, pageUrl, message} = Arflex;
@@ -103,6 +103,7 @@
       plot.setData([series.t, ...series.v]);
       counter.textContent = n + ' samples; cycles ' + (s.cycles ?? '-') + ', state ' + (s.state || '') +
         ', params ' + Object.entries(s.params || {}).map(([k, v]) => k + '=' + v).join(' ');
+      drawHistogram(s);
       for (const [k, v] of Object.entries(s.params || {})) {
         const a = document.getElementById('arflex-applied-' + k);
         if (a) a.textContent = v;
@@ -110,21 +111,39 @@
     };
   }
 
-  let histPlot = null;
-  async function refreshHistogram() {
-    try {
-      const h = await get('histogram', {name});
-      const xs = h.counts.map((_, b) => b);
-      const box = histo.querySelector('.arflex-plot') || el('div', {class: 'arflex-plot'});
-      if (!histPlot && typeof uPlot !== 'undefined') {
-        histo.replaceChildren(el('h2', {}, 'Execution time histogram (means over 100 ms windows, log2 µs buckets)'), box);
-        histPlot = new uPlot({width: 800, height: 200, scales: {x: {time: false}},
-          series: [{label: 'bucket 2^b µs'}, {label: 'windows', stroke: '#1565c0', fill: 'rgba(21,101,192,.3)',
-            paths: uPlot.paths.bars({size: [0.8, 40]})}]}, [xs, h.counts], box);
-      } else if (histPlot) {
-        histPlot.setData([xs, h.counts]);
-      }
-    } catch (e) { /* shown by the stream status */ }
+  // Wake-up latency histogram of the RT half (control block, 100 ns bins), from the stream's
+  // StatsDTO fields: non-empty bins (latencyHistBins/latencyHistCounts), overflow, percentiles.
+  let histPlot = null; let histDrawn = 0;
+  function drawHistogram(s) {
+    if (!Array.isArray(s.latencyHistBins) || !Array.isArray(s.latencyHistCounts) || typeof uPlot === 'undefined') return;
+    const now = Date.now();
+    if (histPlot && now - histDrawn < 1000) return;
+    histDrawn = now;
+    const bins = s.latencyHistBins; const counts = s.latencyHistCounts; const w = s.histBinNs || 100;
+    // Dense from the first to the last non-empty bin, so empty bins show as gaps.
+    const xs = []; const ys = [];
+    if (bins.length) {
+      const lo = bins[0]; const hi = bins[bins.length - 1];
+      for (let b = lo; b <= hi; b++) { xs.push(b * w / 1000); ys.push(0); }
+      bins.forEach((b, k) => { ys[b - lo] = counts[k]; });
+    }
+    const us = ns => (ns / 1000).toFixed(1) + ' µs';
+    const text = (s.latencyCount || 0) + ' samples; p50 ' + us(s.latencyP50Ns || 0) + ', p99 ' + us(s.latencyP99Ns || 0) +
+      ', p99.9 ' + us(s.latencyP999Ns || 0) + ', max ' + us(s.maxLatencyNs || 0) + '; ' + (s.latencyHistOverflow || 0) +
+      ' at or above ' + us(w * 2000) + ' (not drawn)';
+    if (!histPlot) {
+      const box = el('div', {class: 'arflex-plot', id: 'arflex-histogram-plot'});
+      const summary = el('div', {id: 'arflex-histogram-summary'}, text);
+      histo.replaceChildren(el('h2', {}, 'Wake-up latency histogram (RT half, ' + w + ' ns bins)'), summary, box);
+      histPlot = new uPlot({width: 800, height: 200, scales: {x: {time: false}},
+        axes: [{label: 'latency (µs, lower bin edge)'}, {label: 'cycles'}],
+        series: [{label: 'µs'}, {label: 'cycles', stroke: '#1565c0', fill: 'rgba(21,101,192,.3)',
+          paths: uPlot.paths.bars({size: [0.9, 40]})}]}, [xs, ys], box);
+    } else {
+      histPlot.setData([xs, ys]);
+      document.getElementById('arflex-histogram-summary').textContent = text;
+    }
+    histo.dataset.samples = String(s.latencyCount || 0);
   }
 
   async function load() {
@@ -140,6 +159,5 @@
   if (!name) { chooser(); return; }
   app.replaceChildren(el('h2', {id: 'arflex-component-name'}, 'Component ', el('code', {}, name)), status, commands, summary, params, plots, histo);
   load().then(startStream);
-  setInterval(refreshHistogram, 2000);
   window.addEventListener('beforeunload', () => source && source.close());
 })();

@@ -337,6 +337,12 @@ class WebConsoleIT {
         // The live stream shows samples (server-sent events).
         awaitText(By.id("arflex-live-count"), "samples");
         awaitText(By.id("arflex-live-count"), "gain=4.25");
+        // The RT half's wake-up latency histogram (StatsDTO, via the stream) is drawn.
+        awaitText(By.id("arflex-histogram-summary"), "p99.9");
+        new WebDriverWait(browser, WAIT).until(d -> !d.findElements(By.cssSelector("#arflex-histogram-plot canvas")).isEmpty()
+                && Long.parseLong(d.findElement(By.id("arflex-histogram")).getAttribute("data-samples")) > 0);
+        String hist = rt.get("/system/console/arflex-component/api/histogram?name=sample-scaler", true).body();
+        assertTrue(Pattern.compile("\"binNs\":100,\"lowerEdgesNs\":\\[\\d+").matcher(hist).find(), hist);
         shot("08-component-param-applied");
         String comp = rt.get("/system/console/arflex-component/api/component?name=sample-scaler", true).body();
         assertTrue(Pattern.compile("\"name\":\"gain\",\"type\":\"[A-Z]+\",\"value\":\"4\\.25\"").matcher(comp).find(), comp);

@@ -184,6 +184,36 @@ public class Backend {
         return m;
     }
 
+    /**
+     * The RT half's wake-up latency histogram as the DRCR reads it from the control block:
+     * lower bin edges and counts of the non-empty bins, the bin width, the overflow count and
+     * the percentiles (all ns).
+     */
+    Map<String, Object> histogram(String name) throws HttpError {
+        checkName(name);
+        ComponentManagement cm = management(name).orElseThrow(
+                () -> new HttpError(404, "component '" + name + "' has no management service (not installed?)"));
+        StatsDTO s = cm.stats();
+        if (s == null || s.latencyHistBins == null) {
+            throw new HttpError(409, "component '" + name + "' has no RT half running (no histogram)");
+        }
+        Map<String, Object> m = new LinkedHashMap<>();
+        m.put("component", name);
+        m.put("binNs", s.histBinNs);
+        long[] edges = new long[s.latencyHistBins.length];
+        for (int i = 0; i < edges.length; i++) {
+            edges[i] = s.latencyHistBins[i] * s.histBinNs;
+        }
+        m.put("lowerEdgesNs", edges);
+        m.put("counts", s.latencyHistCounts);
+        m.put("overflow", s.latencyHistOverflow);
+        m.put("samples", s.latencyCount);
+        m.put("p50Ns", s.latencyP50Ns);
+        m.put("p99Ns", s.latencyP99Ns);
+        m.put("p999Ns", s.latencyP999Ns);
+        return m;
+    }
+
     // ---- changing ------------------------------------------------------------------------
 
     /** Sets a parameter and returns the value the RT half applied. */

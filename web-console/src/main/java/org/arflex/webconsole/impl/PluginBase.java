@@ -8,7 +8,6 @@ import java.io.InputStream;
 import java.io.OutputStream;
 import java.io.PrintWriter;
 import java.nio.charset.StandardCharsets;
-import java.util.LinkedHashMap;
 import java.util.Map;
 import java.util.concurrent.atomic.AtomicInteger;
 import org.apache.felix.webconsole.servlet.AbstractServlet;
@@ -133,14 +132,7 @@ abstract class PluginBase extends AbstractServlet {
         return switch (what) {
             case "cell" -> b.cell();
             case "component" -> b.component(name);
-            case "histogram" -> {
-                Backend.checkName(name);
-                Map<String, Object> m = new LinkedHashMap<>();
-                m.put("component", name);
-                m.put("bucketsUs", Sampler.BUCKETS);
-                m.put("counts", b.sampler.histogram(name));
-                yield m;
-            }
+            case "histogram" -> b.histogram(name);
             case "contracts" -> Map.of("saved", b.savedContracts());
             case "contract" -> Map.of("name", name, "xml", b.loadContract(name));
             case "plan-uninstall" -> b.planUninstall(name);

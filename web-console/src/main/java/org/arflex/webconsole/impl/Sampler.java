@@ -3,7 +3,6 @@ package org.arflex.webconsole.impl;
 import java.util.HashMap;
 import java.util.LinkedHashMap;
 import java.util.Map;
-import java.util.concurrent.ConcurrentHashMap;
 import java.util.function.Function;
 
 /**
@@ -16,8 +15,6 @@ import java.util.function.Function;
 final class Sampler {
     /** Sampling period. */
     static final long PERIOD_MS = 100;
-    /** Log2 buckets of execution time, 1 us .. ~1 s. */
-    static final int BUCKETS = 21;
 
     /** One published frame: per component, a JSON-ready map. */
     record Frame(long seq, Map<String, Map<String, Object>> byComponent) {
@@ -25,8 +22,6 @@ final class Sampler {
 
     private final Function<String, Map<String, Object>> reader;
     private final Map<String, Integer> subscribers = new HashMap<>();
-    private final Map<String, long[]> histograms = new ConcurrentHashMap<>();
-    private final Map<String, double[]> lastSums = new HashMap<>();
     private Frame latest = new Frame(0, Map.of());
     private Thread thread;
     private boolean closed;
@@ -53,8 +48,6 @@ final class Sampler {
     synchronized void unsubscribe(String name) {
         if (subscribers.merge(name, -1, Integer::sum) <= 0) {
             subscribers.remove(name);
-            histograms.remove(name);
-            lastSums.remove(name);
         }
         notifyAll();
     }
@@ -70,15 +63,6 @@ final class Sampler {
             wait(left);
         }
         return closed ? null : latest;
-    }
-
-    /**
-     * Histogram of a subscribed component's execution time, as means over each sampling window
-     * (counts per log2 bucket of microseconds: bucket b holds [2^b, 2^(b+1)) us).
-     */
-    long[] histogram(String name) {
-        long[] h = histograms.get(name);
-        return h == null ? new long[BUCKETS] : h.clone();
     }
 
     /** Stops the thread and wakes every stream. */
@@ -120,7 +104,6 @@ final class Sampler {
                     sample = Map.of("error", String.valueOf(e.getMessage()));
                 }
                 if (sample != null) {
-                    record(n, sample);
                     frame.put(n, sample);
                 }
             }
@@ -143,28 +126,5 @@ final class Sampler {
                 return;
             }
         }
-    }
-
-    /**
-     * Counts the mean execution time of the cycles completed since the previous sample (from the
-     * cumulative cycle count and mean the control block reports) into a log2 histogram.
-     */
-    private void record(String name, Map<String, Object> sample) {
-        if (!(sample.get("cycles") instanceof Number c) || !(sample.get("meanExecNs") instanceof Number e)) {
-            return;
-        }
-        long cycles = c.longValue();
-        double sum = e.doubleValue() * cycles;
-        double[] before;
-        synchronized (this) {
-            before = lastSums.put(name, new double[] {cycles, sum});
-        }
-        if (before == null || cycles <= before[0]) {
-            return;
-        }
-        double windowMeanNs = (sum - before[1]) / (cycles - before[0]);
-        long us = Math.max(1, (long) (windowMeanNs / 1000.0));
-        int b = Math.min(BUCKETS - 1, 63 - Long.numberOfLeadingZeros(us));
-        histograms.computeIfAbsent(name, k -> new long[BUCKETS])[b]++;
     }
 }
