@@ -251,6 +251,9 @@ final class ContractValidator {
         } else if (!PortTypes.TYPE_NAME.matcher(x.type).matches()) {
             p.at(x, "6.2", f + "/@type", "'" + x.type + "' is not a port type name (namespace.TypeName)");
             ok = false;
+        } else if (x.type.startsWith(PortTypes.EVAL_NAMESPACE)) {
+            p.at(x, "6.7", f + "/@type", "'" + x.type + "': evaluation-only type, not bindable by components");
+            ok = false;
         } else {
             type = types.find(x.type).orElse(null);
             if (type == null) {

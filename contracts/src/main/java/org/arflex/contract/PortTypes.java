@@ -33,6 +33,12 @@ public final class PortTypes {
     /** Resource folder of the shipped definitions, with an {@code index.txt} naming each file. */
     public static final String RESOURCE_DIR = "/arflex/types/";
 
+    /**
+     * Reserved namespace of evaluation-only records (e.g. the simulator's eval.GroundTruth):
+     * no contract port may use it and no port type definition may be named in it (SPEC 6.7).
+     */
+    public static final String EVAL_NAMESPACE = "eval.";
+
     static final Pattern TYPE_NAME = Pattern.compile("[a-z][a-z0-9]{0,15}(\\.[A-Z][A-Za-z0-9]{0,47})");
     private static final Pattern FIELD_NAME = Pattern.compile("[a-z][a-z0-9_]{0,31}");
     private static final Pattern CONST_NAME = Pattern.compile("[A-Z][A-Z0-9_]{0,47}");
@@ -187,6 +193,9 @@ public final class PortTypes {
             p.at(x, "13.1", "portType/@name", "required attribute is missing");
         } else if (!TYPE_NAME.matcher(name).matches()) {
             p.at(x, "13.1", "portType/@name", "'" + name + "' is not a type name (namespace.TypeName, e.g. arflex.Pose)");
+        } else if (name.startsWith(EVAL_NAMESPACE)) {
+            p.at(x, "6.7", "portType/@name", "'" + name + "': the eval. namespace is reserved for evaluation-only types,"
+                    + " which are not port types");
         }
         TypeVersion version = null;
         if (x.version == null) {

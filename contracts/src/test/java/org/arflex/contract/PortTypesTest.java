@@ -174,6 +174,16 @@ class PortTypesTest {
     }
 
     @Test
+    void evalNamespaceIsReservedForEvaluationOnlyRecords() throws Exception {
+        List<Problem> p = problems("<portType xmlns=\"urn:arflex:porttype:1\" name=\"eval.GroundTruth\" version=\"1.0\" "
+                + "methods=\"state\"><field name=\"a\" type=\"u64\"/></portType>");
+        assertEquals(1, p.size(), p.toString());
+        assertEquals("6.7", p.get(0).section());
+        assertEquals("portType/@name", p.get(0).field());
+        assertTrue(p.get(0).message().contains("reserved for evaluation-only types"), p.get(0).message());
+    }
+
+    @Test
     void frameTypesNeedAPayloadBound() throws Exception {
         List<Problem> p = problems("<portType xmlns=\"urn:arflex:porttype:1\" name=\"arflex.F\" version=\"1.0\" "
                 + "methods=\"frame\"><field name=\"a\" type=\"u64\"/></portType>");
