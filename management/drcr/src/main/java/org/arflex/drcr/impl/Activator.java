@@ -93,7 +93,8 @@ public final class Activator implements BundleActivator {
         long network = Commands.parseSize(prop(ctx, "arflex.network", "125000000"));
         actor = new ThreadActor(log);
         Cell.Config cfg = new Cell.Config(rid, Long.parseLong(prop(ctx, "arflex.ready.timeout.ms", "5000")), 3_000,
-                Boolean.parseBoolean(prop(ctx, "arflex.nomlock", "false")), types, Posix::monotonicNs);
+                Boolean.parseBoolean(prop(ctx, "arflex.nomlock", "false")), types, Posix::monotonicNs,
+                Boolean.parseBoolean(prop(ctx, "arflex.evaluation", "false")));
         // The cell is built on the actor so that the planner is only ever touched there.
         ResourceManagerImpl[] rm = new ResourceManagerImpl[1];
         cell = actor.call(() -> {

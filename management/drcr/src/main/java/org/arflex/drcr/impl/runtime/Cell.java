@@ -44,7 +44,28 @@ public final class Cell {
 
     /** Static configuration of a cell. */
     public record Config(String runtimeId, long readyTimeoutMs, long shutdownMs, boolean noMlock,
-                         PortTypes types, LongSupplier monotonicNs) {
+                         PortTypes types, LongSupplier monotonicNs, boolean evaluation) {
+
+        /** A cell without the evaluation switch. */
+        public Config(String runtimeId, long readyTimeoutMs, long shutdownMs, boolean noMlock, PortTypes types,
+                      LongSupplier monotonicNs) {
+            this(runtimeId, readyTimeoutMs, shutdownMs, noMlock, types, monotonicNs, false);
+        }
+    }
+
+    /**
+     * The simulator's ground-truth record (simulator/include/arflex_sim/ground_truth.h): an
+     * evaluation-only state segment {@code out.truth}, type eval.GroundTruth 1.0, 192 bytes,
+     * created only under {@code arflex.evaluation} for components with the attributes
+     * simulated=true and role=robot; sim-robot publishes into it only if it exists.
+     */
+    public static final String TRUTH_PORT = "truth";
+    public static final String TRUTH_TYPE = "eval.GroundTruth";
+    public static final int TRUTH_SIZE = 192;
+
+    /** True when the cell creates the ground-truth segment for this contract. */
+    static boolean wantsGroundTruth(Config cfg, Contract c) {
+        return cfg.evaluation() && "true".equals(c.attributes().get("simulated")) && "robot".equals(c.attributes().get("role"));
     }
 
     private final Config cfg;
@@ -303,6 +324,12 @@ public final class Cell {
     }
 
     private void execute(Plan plan) {
+        // Live rewiring: inputs whose provider changes or goes are unbound before any stop, so
+        // no consumer reads a provider while it goes away; new bindings come after the starts,
+        // when every provider's segment exists.
+        for (Plan.Action a : plan.rebinds()) {
+            rebind(instances.get(a.component()), plan.wiringOf(a.component()), false, a.reason());
+        }
         for (String name : plan.stopOrder()) {
             Instance inst = instances.get(name);
             if (inst != null) {
@@ -320,6 +347,9 @@ public final class Cell {
                 startHalf(inst, plan.cpuAssignment().getOrDefault(name, -1), plan.wiringOf(name));
             }
         }
+        for (Plan.Action a : plan.rebinds()) {
+            rebind(instances.get(a.component()), plan.wiringOf(a.component()), true, a.reason());
+        }
         // Everything the plan leaves inactive shows the planner's reason.
         for (var e : plan.inactiveAfter().entrySet()) {
             Instance inst = instances.get(e.getKey());
@@ -329,6 +359,44 @@ public final class Cell {
                     inst.life.to(State.UNSATISFIED, e.getValue());
                 }
             }
+        }
+    }
+
+    /**
+     * One phase of a REBIND: unbind (bindPhase false) the inputs whose segment changes or goes,
+     * or bind (bindPhase true) the inputs to their new segments. The RT half picks a binding up
+     * at a cycle boundary and keeps running. A refused command means the half cannot follow
+     * the new wiring: it is restarted through the normal failure path, as a crash would be.
+     */
+    private void rebind(Instance inst, List<Wire> wires, boolean bindPhase, String why) {
+        if (inst == null || inst.half == null) {
+            return;
+        }
+        Map<String, String> target = new java.util.TreeMap<>();
+        for (Wire w : wires) {
+            target.put(w.inPort(), segmentOf(w.provider(), w.outPort()));
+        }
+        try {
+            if (!bindPhase) {
+                for (String port : List.copyOf(inst.bound.keySet())) {
+                    if (!inst.bound.get(port).equals(target.get(port))) {
+                        inst.half.unbind(port);
+                        inst.bound.remove(port);
+                    }
+                }
+                return;
+            }
+            for (var e : target.entrySet()) {
+                if (!e.getValue().equals(inst.bound.get(e.getKey()))) {
+                    inst.half.bind(e.getKey(), e.getValue());
+                    inst.bound.put(e.getKey(), e.getValue());
+                }
+            }
+            log.accept("arflex: " + inst.name + " rewired while running (" + why + "); inputs " + inst.bound);
+        } catch (IOException | RuntimeException e) {
+            log.accept("arflex: " + inst.name + ": rewiring failed: " + e.getMessage() + "; restarting it");
+            RtHalf h = inst.half;
+            h.kill();
         }
     }
 
@@ -356,6 +424,13 @@ public final class Cell {
             inst.outputs.put(p.name(), launcher.createOutput(segmentOf(inst.name, p.name()), method, t.name(),
                     t.version().major(), t.version().minor(), elem, Math.max(1, p.depth()), overflow));
         }
+        if (wantsGroundTruth(cfg, inst.contract) && !inst.evaluationOutputs.containsKey(TRUTH_PORT)) {
+            // Never a contract port: no wire, no BIND names it; evaluation tools map it read-only.
+            RtLauncher.Output o = launcher.createOutput(segmentOf(inst.name, TRUTH_PORT), PortSegment.METHOD_STATE,
+                    TRUTH_TYPE, 1, 0, TRUTH_SIZE, 1, PortSegment.OVERFLOW_NONE);
+            inst.evaluationOutputs.put(TRUTH_PORT, o);
+            inst.evaluationSegments = Map.of(TRUTH_PORT, o.name());
+        }
     }
 
     private void closeOutputs(Instance inst) {
@@ -363,6 +438,11 @@ public final class Cell {
             o.close();
         }
         inst.outputs.clear();
+        for (RtLauncher.Output o : inst.evaluationOutputs.values()) {
+            o.close();
+        }
+        inst.evaluationOutputs.clear();
+        inst.evaluationSegments = Map.of();
     }
 
     static ControlBlock.Config controlConfig(Contract c, int cpu, boolean noMlock) {

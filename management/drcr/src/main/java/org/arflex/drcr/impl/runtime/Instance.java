@@ -32,6 +32,14 @@ public final class Instance {
     volatile RtHalf half;
     /** Output port name -> segment; created at the first start, kept until destroyed. */
     final Map<String, RtLauncher.Output> outputs = new LinkedHashMap<>();
+    /**
+     * Evaluation-only segments (not contract ports, never named in a BIND; simulator README
+     * "Ground truth"): port name -> segment, created with the outputs when the cell runs with
+     * arflex.evaluation, removed with them.
+     */
+    final Map<String, RtLauncher.Output> evaluationOutputs = new LinkedHashMap<>();
+    /** Read-only copy of {@link #evaluationOutputs}' names for snapshots: port -> shm name. */
+    volatile Map<String, String> evaluationSegments = Map.of();
     /** Input port -> provider segment it is bound to. */
     final Map<String, String> bound = new TreeMap<>();
     /** Configured value bits per parameter (contract order). */

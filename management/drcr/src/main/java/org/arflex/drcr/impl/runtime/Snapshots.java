@@ -111,6 +111,7 @@ public final class Snapshots {
         d.pid = half != null ? half.pid() : 0;
         d.cpu = i.cpu;
         d.awaitingReset = i.awaitingReset;
+        d.evaluationSegments = new java.util.TreeMap<>(i.evaluationSegments);
         d.bundleId = i.bundleId;
         List<BindingDTO> bs = new ArrayList<>();
         for (var w : cell.planner().wires()) {
