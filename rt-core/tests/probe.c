@@ -28,6 +28,7 @@ static struct probe {
 	int gain;
 	struct probe_out o;
 	bool logged_update;
+	uint64_t require_reset_at; /* ARFLEX_PROBE_REQUIRE_RESET_AT: latch a reset at that update */
 } pr;
 
 static void note(const char *what)
@@ -61,6 +62,8 @@ static int configure(struct arflex_component *c, void *user)
 		r = pr.gain;
 		goto out_fail;
 	}
+	if (getenv("ARFLEX_PROBE_REQUIRE_RESET_AT"))
+		pr.require_reset_at = strtoull(getenv("ARFLEX_PROBE_REQUIRE_RESET_AT"), NULL, 10);
 	if (getenv("ARFLEX_PROBE_FAIL_CONFIGURE")) {
 		r = -ENOTSUP;
 		goto out_fail;
@@ -104,6 +107,8 @@ static int update(struct arflex_component *c, void *user, uint64_t release_ns)
 	if (g1 != g2)
 		pr.o.torn++;
 	pr.o.gain = g2;
+	if (pr.require_reset_at && pr.o.updates == pr.require_reset_at)
+		arflex_component_require_reset(c);
 	pr.logged_update = true;
 	return arflex_state_write(pr.out, &pr.o, sizeof(pr.o));
 }

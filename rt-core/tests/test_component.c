@@ -303,6 +303,40 @@ static void moves_hardware_needs_operator_reset(void **state)
 	th_assert_clean(rid);
 }
 
+/* arflex_component_require_reset: the component latches a reset itself; no update runs
+ * until the operator's RESET. */
+static void component_requires_reset(void **state)
+{
+	struct arflex_host h;
+	struct probe_out o;
+	uint64_t safe_before;
+
+	(void)state;
+	setup_ids("reqreset");
+	make_env("ARFLEX_PROBE_REQUIRE_RESET_AT=5");
+	assert_int_equal(probe_host(&h, "probe", 0, 0, true), 0);
+	spawn_ready(&h);
+	assert_false(arflex_ctl_flags(h.ctl) & ARFLEX_FLAG_RESET_REQUIRED);
+	assert_int_equal(arflex_host_start(&h, T_CALL), 0);
+	assert_true(wait_out(&h, safe_above, 10, false));
+	assert_true(arflex_ctl_flags(h.ctl) & ARFLEX_FLAG_RESET_REQUIRED);
+	assert_true(arflex_ctl_flags(h.ctl) & ARFLEX_FLAG_SAFE_ACTIVE);
+	assert_true(read_out(&h, &o));
+	assert_int_equal(o.updates, 5); /* none after the one that latched */
+	assert_int_equal(o.safe_firsts, 1);
+	safe_before = o.safe_calls;
+	assert_int_equal(arflex_host_reset(&h, T_CALL), 0);
+	assert_true(wait_out(&h, updates_above, 15, false));
+	assert_false(arflex_ctl_flags(h.ctl) & (ARFLEX_FLAG_SAFE_ACTIVE |
+						ARFLEX_FLAG_RESET_REQUIRED));
+	assert_true(read_out(&h, &o));
+	assert_true(o.safe_calls >= safe_before);
+	shutdown_ok(&h);
+	arflex_host_destroy(&h);
+	unlink(logpath);
+	th_assert_clean(rid);
+}
+
 static void failing_configure_leaves_nothing(void **state)
 {
 	struct arflex_host h;
@@ -530,6 +564,7 @@ int main(void)
 		cmocka_unit_test(params_applied_at_cycle_boundary),
 		cmocka_unit_test(safe_when_heartbeat_stops),
 		cmocka_unit_test(moves_hardware_needs_operator_reset),
+		cmocka_unit_test(component_requires_reset),
 		cmocka_unit_test(failing_configure_leaves_nothing),
 		cmocka_unit_test(failing_start_is_refused),
 		cmocka_unit_test(bind_and_unbind_while_running),

@@ -5,7 +5,8 @@
 // Ports: in joint_state (arflex.JointState), in wrench (arflex.Wrench), out safety
 // (arflex.SafetyState, written every cycle). An unbound input is simply not checked.
 //
-// Latch: on a trip the RT half sets ARFLEX_FLAG_RESET_REQUIRED in its own control block
+// Latch: on a trip the RT half sets ARFLEX_FLAG_RESET_REQUIRED in its own control block with
+// arflex_component_require_reset()
 // (the RT process is the writer of `flags`, rt-core/docs/ABI.md §3), so rt-core calls the safe
 // hook instead of update until the operator's RESET command clears it; the safe hook keeps
 // writing PROTECTIVE_STOP. A rising edge 0 -> 1 of the mutable parameter `reset` clears it as
@@ -44,8 +45,9 @@ struct State {
 } g;
 
 struct arflex_ctl* Ctl(struct arflex_component* c) {
-  // The control block is shared memory this process may write (`flags` is RT-written);
-  // the component API hands it out read-only for the common case.
+  // Only for the guard's own unlatch (the `reset` parameter edge in Safe): rt-core has a
+  // public call to set RESET_REQUIRED (arflex_component_require_reset) but, on purpose, none
+  // to clear it; `flags` is RT-written shared memory the component API hands out read-only.
   return const_cast<struct arflex_ctl*>(arflex_component_ctl(c));
 }
 
@@ -115,10 +117,9 @@ bool ResetEdge(struct arflex_component* c) {
 }
 
 int Update(struct arflex_component* c, void*, uint64_t release_ns) {
-  struct arflex_ctl* ctl = Ctl(c);
   ResetEdge(c);
   // update runs again only when RESET_REQUIRED is clear: the operator's RESET came.
-  if (g.latched && !(__atomic_load_n(&ctl->flags, __ATOMIC_ACQUIRE) &
+  if (g.latched && !(__atomic_load_n(&arflex_component_ctl(c)->flags, __ATOMIC_ACQUIRE) &
                      ARFLEX_FLAG_RESET_REQUIRED)) {
     g.latched = false;
     g.reason = 0;
@@ -154,7 +155,7 @@ int Update(struct arflex_component* c, void*, uint64_t release_ns) {
     g.latched = true;
     g.reason = reason;
     ++g.trips;
-    __atomic_or_fetch(&ctl->flags, ARFLEX_FLAG_RESET_REQUIRED, __ATOMIC_RELEASE);
+    arflex_component_require_reset(c);
   }
   return Write(c, release_ns, 0);
 }

@@ -144,6 +144,12 @@ ARFLEX_API const char *arflex_component_runtime(const struct arflex_component *c
 ARFLEX_API const char *arflex_component_instance(const struct arflex_component *c);
 /** True while safe mode is active. */
 ARFLEX_API bool arflex_component_safe_active(const struct arflex_component *c);
+/** Latches an operator reset (e.g. a safety trip): atomically sets ARFLEX_FLAG_RESET_REQUIRED
+ *  in the control block. From the next cycle on the RT thread calls the safe hook instead of
+ *  update until the operator's RESET command (arflex_host_reset / the DRCR's reset) clears
+ *  the flag; the flag survives a restart of the RT process. Idempotent. RT safe: one atomic
+ *  OR, callable from any hook or thread of the component. */
+ARFLEX_API void arflex_component_require_reset(struct arflex_component *c);
 
 #ifdef __cplusplus
 }

@@ -120,6 +120,11 @@ bool arflex_component_safe_active(const struct arflex_component *c)
 	return (arflex_ctl_flags(c->ctl) & ARFLEX_FLAG_SAFE_ACTIVE) != 0;
 }
 
+void arflex_component_require_reset(struct arflex_component *c)
+{
+	__atomic_or_fetch(&c->ctl->flags, ARFLEX_FLAG_RESET_REQUIRED, __ATOMIC_RELEASE);
+}
+
 bool arflex_input_bound(const struct arflex_input *in)
 {
 	return in->cur != NULL;
