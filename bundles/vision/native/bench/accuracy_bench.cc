@@ -14,6 +14,7 @@
 // Usage: arflex-accuracy-bench [--json FILE] [--width W --height H] [--poses N]
 //                              [--noise SIGMA] [--blur SIGMA] [--period-ms P] [--quick]
 //                              [--no-refine] [--only INDEX] [--trace] [--outlier-px PX]
+//                              [--with-orientation]
 // --quick: only the payload-0 run; --no-refine: AprilTag's corners without the edge re-fit.
 #include <algorithm>
 #include <array>
@@ -61,6 +62,9 @@ struct Args {
   bool quick = false;
   bool refine = true;
   double outlier_px = vision::EstimatorOptions{}.outlier_px;
+  // Correct the position only (the law's orientation = false): the tool block's orientation
+  // from the cameras is too uncertain (tens of mdeg) to correct with; --with-orientation.
+  bool position_only = true;
   int only = -1;       // run only this target (debugging)
   bool trace = false;  // print every measurement of the loop
 };
@@ -345,6 +349,7 @@ bool Bench::Run(const std::string& name, double payload, const std::vector<int>&
   // 0.01 rad/s the wrist corrections take most of a second.
   CorrectionOptions copt;
   copt.max_rate = 0.05;
+  copt.orientation = !args_.position_only;
   const double dt = cell_->timestep();
   const int period_steps = std::max(1, static_cast<int>(std::lround(args_.period_ms * 1e-3 / dt)));
   const std::vector<Eigen::Isometry3d> targets = Targets(args_.poses);
@@ -510,9 +515,9 @@ void PrintRun(const RunResult& r, bool per_pose) {
 void WriteJson(FILE* f, const Args& a, const std::vector<RunResult>& runs) {
   std::fprintf(f, "{\n  \"benchmark\": \"arflex-accuracy-bench\",\n");
   std::fprintf(f, "  \"config\": {\"width\": %d, \"height\": %d, \"poses\": %d, \"noise_sigma\": %g, "
-                  "\"blur_sigma\": %g, \"vision_period_ms\": %d, \"corner_refit\": %s, \"outlier_px\": %g},\n",
+                  "\"blur_sigma\": %g, \"vision_period_ms\": %d, \"corner_refit\": %s, \"outlier_px\": %g, \"position_only\": %s},\n",
                a.width, a.height, a.poses, a.noise, a.blur, a.period_ms, a.refine ? "true" : "false",
-               a.outlier_px);
+               a.outlier_px, a.position_only ? "true" : "false");
   std::fprintf(f, "  \"runs\": [\n");
   for (size_t i = 0; i < runs.size(); ++i) {
     const RunResult& r = runs[i];
@@ -572,6 +577,10 @@ bool ParseArgs(int argc, char** argv, Args* a) {
     }
     if (k == "--no-refine") {
       a->refine = false;
+      continue;
+    }
+    if (k == "--with-orientation") {
+      a->position_only = false;
       continue;
     }
     if (k == "--trace") {
@@ -641,9 +650,11 @@ int main(int argc, char** argv) {
   };
   if (args.quick) specs.resize(1);
   std::printf("arflex-accuracy-bench: %d poses, %dx%d, noise %.1f DN, blur %.1f px, vision "
-              "period %d ms (simulated time), corner re-fit %s, outlier threshold %.2f px\n",
+              "period %d ms (simulated time), corner re-fit %s, outlier threshold %.2f px, "
+              "correcting %s\n",
               args.poses, args.width, args.height, args.noise, args.blur, args.period_ms,
-              args.refine ? "on" : "off", args.outlier_px);
+              args.refine ? "on" : "off", args.outlier_px,
+              args.position_only ? "the position" : "position and orientation");
   std::vector<RunResult> runs;
   Bench bench(args);
   for (const Spec& s : specs) {
