@@ -58,7 +58,7 @@ void ApplyParams(arflex_component* c) {
   o.max_step = F64(c, g.p_step, 2e-3);
   o.max_rate = F64(c, g.p_rate, 1e-2);
   o.max_correction = F64(c, g.p_max, 2e-2);
-  o.orientation = Bool(c, g.p_orientation, true);
+  o.orientation = Bool(c, g.p_orientation, false);
   g.law.SetOptions(o);  // invalid values (outside the contract's ranges) keep the old ones
   const bool enable = Bool(c, g.p_enable, true);
   if (enable != g.law.enabled()) g.law.SetEnabled(enable);
