@@ -26,7 +26,7 @@ hash_password() {
 }
 if [ -n "${ARFLEX_CONSOLE_PASSWORD:-}" ]; then
   CREDS=$(mktemp "$ARFLEX_HOME/console.XXXXXX.properties")
-  trap 'rm -f "$CREDS"' EXIT
+  CREDS_TMP=$CREDS
   { echo "felix.webconsole.username=${ARFLEX_CONSOLE_USER:-arflex}"
     echo "felix.webconsole.password=$(printf '%s' "$ARFLEX_CONSOLE_PASSWORD" | hash_password)"; } > "$CREDS"
 elif [ ! -f "$CREDS" ]; then
@@ -41,24 +41,41 @@ console_bundles=$(for jar in console/*.jar; do printf 'file:%s ' "$RUNTIME_DIR/$
 port=$(sed -n 's/^org.osgi.service.http.port=//p' conf/config.properties)
 echo "arflex: web console at http://127.0.0.1:${port:-8480}/system/console (user from $CREDS)"
 
+# The runtime's output also goes to a private log, so the command feeder below can wait for the
+# DRCR to be up before it types (Gogo starts reading before the DRCR's commands exist).
+LOG=$(mktemp "$ARFLEX_HOME/runtime.XXXXXX.log")
+trap 'rm -f "$LOG" ${CREDS_TMP:+"$CREDS_TMP"}' EXIT
+
+await_drcr() {
+  local deadline=$((SECONDS + 120))
+  until grep -q "arflex: DRCR started" "$LOG"; do
+    if [ $SECONDS -ge $deadline ]; then
+      echo "echo 'arflex run: the DRCR did not start within 120 s; see the messages above'"
+      return 1
+    fi
+    sleep 0.2
+  done
+}
+
 commands() {
-  # Give the framework a moment to start the DRCR's shell commands; Gogo queues the input,
-  # so this only orders the echo of the commands with the framework's own output.
-  echo "echo 'ARFLEX runtime up; installing the cell from $RUNTIME_DIR/cell'"
-  shopt -s nullglob
+  await_drcr || { echo "stop 0"; return; }
+  echo "echo 'ARFLEX runtime up; installing the cell (conf/cell.gosh)'"
   # Felix's start installs a bundle from its URL and starts it; the DRCR's extender then reads
   # its contract, plans, and starts its RT half once its inputs are satisfied.
-  for jar in cell/*.jar; do
-    echo "start file:$RUNTIME_DIR/$jar"
-  done
-  # Only orders the first listing after the DRCR's start-up messages.
-  sleep 3
+  local line
+  while IFS= read -r line || [ -n "$line" ]; do
+    case "$line" in
+      "#"*|"") ;;
+      *) printf '%s\n' "${line//@CELL@/$RUNTIME_DIR/cell}" ;;
+    esac
+  done < conf/cell.gosh
   echo "arflex:list"
   if [ -n "$HEADLESS" ]; then
     local end=$((SECONDS + HEADLESS))
     while [ $SECONDS -lt $end ]; do
       sleep 5
       echo "arflex:list"
+      echo "arflex:stats sim-robot"
     done
     echo "stop 0"
   else
@@ -67,4 +84,4 @@ commands() {
 }
 
 commands | java -Dfelix.system.properties="file:$CREDS" -Darflex.console.bundles="$console_bundles" \
-  -jar bin/felix.jar
+  -jar bin/felix.jar 2>&1 | tee "$LOG"

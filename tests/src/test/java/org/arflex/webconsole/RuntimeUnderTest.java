@@ -57,6 +57,8 @@ final class RuntimeUnderTest implements AutoCloseable {
         copyTree(assembled, runtimeDir);
         deleteTree(runtimeDir.resolve("felix-cache"));
         deleteTree(runtimeDir.resolve("cell"));
+        // No demonstration cell: the tests install their own components through the console.
+        Files.writeString(runtimeDir.resolve("conf/cell.gosh"), "# the browser tests install their own components\n");
         // The freshly built console bundle replaces any copy the assembly already carries.
         for (String dir : List.of("bundle", "console")) {
             try (Stream<Path> s = Files.list(runtimeDir.resolve(dir))) {

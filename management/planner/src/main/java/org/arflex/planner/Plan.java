@@ -18,7 +18,10 @@ import java.util.TreeSet;
  * of {@link #startGroups()} in order (providers before dependents, by the wiring after the
  * change; a group is a cycle of required inputs, or a single component), create the port
  * segments of all its members, then start them. A {@link Op#RESTART} appears in both sequences.
- * {@link #toText()} is what the {@code plan} command prints.
+ * A {@link Op#REBIND} appears in neither: before the stops, unbind its inputs whose provider
+ * changes or goes; after the starts, bind its inputs to their new providers ({@link
+ * #wiringOf(String)}), while it keeps running. {@link #toText()} is what the {@code plan}
+ * command prints.
  */
 public final class Plan {
 
@@ -28,8 +31,14 @@ public final class Plan {
         START,
         /** Active before, not Active after. */
         STOP,
-        /** Active before and after, but replaced, rewired or moved: stopped, then started. */
-        RESTART
+        /** Active before and after, but replaced, moved, or a provider's port changed shape: stopped, then started. */
+        RESTART,
+        /**
+         * Active before and after with the same contract and CPU; only input wires change, and
+         * they are bound and unbound while it runs (no restart, so a moving component keeps
+         * moving and needs no operator reset).
+         */
+        REBIND
     }
 
     /**
@@ -109,7 +118,7 @@ public final class Plan {
         return title;
     }
 
-    /** Every action, sorted by op (START, STOP, RESTART) then component name. */
+    /** Every action, sorted by op (START, STOP, RESTART, REBIND) then component name. */
     public List<Action> actions() {
         return actions;
     }
@@ -127,6 +136,11 @@ public final class Plan {
     /** The RESTART actions, by name. */
     public List<Action> restarts() {
         return only(Op.RESTART);
+    }
+
+    /** The REBIND actions, by name. */
+    public List<Action> rebinds() {
+        return only(Op.REBIND);
     }
 
     private List<Action> only(Op op) {

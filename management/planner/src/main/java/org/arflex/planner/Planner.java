@@ -372,8 +372,11 @@ public final class Planner {
                 actions.add(new Plan.Action(Plan.Op.START, n, why + "; " + admitted));
                 starting.add(n);
             } else {
-                List<String> why = restartReasons(n, replaced, oldEff.get(n), newEff.get(n), oldContracts, adm);
-                if (!why.isEmpty()) {
+                List<String> why = new ArrayList<>();
+                boolean rewireOnly = restartReasons(n, replaced, oldEff.get(n), newEff.get(n), oldContracts, adm, why);
+                if (!why.isEmpty() && rewireOnly) {
+                    actions.add(new Plan.Action(Plan.Op.REBIND, n, String.join("; ", why)));
+                } else if (!why.isEmpty()) {
                     actions.add(new Plan.Action(Plan.Op.RESTART, n, String.join("; ", why)));
                     stopping.add(n);
                     starting.add(n);
@@ -434,10 +437,16 @@ public final class Planner {
         return s;
     }
 
-    private List<String> restartReasons(String n, SortedMap<String, Contract> replaced, List<Wire> oldWires,
-            List<Wire> newWires, Map<String, Contract> oldContracts, AdmissionResult adm) {
-        List<String> why = new ArrayList<>();
+    /**
+     * Collects into {@code why} what changed for a component Active before and after; returns
+     * true when only its input wires changed (same contract, same CPU, every provider port of
+     * the same shape), which the DRCR applies live with UNBIND/BIND instead of a restart.
+     */
+    private boolean restartReasons(String n, SortedMap<String, Contract> replaced, List<Wire> oldWires,
+            List<Wire> newWires, Map<String, Contract> oldContracts, AdmissionResult adm, List<String> why) {
+        boolean structural = false;
         if (replaced.containsKey(n)) {
+            structural = true;
             String o = replaced.get(n).version();
             String v = resolver.contract(n).get().version();
             why.add(o.equals(v) ? "contract changed (version " + v + ")" : "replaced " + o + " -> " + v);
@@ -461,6 +470,7 @@ public final class Planner {
                     PortSpec op = oldProvider.port(a.outPort()).orElse(null);
                     PortSpec np = resolver.contract(a.provider()).get().port(a.outPort()).orElse(null);
                     if (op != null && np != null && !samePortShape(op, np)) {
+                        structural = true;
                         why.add("provider port " + a.source() + " changed (" + shape(op) + " -> " + shape(np) + ")");
                     }
                 }
@@ -475,9 +485,10 @@ public final class Planner {
         Integer oldCpu = cpuOf.get(n);
         OptionalIntBox newCpu = new OptionalIntBox(adm.cpuOf(n));
         if (oldCpu != null && newCpu.present && oldCpu != newCpu.value) {
+            structural = true;
             why.add("moved cpu " + oldCpu + " -> " + newCpu.value);
         }
-        return why;
+        return !structural;
     }
 
     private record OptionalIntBox(boolean present, int value) {

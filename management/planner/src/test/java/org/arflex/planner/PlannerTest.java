@@ -258,17 +258,22 @@ class PlannerTest {
     }
 
     @Test
-    void optionalProviderArrivingRewiresTheConsumer() {
+    void optionalProviderArrivingRewiresTheConsumerWhileItRuns() {
         Planner p = new Planner(CAPS);
         p.apply(Change.install(C.of("display").inOptional("x", S).build()));
         assertEquals(Set.of("display"), p.active());
         Plan plan = p.apply(Change.install(sampler()));
-        assertEquals(new Plan.Action(Plan.Op.RESTART, "display", "input 'x' now from sampler.out"),
+        assertEquals(new Plan.Action(Plan.Op.REBIND, "display", "input 'x' now from sampler.out"),
                 plan.action("display").get());
-        assertEquals(List.of("sampler", "display"), plan.startOrder());
+        // Rebinding is not a restart: the consumer is neither stopped nor started.
+        assertEquals(List.of("sampler"), plan.startOrder());
+        assertEquals(List.of(), plan.stopOrder());
+        assertEquals(List.of(new Wire("display", "x", "sampler", "out")), plan.wiringOf("display"));
         plan = p.plan(Change.uninstall("sampler"));
-        assertEquals(new Plan.Action(Plan.Op.RESTART, "display", "input 'x' lost sampler.out"),
+        assertEquals(new Plan.Action(Plan.Op.REBIND, "display", "input 'x' lost sampler.out"),
                 plan.action("display").get());
+        assertEquals(List.of("sampler"), plan.stopOrder());
+        assertTrue(plan.toText().contains("REBIND   display"), plan.toText());
     }
 
     @Test

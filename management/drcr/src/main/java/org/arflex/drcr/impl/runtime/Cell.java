@@ -338,6 +338,19 @@ public final class Cell {
                 stopHalf(inst, why);
             }
         }
+        // Every output segment of every component about to start exists before the first one
+        // starts: a member of a start group (a cycle) binds to its partners' outputs at once.
+        // A failure here is reported by that component's own start below.
+        for (String name : plan.startOrder()) {
+            Instance inst = instances.get(name);
+            if (inst != null && inst.half == null) {
+                try {
+                    ensureOutputs(inst);
+                } catch (IOException | RuntimeException e) {
+                    // startHalf tries again and fails the component with this reason.
+                }
+            }
+        }
         for (String name : plan.startOrder()) {
             Instance inst = instances.get(name);
             // A start that failed earlier in this loop blocked its component, and the nested
