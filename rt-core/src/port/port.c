@@ -287,15 +287,19 @@ int arflex_stream_push(struct arflex_port *p, const void *val, size_t len)
 
 	if (!h || !p->writable || p->method != ARFLEX_PORT_STREAM || len > p->elem_size)
 		return -EINVAL;
-	STORE(&h->written, LOADR(&h->written) + 1);
+	/* written is counted last, after the push took effect (dropped or published): a reader
+	 * that sees written == N then sees every outcome of the first N pushes, so
+	 * delivered + dropped + lost + (head - tail) == written holds for it. */
 	idx = p->next_idx;
 	if (p->overflow == ARFLEX_OVERFLOW_DROP_NEWEST && idx - LOAD(&h->tail) >= p->depth) {
 		STORE(&h->dropped, LOADR(&h->dropped) + 1);
+		STORE(&h->written, LOADR(&h->written) + 1);
 		return 0;
 	}
 	slot_write(p, idx, val, len);
 	p->next_idx = idx + 1;
 	STORE(&h->head, idx + 1);
+	STORE(&h->written, LOADR(&h->written) + 1);
 	return 1;
 }
 
