@@ -25,6 +25,7 @@
 
 #include "arflex/host.h"
 #include "arflex_types/sample.h"
+#include "helper.h" /* rt-core test kit: leak checks */
 
 #define SEC UINT64_C(1000000000)
 #define MS UINT64_C(1000000)
@@ -193,40 +194,9 @@ out:
 
 static bool leaked(const char *inst)
 {
-	char prefix[64];
-	bool any = false;
-	DIR *d = opendir("/dev/shm");
-
-	snprintf(prefix, sizeof(prefix), "arflex.%s.", rid);
-	if (d) {
-		struct dirent *e;
-
-		while ((e = readdir(d))) {
-			if (strncmp(e->d_name, prefix, strlen(prefix)) == 0) {
-				fprintf(stderr, "leak: /dev/shm/%s\n", e->d_name);
-				any = true;
-			}
-		}
-		closedir(d);
-	}
-	/* /dev/mqueue may not be mounted: check the queues by name. */
-	for (unsigned j = 0; j < 2; j++) {
-		char name[ARFLEX_OBJ_NAME_SIZE];
-		mqd_t q;
-
-		arflex_ctl_obj_name(name, sizeof(name), rid, inst, j ? "rsp" : "cmd");
-		q = mq_open(name, O_RDONLY);
-		if (q != (mqd_t)-1) {
-			fprintf(stderr, "leak: queue %s\n", name);
-			mq_close(q);
-			any = true;
-		}
-	}
-	if (waitpid(-1, NULL, WNOHANG) != -1 || errno != ECHILD) {
-		fprintf(stderr, "leak: a child process is left\n");
-		any = true;
-	}
-	return any;
+	/* /dev/mqueue may not be mounted: the kit also probes the tracked queues by name. */
+	th_track(rid, inst);
+	return th_leftovers(rid) > 0 || !th_no_children();
 }
 
 int main(int argc, char **argv)

@@ -1,18 +1,17 @@
+/* The test kit without a test framework: ids, leak checks, small file reads. Linked by the
+ * cmocka suites (through arflex_test_helper) and by the component tests of the bundles. */
 #include "helper.h"
 
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <mqueue.h>
-#include <setjmp.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/mman.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <cmocka.h>
 
 void th_rid(char *buf, size_t size, const char *tag)
 {
@@ -135,16 +134,6 @@ int th_threads(void)
 	return n;
 }
 
-void th_assert_clean(const char *rid)
-{
-	int left = th_leftovers(rid);
-
-	if (left)
-		th_sweep(rid);
-	assert_int_equal(left, 0);
-	assert_true(th_no_children());
-	assert_int_equal(th_threads(), 1);
-}
 
 long th_read_file(const char *path, char *buf, size_t size)
 {

@@ -1,4 +1,6 @@
-/* Shared test helpers: unique ids and the no-leak check every test ends with. */
+/* Shared test helpers: unique ids and the no-leak check every test ends with. Everything but
+ * th_assert_clean is in arflex_testkit (no test framework); th_assert_clean needs cmocka
+ * (arflex_test_helper). */
 #ifndef ARFLEX_TEST_HELPER_H
 #define ARFLEX_TEST_HELPER_H
 
@@ -9,7 +11,8 @@
 /* Writes "t<tag>-<pid>" (a valid runtime id, unique per test process) into @buf. */
 void th_rid(char *buf, size_t size, const char *tag);
 
-/* Counts /dev/shm/arflex.<rid>.* and /dev/mqueue/arflex.<rid>.* entries, printing each. */
+/* Counts /dev/shm/arflex.<rid>.* and /dev/mqueue/arflex.<rid>.* entries and the queues
+ * registered with th_track, printing each. */
 int th_leftovers(const char *rid);
 
 /* True when this process has no child (reaped or not). */

@@ -27,6 +27,7 @@
 
 #include "arflex/host.h"
 #include "arflex_types/sample.h"
+#include "helper.h" /* rt-core test kit: leak checks */
 
 #define SEC UINT64_C(1000000000)
 #define MS UINT64_C(1000000)
@@ -200,30 +201,7 @@ static bool consumer_half_untouched(unsigned i)
 
 static bool leaked(void)
 {
-	static const char *const dirs[] = { "/dev/shm", "/dev/mqueue" };
-	char prefix[64];
-	bool any = false;
-
-	snprintf(prefix, sizeof(prefix), "arflex.%s.", rid);
-	for (unsigned i = 0; i < 2; i++) {
-		DIR *d = opendir(dirs[i]);
-		struct dirent *e;
-
-		if (!d)
-			continue;
-		while ((e = readdir(d))) {
-			if (strncmp(e->d_name, prefix, strlen(prefix)) == 0) {
-				fprintf(stderr, "leak: %s/%s\n", dirs[i], e->d_name);
-				any = true;
-			}
-		}
-		closedir(d);
-	}
-	if (waitpid(-1, NULL, WNOHANG) != -1 || errno != ECHILD) {
-		fprintf(stderr, "leak: a child process is left\n");
-		any = true;
-	}
-	return any;
+	return th_leftovers(rid) > 0 || !th_no_children();
 }
 
 static int start_monitor(void)

@@ -32,6 +32,7 @@
 #include "arflex/host.h"
 
 #include "sample_type.h"
+#include "helper.h" /* rt-core test kit: leak checks */
 
 #define SEC UINT64_C(1000000000)
 #define MS UINT64_C(1000000)
@@ -57,43 +58,9 @@ static int failures;
 
 static bool leaked(void)
 {
-	static const char *const dirs[] = { "/dev/shm", "/dev/mqueue" };
-	static const char *const chans[] = { "cmd", "rsp" };
-	char prefix[64];
-	bool any = false;
-
-	snprintf(prefix, sizeof(prefix), "arflex.%s.", rid);
-	for (unsigned i = 0; i < 2; i++) {
-		DIR *d = opendir(dirs[i]);
-		struct dirent *e;
-
-		if (!d)
-			continue;
-		while ((e = readdir(d))) {
-			if (strncmp(e->d_name, prefix, strlen(prefix)) == 0) {
-				fprintf(stderr, "leak: %s/%s\n", dirs[i], e->d_name);
-				any = true;
-			}
-		}
-		closedir(d);
-	}
-	for (unsigned j = 0; j < 2; j++) { /* /dev/mqueue may not be mounted */
-		char name[ARFLEX_OBJ_NAME_SIZE];
-		mqd_t q;
-
-		arflex_ctl_obj_name(name, sizeof(name), rid, "probe", chans[j]);
-		q = mq_open(name, O_RDONLY);
-		if (q != (mqd_t)-1) {
-			fprintf(stderr, "leak: queue %s\n", name);
-			mq_close(q);
-			any = true;
-		}
-	}
-	if (waitpid(-1, NULL, WNOHANG) != -1 || errno != ECHILD) {
-		fprintf(stderr, "leak: a child process is left\n");
-		any = true;
-	}
-	return any;
+	/* /dev/mqueue may not be mounted: the kit also probes the tracked queues by name. */
+	th_track(rid, "probe");
+	return th_leftovers(rid) > 0 || !th_no_children();
 }
 
 static int make_probe(uint32_t depth, const struct arflex_port_type *type)

@@ -25,6 +25,7 @@
 #include "arflex/host.h"
 
 #include "sample_type.h"
+#include "helper.h" /* rt-core test kit: leak checks */
 
 #define SEC UINT64_C(1000000000)
 #define MS UINT64_C(1000000)
@@ -171,48 +172,10 @@ static const struct arflex_sample *xhist_get(uint64_t seq)
 
 static bool leaked(void)
 {
-	static const char *const dirs[] = { "/dev/shm", "/dev/mqueue" };
-	char prefix[64];
-	bool any = false;
-
-	snprintf(prefix, sizeof(prefix), "arflex.%s.", rid);
-	for (unsigned i = 0; i < 2; i++) {
-		DIR *d = opendir(dirs[i]);
-		struct dirent *e;
-
-		if (!d)
-			continue;
-		while ((e = readdir(d))) {
-			if (strncmp(e->d_name, prefix, strlen(prefix)) == 0) {
-				fprintf(stderr, "leak: %s/%s\n", dirs[i], e->d_name);
-				any = true;
-			}
-		}
-		closedir(d);
-	}
-	/* /dev/mqueue may not be mounted: check the queues by name as well. */
-	for (unsigned i = 0; i < 2; i++) {
-		static const char *const insts[] = { "counter", "scaler" };
-		static const char *const chans[] = { "cmd", "rsp" };
-
-		for (unsigned j = 0; j < 2; j++) {
-			char name[ARFLEX_OBJ_NAME_SIZE];
-			mqd_t q;
-
-			arflex_ctl_obj_name(name, sizeof(name), rid, insts[i], chans[j]);
-			q = mq_open(name, O_RDONLY);
-			if (q != (mqd_t)-1) {
-				fprintf(stderr, "leak: queue %s\n", name);
-				mq_close(q);
-				any = true;
-			}
-		}
-	}
-	if (waitpid(-1, NULL, WNOHANG) != -1 || errno != ECHILD) {
-		fprintf(stderr, "leak: a child process is left\n");
-		any = true;
-	}
-	return any;
+	/* /dev/mqueue may not be mounted: the kit also probes the tracked queues by name. */
+	th_track(rid, "counter");
+	th_track(rid, "scaler");
+	return th_leftovers(rid) > 0 || !th_no_children();
 }
 
 static int start_pair(bool bind)
