@@ -112,7 +112,7 @@ enum arflex_warn_kind {
 	ARFLEX_WARN_UPDATE = 7,      /**< update hook returned an error */
 	ARFLEX_WARN_PARAM = 8,       /**< a parameter request was rejected */
 	ARFLEX_WARN_INPUT = 9,       /**< an input read failed (retries exhausted, bad header) */
-	ARFLEX_WARN_SAFE = 10,       /**< safe mode entered (heartbeat lost) */
+	ARFLEX_WARN_SAFE = 10,       /**< safe mode entered (heartbeat lost or reset required) */
 };
 
 /* ---- statistics (seqlock) ----------------------------------------------------------- */

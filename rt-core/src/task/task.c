@@ -24,7 +24,7 @@ static const char *const warn_names[ARFLEX_WARN_KINDS] = {
 	[ARFLEX_WARN_UPDATE] = "update hook returned an error",
 	[ARFLEX_WARN_PARAM] = "parameter request rejected",
 	[ARFLEX_WARN_INPUT] = "input read failed",
-	[ARFLEX_WARN_SAFE] = "safe mode entered: runtime heartbeat lost",
+	[ARFLEX_WARN_SAFE] = "safe mode entered (runtime heartbeat lost or operator reset required)",
 };
 
 const char *arflex_warn_name(unsigned kind)
