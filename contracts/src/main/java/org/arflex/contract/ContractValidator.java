@@ -613,11 +613,25 @@ final class ContractValidator {
                 cpus.addAll(set);
             }
         }
+        boolean exclusive = false;
+        if (t.exclusive != null) {
+            Boolean b = Values.bool(t.exclusive);
+            if (b == null) {
+                p.at(t, "8.6", "timing/@exclusive", "'" + t.exclusive + "' is not a bool (true or false)");
+                ok = false;
+            } else if (service && b) {
+                p.at(t, "8.6", "timing/@exclusive",
+                        "a service task runs at SCHED_OTHER on no reserved CPU and cannot hold one exclusively");
+                ok = false;
+            } else {
+                exclusive = b;
+            }
+        }
         if (!ok) {
             return null;
         }
         return new Timing(period == null ? 0 : period, deadline == null ? 0 : deadline, wcet == null ? 0 : wcet,
-                priority, cpus);
+                priority, cpus, exclusive);
     }
 
     private static Long duration(Problems p, Located node, String text, String field, boolean required) {

@@ -95,6 +95,9 @@ public final class ContractWriter {
                 if (!t.cpus().isEmpty()) {
                     w.writeAttribute("cpus", t.cpus().stream().map(String::valueOf).collect(Collectors.joining(",")));
                 }
+                if (t.exclusive()) {
+                    w.writeAttribute("exclusive", "true");
+                }
             }
             nl(w, 1);
             w.writeEmptyElement("resources");

@@ -120,6 +120,20 @@ class ContractParserTest {
     }
 
     @Test
+    void exclusiveCpuIsParsedWrittenAndDefaultsToShared() throws Exception {
+        Contract probe = PARSER.parse(resource("/good/latency-probe.xml"), "latency-probe.xml");
+        assertTrue(probe.timing().exclusive());
+        assertEquals(List.of(1), probe.timing().cpus());
+        String written = ContractWriter.create().write(probe);
+        assertTrue(written.contains("exclusive=\"true\""), written);
+        assertEquals(probe, PARSER.parse(written, "latency-probe.xml"));
+        Contract shared = PARSER.parse(resource("/good/sample-scaler.xml"), "sample-scaler.xml");
+        assertFalse(shared.timing().exclusive());
+        assertFalse(ContractWriter.create().write(shared).contains("exclusive"));
+        assertEquals(new Timing(1, 1, 1, 1, List.of(0)), new Timing(1, 1, 1, 1, List.of(0), false));
+    }
+
+    @Test
     void serviceWithoutTimingGetsZeroTimingAndRoundTrips() throws Exception {
         Contract c = PARSER.parse(resource("/good/debug-monitor.xml"), "debug-monitor.xml");
         assertEquals(Contract.TaskType.SERVICE, c.taskType());

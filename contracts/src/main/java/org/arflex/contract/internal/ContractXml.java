@@ -112,6 +112,7 @@ public final class ContractXml extends Located {
         @JacksonXmlProperty(isAttribute = true) public String wcet;
         @JacksonXmlProperty(isAttribute = true) public String priority;
         @JacksonXmlProperty(isAttribute = true) public String cpus;
+        @JacksonXmlProperty(isAttribute = true) public String exclusive;
     }
 
     /** {@code <resources>}. */
