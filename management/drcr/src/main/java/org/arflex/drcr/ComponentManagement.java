@@ -1,6 +1,7 @@
 package org.arflex.drcr;
 
 import org.arflex.drcr.dto.InstanceDTO;
+import org.arflex.drcr.dto.PortValueDTO;
 import org.arflex.drcr.dto.StatsDTO;
 
 /**
@@ -40,6 +41,20 @@ public interface ComponentManagement {
 
     /** RT statistics, or null when no RT half runs. */
     StatsDTO stats();
+
+    /**
+     * Since 0.2.0: the newest value of one of this instance's output ports, read from a
+     * read-only mapping of the port segment under the slot's seqlock (the producer is never
+     * written to, locked or slowed) and decoded with the port type's field definitions. For a
+     * stream or frame port the newest slot is copied, nothing is consumed. Runs off the DRCR's
+     * actor thread except for a short lookup of the segment. Callers should poll at a modest
+     * rate (the web console: at most 10 Hz per port).
+     *
+     * @return the value; {@link PortValueDTO#index} is -1 when nothing was published yet
+     * @throws IllegalArgumentException naming the port when this instance has no such output
+     * @throws IllegalStateException when the segment cannot be read (gone, wrong type)
+     */
+    PortValueDTO portValue(String port);
 
     /**
      * Operator reset: lets a component that moves hardware drive its outputs again after a

@@ -47,6 +47,11 @@ public interface Posix extends Library {
 
     int close(int fd) throws LastErrorException;
 
+    int SEEK_END = 2;
+
+    /** With SEEK_END and offset 0: the size of a shared-memory object. */
+    long lseek(int fd, long offset, int whence) throws LastErrorException;
+
     /** mq_open is variadic; with O_CREAT the mode and attribute arguments follow. */
     int mq_open(String name, int oflag, int mode, MqAttr attr) throws LastErrorException;
 

@@ -2,11 +2,13 @@ package org.arflex.drcr.impl.services;
 
 import org.arflex.drcr.ComponentManagement;
 import org.arflex.drcr.dto.InstanceDTO;
+import org.arflex.drcr.dto.PortValueDTO;
 import org.arflex.drcr.dto.StatsDTO;
 import org.arflex.drcr.impl.runtime.Cell;
+import org.arflex.drcr.impl.runtime.PortValues;
 import org.arflex.drcr.impl.runtime.Snapshots;
 
-/** The management service of one instance; every call runs on the actor thread. */
+/** The management service of one instance; every call runs on the actor thread (a port read only its lookup). */
 final class ComponentManagementImpl implements ComponentManagement {
 
     private final String name;
@@ -46,6 +48,13 @@ final class ComponentManagementImpl implements ComponentManagement {
     @Override
     public StatsDTO stats() {
         return instance().stats;
+    }
+
+    @Override
+    public PortValueDTO portValue(String port) {
+        // Only the lookup runs on the actor; the read itself maps the segment read-only here.
+        PortValues.Ref ref = cell.actor().call(() -> PortValues.ref(cell, name, port), Services.CALL_MS);
+        return PortValues.read(ref, cell.config().monotonicNs().getAsLong());
     }
 
     @Override

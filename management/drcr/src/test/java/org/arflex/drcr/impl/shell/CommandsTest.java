@@ -167,6 +167,11 @@ class CommandsTest {
         }
 
         @Override
+        public org.arflex.drcr.dto.PortValueDTO portValue(String port) {
+            throw new IllegalArgumentException("component 'cons' has no output port '" + port + "'");
+        }
+
+        @Override
         public void reset() {
             calls.add("reset");
         }
