@@ -29,6 +29,11 @@ import org.arflex.contract.Timing;
  * tasks take no CPU budget. The WCET used is the larger of the declared and the measured one
  * (noted in the reason).
  *
+ * <p><b>CPUs kept apart.</b> A task whose timing is {@link Timing#exclusive() exclusive}
+ * (SPEC §8.6) goes only to a CPU holding no other task, and no task is placed on that CPU after
+ * it; tasks that share CPUs try the CPUs that no exclusive candidate names last. A
+ * {@link Capacities.Cpu#reserved() reserved} CPU takes only tasks whose contract names it.
+ *
  * <p><b>Budgets.</b> Memory and network budgets are summed against the capacities.
  *
  * <p><b>Order.</b> Components are admitted by decreasing effective criticality: a provider's is
@@ -119,10 +124,31 @@ public final class Admission {
         final double cap;
         final List<Entry> tasks = new ArrayList<>();
         double util;
+        final boolean reserved;
+        /** The exclusive task placed here, or null. */
+        String owner;
 
         Cpu(Capacities.Cpu c) {
             this.id = c.id();
             this.cap = c.utilisationCap();
+            this.reserved = c.reserved();
+        }
+
+        /** Why {@code t} may not share this CPU (SPEC §8.6), or null. */
+        String exclusion(Schedulability.Task t, boolean exclusive) {
+            if (owner != null) {
+                return "cpu " + id + ": held exclusively by '" + owner + "' (timing/@exclusive)";
+            }
+            if (exclusive && !tasks.isEmpty()) {
+                List<String> names = new ArrayList<>();
+                for (Entry e : tasks) {
+                    names.add("'" + e.task.name() + "'");
+                }
+                names.sort(null);
+                return "cpu " + id + ": '" + t.name() + "' asks for a cpu of its own (timing/@exclusive), but cpu "
+                        + id + " already holds " + String.join(", ", names);
+            }
+            return null;
         }
 
         /** All deadlines implicit and priorities rate monotonic (so the bounds apply). */
@@ -296,6 +322,8 @@ public final class Admission {
         final Map<String, Entry> entryOf = new HashMap<>();
         final Map<String, String> notes = new HashMap<>();
         final Set<String> admitted = new HashSet<>();
+        /** CPUs named in {@code timing/@cpus} by an exclusive candidate not admitted yet: count per CPU. */
+        final Map<Integer, Integer> wantedExclusively = new HashMap<>();
         long memUsed;
         long netUsed;
 
@@ -332,6 +360,17 @@ public final class Admission {
             for (Capacities.Cpu c : caps.cpus()) {
                 cpus.put(c.id(), new Cpu(c));
             }
+            for (Contract c : cands.values()) {
+                if (isExclusive(c)) {
+                    for (int id : new TreeSet<>(c.timing().cpus())) {
+                        wantedExclusively.merge(id, 1, Integer::sum);
+                    }
+                }
+            }
+        }
+
+        static boolean isExclusive(Contract c) {
+            return c.taskType() != Contract.TaskType.SERVICE && c.timing().exclusive();
         }
 
         final Map<String, Set<String>> providerCache = new HashMap<>();
@@ -457,6 +496,11 @@ public final class Admission {
 
         void refuseAll(List<String> members, String culprit, String reason) {
             for (String n : members) {
+                if (isExclusive(cands.get(n))) {
+                    for (int id : new TreeSet<>(cands.get(n).timing().cpus())) {
+                        wantedExclusively.computeIfPresent(id, (k, v) -> v > 1 ? v - 1 : null);
+                    }
+                }
                 String r = n.equals(culprit) ? reason
                         : "refused with its cycle " + members + ": '" + culprit + "': " + reason;
                 decisions.put(n, new Decision(n, false, OptionalInt.empty(), wcetOf(cands.get(n)), -1, r));
@@ -512,7 +556,15 @@ public final class Admission {
                 }
                 List<Cpu> allowed = new ArrayList<>();
                 if (t.cpus().isEmpty()) {
-                    allowed.addAll(cpus.values());
+                    for (Cpu cpu : cpus.values()) {
+                        if (!cpu.reserved) {
+                            allowed.add(cpu);
+                        }
+                    }
+                    if (allowed.isEmpty() && !cpus.isEmpty()) {
+                        return "cpu: every capacity cpu is reserved (" + join(cpus.keySet())
+                                + ") and the contract names none in timing/@cpus";
+                    }
                 } else {
                     for (int id : new TreeSet<>(t.cpus())) {
                         Cpu cpu = cpus.get(id);
@@ -526,9 +578,12 @@ public final class Admission {
                             : "allowed cpus " + join(new TreeSet<>(t.cpus())) + " not in capacities (have "
                                     + (cpus.isEmpty() ? "none" : join(cpus.keySet())) + ")");
                 }
-                // Keep the previous CPU when it still fits; otherwise worst fit, then lowest id.
+                // Keep the previous CPU when it still fits; otherwise worst fit, then lowest id;
+                // a shared task tries the CPUs an exclusive candidate still wants last.
+                boolean exclusive = t.exclusive();
                 List<Cpu> order = new ArrayList<>(allowed);
-                order.sort(Comparator.comparingDouble((Cpu x) -> x.util).thenComparingInt(x -> x.id));
+                order.sort(Comparator.comparingInt((Cpu x) -> !exclusive && wantedExclusively.containsKey(x.id) ? 1 : 0)
+                        .thenComparingDouble(x -> x.util).thenComparingInt(x -> x.id));
                 Integer prev = previousCpu.get(n);
                 if (prev != null) {
                     for (int k = 0; k < order.size(); k++) {
@@ -540,6 +595,11 @@ public final class Admission {
                 }
                 List<String> why = new ArrayList<>();
                 for (Cpu cpu : order) {
+                    String excl = cpu.exclusion(task, exclusive);
+                    if (excl != null) {
+                        why.add(excl);
+                        continue;
+                    }
                     Fit f = cpu.test(task);
                     if (f.ok()) {
                         chosen = cpu;
@@ -568,7 +628,19 @@ public final class Admission {
                 Runnable cpuUndo = cpu.add(e);
                 placedOn.put(n, cpu);
                 entryOf.put(n, e);
+                if (exclusive) {
+                    cpu.owner = n;
+                    for (int id : new TreeSet<>(t.cpus())) {
+                        wantedExclusively.computeIfPresent(id, (k, v) -> v > 1 ? v - 1 : null);
+                    }
+                }
                 undo.add(() -> {
+                    if (exclusive) {
+                        cpu.owner = null;
+                        for (int id : new TreeSet<>(t.cpus())) {
+                            wantedExclusively.merge(id, 1, Integer::sum);
+                        }
+                    }
                     cpuUndo.run();
                     old.forEach((x, r) -> x.r = r);
                     placedOn.remove(n);
@@ -625,10 +697,11 @@ public final class Admission {
                 } else {
                     Entry e = entryOf.get(n);
                     r = e.r;
+                    String where = "cpu " + cpu.id + (n.equals(cpu.owner) ? " (exclusive)" : "");
                     reason = r >= 0
-                            ? "cpu " + cpu.id + ": R=" + Text.duration(r) + " <= D=" + Text.duration(e.task.deadlineNs())
+                            ? where + ": R=" + Text.duration(r) + " <= D=" + Text.duration(e.task.deadlineNs())
                                     + " (U=" + Text.util(cpu.util) + ")"
-                            : "cpu " + cpu.id + ": hyperbolic bound holds (U=" + Text.util(cpu.util) + ")";
+                            : where + ": hyperbolic bound holds (U=" + Text.util(cpu.util) + ")";
                     if (notes.containsKey(n)) {
                         reason += "; " + notes.get(n);
                     }

@@ -21,8 +21,11 @@ public record Capacities(List<Cpu> cpus, long memoryBytes, long networkBps) {
      * @param id             Linux CPU number
      * @param utilisationCap the share of the CPU admission may fill, {@code 0 < cap <= 1}
      *                       (for example 0.9 keeps 10% for the kernel and services)
+     * @param reserved       admission places only components that name this CPU in their
+     *                       contract's {@code timing/@cpus} here, never one that lets admission
+     *                       choose (framework property {@code arflex.cpus.reserved})
      */
-    public record Cpu(int id, double utilisationCap) {
+    public record Cpu(int id, double utilisationCap, boolean reserved) {
         public Cpu {
             if (id < 0) {
                 throw new IllegalArgumentException("cpu id " + id + " is negative");
@@ -31,6 +34,11 @@ public record Capacities(List<Cpu> cpus, long memoryBytes, long networkBps) {
                 throw new IllegalArgumentException("cpu " + id + ": utilisation cap " + utilisationCap
                         + " is not in (0, 1]");
             }
+        }
+
+        /** A CPU that is not reserved. */
+        public Cpu(int id, double utilisationCap) {
+            this(id, utilisationCap, false);
         }
     }
 
@@ -74,6 +82,31 @@ public record Capacities(List<Cpu> cpus, long memoryBytes, long networkBps) {
     /** A copy with another network capacity. */
     public Capacities withNetworkBps(long bps) {
         return new Capacities(cpus, memoryBytes, bps);
+    }
+
+    /**
+     * A copy in which exactly the CPUs in {@code ids} are {@link Cpu#reserved() reserved}.
+     *
+     * @throws IllegalArgumentException when an id is not one of the capacity CPUs
+     */
+    public Capacities withReserved(java.util.Collection<Integer> ids) {
+        HashSet<Integer> have = new HashSet<>();
+        cpus.forEach(c -> have.add(c.id()));
+        for (int id : ids) {
+            if (!have.contains(id)) {
+                throw new IllegalArgumentException("reserved cpu " + id + " is not among the capacity cpus " + have);
+            }
+        }
+        List<Cpu> list = new ArrayList<>();
+        for (Cpu c : cpus) {
+            list.add(new Cpu(c.id(), c.utilisationCap(), ids.contains(c.id())));
+        }
+        return new Capacities(list, memoryBytes, networkBps);
+    }
+
+    /** Ids of the reserved CPUs, ascending. */
+    public List<Integer> reservedCpus() {
+        return cpus.stream().filter(Cpu::reserved).map(Cpu::id).toList();
     }
 
     /** A copy with another CPU list. */

@@ -567,7 +567,7 @@ public final class Planner {
     private static String cpus(Capacities c) {
         List<String> s = new ArrayList<>();
         for (Capacities.Cpu cpu : c.cpus()) {
-            s.add(cpu.id() + "(" + Text.trim(cpu.utilisationCap()) + ")");
+            s.add(cpu.id() + "(" + Text.trim(cpu.utilisationCap()) + (cpu.reserved() ? ", reserved" : "") + ")");
         }
         return s.isEmpty() ? "none" : String.join(" ", s);
     }

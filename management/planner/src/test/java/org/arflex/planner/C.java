@@ -94,6 +94,13 @@ final class C {
         return this;
     }
 
+    /** Makes the timing exclusive (SPEC 8.6), keeping everything else. */
+    C exclusive() {
+        timing = new Timing(timing.periodNs(), timing.deadlineNs(), timing.wcetNs(), timing.priority(), timing.cpus(),
+                true);
+        return this;
+    }
+
     C mem(long bytes) {
         mem = bytes;
         return this;
