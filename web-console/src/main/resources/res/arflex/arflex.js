@@ -75,5 +75,49 @@ const Arflex = (() => {
 
   function clear(node) { node.replaceChildren(); return node; }
 
-  return {app, root, appRoot, el, get, post, fmtNs, fmtBytes, stateBadge, pageUrl, message, clear};
+  const COLORS = ['#c62828', '#1565c0', '#2e7d32', '#6a1b9a', '#ef6c00', '#00838f', '#5d4037', '#455a64'];
+
+  /** A rolling uPlot of the last `opts.window` points in `box`: push(tSeconds, [v1, v2, ...]). */
+  function rollingPlot(box, labels, opts) {
+    const o = opts || {};
+    const keep = o.window || 300;
+    const data = [[], ...labels.map(() => [])];
+    const plot = new uPlot({width: o.width || 800, height: o.height || 220,
+      series: [{}, ...labels.map((l, n) => ({label: l, stroke: (o.colors || COLORS)[n % COLORS.length]}))],
+      axes: [{}, {label: o.unit || ''}]}, data, box);
+    let n = 0;
+    box.dataset.samples = '0';
+    return {
+      push(t, values) {
+        data[0].push(t);
+        values.forEach((v, j) => data[j + 1].push(typeof v === 'number' && isFinite(v) ? v : null));
+        if (data[0].length > keep) data.forEach(a => a.shift());
+        plot.setData(data);
+        n++;
+        box.dataset.samples = String(n);
+      },
+      get count() { return n; },
+      plot
+    };
+  }
+
+  /** Live stream of a component (and some of its output ports): EventSource, one JSON frame per message. */
+  function stream(name, ports, onFrame) {
+    if (typeof EventSource === 'undefined') return null;
+    const q = {name};
+    if (ports && ports.length) q.ports = ports.join(',');
+    const src = new EventSource(root + '/api/stream?' + new URLSearchParams(q));
+    src.onmessage = ev => onFrame(JSON.parse(ev.data));
+    window.addEventListener('beforeunload', () => src.close());
+    return src;
+  }
+
+  /** Formats a number for display (short, finite). */
+  function fmtNum(v) {
+    if (typeof v !== 'number' || !isFinite(v)) return String(v);
+    if (Number.isInteger(v)) return String(v);
+    return Math.abs(v) >= 1e4 || Math.abs(v) < 1e-3 ? v.toExponential(4) : v.toFixed(5);
+  }
+
+  return {app, root, appRoot, el, get, post, fmtNs, fmtBytes, fmtNum, stateBadge, pageUrl, message, clear, rollingPlot, stream};
 })();

@@ -2,10 +2,71 @@
  * CPU, memory and network budgets against capacity. Refreshed once a second. */
 'use strict';
 (() => {
-  const {app, el, get, fmtNs, fmtBytes, stateBadge, pageUrl, message} = Arflex;
+  const {app, el, get, post, fmtNs, fmtBytes, fmtNum, stateBadge, pageUrl, message, rollingPlot, stream} = Arflex;
   const status = el('div', {id: 'arflex-cell-status'});
   const body = el('div', {id: 'arflex-cell'});
-  app.replaceChildren(el('h2', {}, 'Cell'), status, body);
+  const tcp = el('div', {id: 'arflex-tcp-error'});
+  app.replaceChildren(el('h2', {}, 'Cell'), status, body, tcp);
+
+  // Preset plot: the tool-centre error that tcp-correction publishes (output `error`,
+  // arflex.Sample, mm), drawn as two series, with and without correction, split by the applied
+  // value of its `enable` parameter, which the button toggles. `?error=component.port` points
+  // the preset at another Sample port (another cell); the toggle appears only where the
+  // component has a mutable bool parameter `enable`.
+  const errorParam = new URLSearchParams(window.location.search).get('error') || 'tcp-correction.error';
+  const preset = {component: errorParam.substring(0, errorParam.lastIndexOf('.')),
+    port: errorParam.substring(errorParam.lastIndexOf('.') + 1), toggle: 'enable'};
+  let tcpStream = null; let tcpPlot = null; let tcpShown; let tcpEnabled = null;
+  function renderTcp(cell) {
+    const inst = (cell.instances || []).find(i => i.name === preset.component);
+    const contract = (cell.contracts || []).find(c => c.name === preset.component);
+    const port = contract && (contract.ports || []).find(p => p.direction === 'OUT' && p.name === preset.port);
+    const ok = inst && port && port.type === 'arflex.Sample' && inst.state === 'ACTIVE';
+    const why = ok ? null : !inst ? 'No component ' + preset.component + ' in the cell.'
+      : !port ? preset.component + ' has no output port ' + preset.port + '.'
+      : port.type !== 'arflex.Sample' ? preset.component + '.' + preset.port + ' is ' + port.type + ', not arflex.Sample.'
+      : preset.component + ' is ' + inst.state + ', not Active.';
+    const key = ok ? 'pid ' + inst.pid : why;
+    if (key === tcpShown) return;
+    tcpShown = key;
+    if (tcpStream) { tcpStream.close(); tcpStream = null; }
+    tcpPlot = null;
+    const head = el('h2', {}, 'Tool-centre error, with and without correction');
+    if (!ok) {
+      tcp.replaceChildren(head, el('p', {id: 'arflex-tcp-error-none'}, why));
+      return;
+    }
+    const toggleSpec = (inst.params || []).find(p => p.name === preset.toggle && p.mutable && p.type === 'BOOL');
+    const last = el('div', {id: 'arflex-tcp-error-last'}, 'waiting for values…');
+    const box = el('div', {class: 'arflex-plot', id: 'arflex-tcp-error-plot'});
+    const toggle = toggleSpec ? el('button', {type: 'button', id: 'arflex-tcp-toggle', onclick: async () => {
+      const next = tcpEnabled === 'true' ? 'false' : 'true';
+      try {
+        const r = await post('param', {name: preset.component, param: preset.toggle, value: next});
+        message(status, preset.component + ' ' + preset.toggle + ' applied by the RT half: ' + r.applied, 'ok');
+      } catch (e) { message(status, preset.toggle + ': ' + e.message, 'error'); }
+    }}, 'Toggle correction') : '';
+    tcp.replaceChildren(head, el('p', {}, el('code', {}, preset.component + '.' + preset.port), ' ', toggle), last, box);
+    if (typeof uPlot === 'undefined') return;
+    // tcp-correction publishes its error in mm (an arflex.Sample carries no unit of its own).
+    const unit = errorParam === 'tcp-correction.error' ? 'mm' : '';
+    tcpPlot = toggleSpec ? rollingPlot(box, ['with correction', 'without correction'], {unit, window: 600,
+      colors: ['#2e7d32', '#c62828']}) : rollingPlot(box, [preset.component + '.' + preset.port], {unit, window: 600});
+    tcpStream = stream(preset.component, [preset.port], f => {
+      if (f.gone || !f.ports) return;
+      const v = f.ports[preset.port];
+      if (!v || v.error) { last.textContent = v ? 'error: ' + v.error : 'no value'; return; }
+      if (v.index < 0 || !v.fields || !Array.isArray(v.fields.value)) { last.textContent = 'nothing published yet'; return; }
+      const x = v.fields.value[0];
+      tcpEnabled = toggleSpec ? String((f.params || {})[preset.toggle]) : null;
+      const on = !toggleSpec || tcpEnabled === 'true';
+      tcpPlot.push(f.t / 1000, !toggleSpec ? [x] : on ? [x, null] : [null, x]);
+      last.textContent = preset.port + ' = ' + fmtNum(x) + (toggleSpec ? ', correction ' + (on ? 'on' : 'off') : '') +
+        ' (' + tcpPlot.count + ' samples)';
+      box.dataset.last = String(x);
+      box.dataset.correction = toggleSpec ? (on ? 'on' : 'off') : '';
+    });
+  }
 
   function bar(used, capacity) {
     const frac = capacity > 0 ? used / capacity : (used > 0 ? 1 : 0);
@@ -65,7 +126,9 @@
 
   async function refresh() {
     try {
-      render(await get('cell'));
+      const data = await get('cell');
+      render(data);
+      if (data.drcr) renderTcp(data.cell);
     } catch (e) {
       message(status, 'Cannot read the cell: ' + e.message, 'error');
     }

@@ -25,6 +25,7 @@
   const params = el('div', {id: 'arflex-params'});
   const plots = el('div', {id: 'arflex-plots'});
   const histo = el('div', {id: 'arflex-histogram'});
+  const portBox = el('div', {id: 'arflex-ports-live'});
 
   function kv(rows) {
     return el('table', {class: 'arflex-table'}, rows.map(([k, v]) => el('tr', {}, el('th', {}, k), el('td', {}, v))));
@@ -82,8 +83,10 @@
   // Live plot: a rolling window of the streamed samples.
   const WINDOW = 300;
   let plot = null; let series = null; let source = null;
+  let watched = null; // {port, field, plot, last}
   function startStream() {
     if (typeof EventSource === 'undefined' || typeof uPlot === 'undefined') return;
+    if (source) source.close();
     const keys = ['maxLatencyNs', 'meanExecNs', 'maxExecNs'];
     series = {t: [], v: keys.map(() => [])};
     const box = el('div', {class: 'arflex-plot', id: 'arflex-live-plot'});
@@ -91,10 +94,12 @@
     plots.replaceChildren(el('h2', {}, 'Live statistics (10 Hz)'), counter, box);
     plot = new uPlot({width: 800, height: 240, series: [{}, ...keys.map((k, n) => ({label: k.replace('Ns', ' (µs)'),
       stroke: ['#c62828', '#1565c0', '#2e7d32'][n]}))], axes: [{}, {label: 'µs'}]}, [[], ...keys.map(() => [])], box);
-    source = new EventSource(Arflex.root + '/api/stream?' + new URLSearchParams({name}));
+    source = new EventSource(Arflex.root + '/api/stream?' + new URLSearchParams(
+      watched ? {name, ports: watched.port} : {name}));
     let n = 0;
     source.onmessage = ev => {
       const s = JSON.parse(ev.data);
+      if (watched && s.ports) drawPort(s.t / 1000, s.ports[watched.port]);
       if (s.gone) { counter.textContent = 'component gone'; return; }
       n++;
       series.t.push(s.t / 1000);
@@ -146,18 +151,73 @@
     histo.dataset.samples = String(s.latencyCount || 0);
   }
 
+  // Live plot of any output port value: the port's fields come from one read (api/port), the
+  // values from the same stream (the sampler reads each watched port once per period, 10 Hz).
+  function renderPortChooser(d) {
+    const outs = ((d.contract || {}).ports || []).filter(p => p.direction === 'OUT');
+    if (!outs.length) { portBox.replaceChildren(); return; }
+    const portSel = el('select', {id: 'arflex-port-select'}, outs.map(p => el('option', {value: p.name}, p.name + ' (' + p.type + ', ' + p.method + ')')));
+    const fieldSel = el('select', {id: 'arflex-port-field'});
+    const err = el('span', {class: 'arflex-field-error', id: 'arflex-port-error'});
+    async function fields() {
+      err.textContent = '';
+      try {
+        const v = await get('port', {name, port: portSel.value});
+        fieldSel.replaceChildren(...(v.fields || []).map(f => el('option', {value: f.name},
+          f.name + (f.count > 1 ? '[' + f.count + ']' : '') + (f.unit ? ' (' + f.unit + ')' : ''))));
+        const pref = (v.fields || []).find(f => f.name === 'value') || (v.fields || []).find(f => !/^(seq|t_ns|stamp_ns)$/.test(f.name));
+        if (pref) fieldSel.value = pref.name;
+        if (!(v.fields || []).length) err.textContent = v.index < 0 ? 'nothing published on this port yet' : 'no fields';
+      } catch (e) { err.textContent = e.message; }
+    }
+    portSel.addEventListener('change', fields);
+    const go = el('button', {type: 'button', id: 'arflex-port-plot-btn', onclick: () => {
+      if (!fieldSel.value) { err.textContent = 'choose a field'; return; }
+      watchPort(portSel.value, fieldSel.value);
+    }}, 'Plot');
+    portBox.replaceChildren(el('h2', {}, 'Live port values (10 Hz)'),
+      el('p', {}, 'Port ', portSel, ' field ', fieldSel, ' ', go, err), el('div', {id: 'arflex-port-area'}));
+    fields();
+  }
+
+  function watchPort(port, field) {
+    const area = document.getElementById('arflex-port-area');
+    const last = el('div', {id: 'arflex-port-last'}, 'waiting for values of ' + port + '.' + field + '…');
+    const box = el('div', {class: 'arflex-plot', id: 'arflex-port-plot'});
+    area.replaceChildren(last, box);
+    watched = {port, field, box, last, plot: null};
+    startStream();
+  }
+
+  function drawPort(t, v) {
+    const w = watched;
+    if (!v) return;
+    if (v.error) { w.last.textContent = 'error: ' + v.error; return; }
+    const values = (v.fields || {})[w.field];
+    if (!Array.isArray(values)) { w.last.textContent = v.index < 0 ? 'nothing published yet' : 'no field ' + w.field; return; }
+    if (!w.plot) {
+      const labels = values.length === 1 ? [w.port + '.' + w.field] : values.map((_, i) => w.field + '[' + i + ']');
+      w.plot = Arflex.rollingPlot(w.box, labels.slice(0, 8));
+    }
+    w.plot.push(t, values.slice(0, 8));
+    w.box.dataset.last = values.map(Arflex.fmtNum).join(' ');
+    w.last.textContent = w.port + '.' + w.field + ' = ' + values.slice(0, 8).map(Arflex.fmtNum).join(', ') +
+      ' (element ' + v.index + ', ' + w.plot.count + ' samples)';
+  }
+
   async function load() {
     try {
       const d = await get('component', {name});
       renderSummary(d);
       renderParams(d);
+      if (!portBox.firstChild) renderPortChooser(d);
     } catch (e) {
       message(status, 'Component ' + name + ' is not in the cell now (' + e.message + ')', 'error');
     }
   }
 
   if (!name) { chooser(); return; }
-  app.replaceChildren(el('h2', {id: 'arflex-component-name'}, 'Component ', el('code', {}, name)), status, commands, summary, params, plots, histo);
+  app.replaceChildren(el('h2', {id: 'arflex-component-name'}, 'Component ', el('code', {}, name)), status, commands, summary, params, plots, portBox, histo);
   load().then(startStream);
   window.addEventListener('beforeunload', () => source && source.close());
 })();

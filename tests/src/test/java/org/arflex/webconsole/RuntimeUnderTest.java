@@ -68,6 +68,17 @@ final class RuntimeUnderTest implements AutoCloseable {
             }
         }
         Files.copy(jar, runtimeDir.resolve("console/org.arflex.webconsole.jar"));
+        // The debug monitor the console installs from its Debug page: where the assembly ships it
+        // (tools/), from the freshly built bundle when the assembly does not carry one yet.
+        Path tools = Files.createDirectories(runtimeDir.resolve("tools"));
+        String debugmon = System.getProperty("arflex.it.debugmon");
+        boolean shipped;
+        try (Stream<Path> s = Files.list(tools)) {
+            shipped = s.anyMatch(p -> p.getFileName().toString().startsWith("org.arflex.debug.monitor"));
+        }
+        if (!shipped && debugmon != null && Files.isRegularFile(Path.of(debugmon))) {
+            Files.copy(Path.of(debugmon), tools.resolve("org.arflex.debug.monitor.jar"));
+        }
         this.port = freePort();
         Path conf = runtimeDir.resolve("conf/config.properties");
         String props = Files.readString(conf).replaceAll("(?m)^org\\.osgi\\.service\\.http\\.port=.*$",

@@ -30,7 +30,8 @@ import org.openqa.selenium.support.ui.WebDriverWait;
  * Benchmark, not a test (run on purpose: {@code mvn -o -Darflex.native.skip=true -pl web-console
  * verify -Dit.test=StreamLoadBench}): the RT statistics of the two sample components over a
  * fixed window, once with no browser and once while three headless browsers show the component
- * page with its live plots (server-sent events at 10 Hz). Prints a table and writes
+ * page with its live plots (server-sent events at 10 Hz: statistics, and the value of the
+ * component's output port read from its segment). Prints a table and writes
  * target/bench/stream-load.json. The components are restarted (bundle stop/start) before each
  * window so each window's statistics start from zero.
  */
@@ -76,6 +77,14 @@ class StreamLoadBench {
                 b.get(rt.base() + "/system/console/arflex-component?name=" + COMPONENTS[i % 2]);
                 new WebDriverWait(b, Duration.ofSeconds(30)).until(
                         ExpectedConditions.textToBePresentInElementLocated(By.id("arflex-live-count"), "samples"));
+                // Also plot the component's output port value (the same stream then carries it).
+                new WebDriverWait(b, Duration.ofSeconds(30)).until(d -> !new org.openqa.selenium.support.ui.Select(
+                        d.findElement(By.id("arflex-port-field"))).getOptions().isEmpty());
+                b.findElement(By.id("arflex-port-plot-btn")).click();
+                new WebDriverWait(b, Duration.ofSeconds(30)).until(d -> {
+                    String n = d.findElement(By.id("arflex-port-plot")).getAttribute("data-samples");
+                    return n != null && Long.parseLong(n) > 0;
+                });
             }
             result.put("threeBrowsers", window());
         } finally {
@@ -114,7 +123,8 @@ class StreamLoadBench {
         for (String c : COMPONENTS) {
             String body = send(HttpRequest.newBuilder(uri("/system/console/arflex-component/api/component?name=" + c)).GET()).body();
             Map<String, Object> s = new LinkedHashMap<>();
-            for (String k : new String[] {"cycles", "overruns", "wcetOverruns", "maxLatencyNs", "maxExecNs", "meanExecNs"}) {
+            for (String k : new String[] {"cycles", "overruns", "wcetOverruns", "maxLatencyNs", "latencyP50Ns",
+                "latencyP99Ns", "latencyP999Ns", "maxExecNs", "meanExecNs"}) {
                 Matcher m = Pattern.compile("\"stats\":\\{[^}]*\"" + k + "\":(\\d+)").matcher(body);
                 s.put(k, m.find() ? Long.parseLong(m.group(1)) : null);
             }
@@ -161,13 +171,15 @@ class StreamLoadBench {
 
     @SuppressWarnings("unchecked")
     private static void print(Map<String, Object> result) {
-        System.out.printf(Locale.ROOT, "%-14s %-15s %9s %9s %9s %14s %12s %12s%n", "run", "component", "cycles",
-                "overruns", "wcet-over", "max-latency-us", "max-exec-us", "mean-exec-us");
+        System.out.printf(Locale.ROOT, "%-14s %-15s %9s %9s %9s %10s %10s %10s %14s %12s %12s%n", "run", "component",
+                "cycles", "overruns", "wcet-over", "lat-p50-us", "lat-p99-us", "p99.9-us", "max-latency-us", "max-exec-us",
+                "mean-exec-us");
         result.forEach((run, comps) -> ((Map<String, Object>) comps).forEach((c, v) -> {
             Map<String, Object> s = (Map<String, Object>) v;
-            System.out.printf(Locale.ROOT, "%-14s %-15s %9s %9s %9s %14.1f %12.1f %12.1f%n", run, c, s.get("cycles"),
-                    s.get("overruns"), s.get("wcetOverruns"), us(s.get("maxLatencyNs")), us(s.get("maxExecNs")),
-                    us(s.get("meanExecNs")));
+            System.out.printf(Locale.ROOT, "%-14s %-15s %9s %9s %9s %10.1f %10.1f %10.1f %14.1f %12.1f %12.1f%n", run, c,
+                    s.get("cycles"), s.get("overruns"), s.get("wcetOverruns"), us(s.get("latencyP50Ns")),
+                    us(s.get("latencyP99Ns")), us(s.get("latencyP999Ns")), us(s.get("maxLatencyNs")),
+                    us(s.get("maxExecNs")), us(s.get("meanExecNs")));
         }));
     }
 

@@ -420,6 +420,141 @@ class WebConsoleIT {
                 () -> "ACTIVE".equals(instanceState("sample-counter")) && "ACTIVE".equals(instanceState("sample-scaler")));
     }
 
+    private static long pid(String name) {
+        Matcher m = Pattern.compile("\"name\":\"" + Pattern.quote(name) + "\",\"state\"[^{}]*?\"pid\":(\\d+)").matcher(cell());
+        return m.find() ? Long.parseLong(m.group(1)) : -1;
+    }
+
+    /** Waits until {@code attr} of the element is a number >= min; returns it. */
+    private static long awaitAtLeast(By by, String attr, long min) {
+        long[] seen = {Long.MIN_VALUE};
+        new WebDriverWait(browser, WAIT).until(d -> {
+            String v = d.findElement(by).getAttribute(attr);
+            if (v == null || v.isBlank()) {
+                return false;
+            }
+            seen[0] = Long.parseLong(v);
+            return seen[0] >= min;
+        });
+        return seen[0];
+    }
+
+    /** Waits until {@code attr} of the element differs from {@code old} (and is set); returns it. */
+    private static String awaitChange(By by, String attr, String old) {
+        String[] seen = {null};
+        new WebDriverWait(browser, WAIT).until(d -> {
+            seen[0] = d.findElement(by).getAttribute(attr);
+            return seen[0] != null && !seen[0].isBlank() && !seen[0].equals(old);
+        });
+        return seen[0];
+    }
+
+    @Test
+    @Order(11)
+    void aPortValuePlotShowsChangingValues() throws IOException {
+        // The counter's sine (arflex.Sample state port `count`), read by the DRCR from a read-only mapping.
+        String one = rt.get("/system/console/arflex-component/api/port?name=sample-counter&port=count", true).body();
+        assertTrue(one.contains("\"type\":\"arflex.Sample\"") && one.contains("\"name\":\"value\""), one);
+        assertEquals(404, rt.get("/system/console/arflex-component/api/port?name=sample-counter&port=nope", true).statusCode());
+        assertEquals(400, rt.get("/system/console/arflex-component/api/port?name=sample-counter&port=%3Cb%3E", true).statusCode());
+        long pid = pid("sample-counter");
+        open("arflex-component?name=sample-counter");
+        await(By.id("arflex-port-select"));
+        new WebDriverWait(browser, WAIT).until(d -> "value".equals(
+                new org.openqa.selenium.support.ui.Select(d.findElement(By.id("arflex-port-field"))).getFirstSelectedOption().getAttribute("value")));
+        new org.openqa.selenium.support.ui.Select(browser.findElement(By.id("arflex-port-select"))).selectByValue("count");
+        browser.findElement(By.id("arflex-port-plot-btn")).click();
+        By plot = By.id("arflex-port-plot");
+        awaitAtLeast(plot, "data-samples", 2);
+        String first = browser.findElement(plot).getAttribute("data-last");
+        String second = awaitChange(plot, "data-last", first);
+        String third = awaitChange(plot, "data-last", second);
+        assertFalse(first.equals(third) && first.equals(second), "the value changes: " + first + ", " + second + ", " + third);
+        new WebDriverWait(browser, WAIT).until(d -> !d.findElements(By.cssSelector("#arflex-port-plot canvas")).isEmpty());
+        awaitText(By.id("arflex-port-last"), "count.value = ");
+        browser.executeScript("arguments[0].scrollIntoView();", browser.findElement(By.id("arflex-ports-live")));
+        shot("13-component-port-plot");
+        assertEquals(pid, pid("sample-counter"), "watching a port does not disturb its producer");
+    }
+
+    @Test
+    @Order(12)
+    void theCellPresetPlotsTheErrorPortOrSaysWhyNot() throws IOException {
+        open("arflex-cell");
+        awaitText(By.id("arflex-tcp-error-none"), "tcp-correction");
+        // The same preset pointed at another Sample port (how another cell uses it): values drawn.
+        open("arflex-cell?error=sample-scaler.y");
+        By plot = By.id("arflex-tcp-error-plot");
+        awaitAtLeast(plot, "data-samples", 2);
+        awaitChange(plot, "data-last", browser.findElement(plot).getAttribute("data-last"));
+        awaitText(By.id("arflex-tcp-error-last"), "y = ");
+        assertTrue(browser.findElements(By.id("arflex-tcp-toggle")).isEmpty(), "no enable parameter, no toggle");
+        shot("14-cell-error-preset");
+    }
+
+    @Test
+    @Order(13)
+    void installTheDebugMonitorWatchAValueAndUninstallItWithTheOthersUndisturbed() throws IOException {
+        long counterPid = pid("sample-counter");
+        long scalerPid = pid("sample-scaler");
+        assertTrue(counterPid > 0 && scalerPid > 0, cell());
+        open("arflex-debug");
+        await(By.id("arflex-debug-jar"));
+        await(By.id("arflex-debug-none"));
+        new org.openqa.selenium.support.ui.Select(await(By.id("arflex-debug-target-0"))).selectByValue("sample-counter.count");
+        new org.openqa.selenium.support.ui.Select(browser.findElement(By.id("arflex-debug-target-1"))).selectByValue("sample-scaler.y");
+        browser.findElement(By.id("arflex-debug-plan")).click();
+        assertFalse(await(By.id("arflex-plan-text")).getText().isBlank(), "the plan is shown before confirming");
+        assertEquals(null, instanceState("debug-monitor"), "nothing installed before confirming");
+        shot("15-debug-plan");
+        browser.findElement(By.id("arflex-debug-confirm")).click();
+        RuntimeUnderTest.awaitCondition("debug-monitor Active", WAIT, () -> "ACTIVE".equals(instanceState("debug-monitor")));
+
+        // Watch: the monitor republishes the counter's value; the page shows it change.
+        By last = By.id("arflex-debug-m0-last");
+        long i0 = awaitAtLeast(last, "data-index", 0);
+        String v0 = browser.findElement(last).getAttribute("data-value");
+        awaitAtLeast(last, "data-index", i0 + 2);
+        awaitChange(last, "data-value", v0);
+        awaitAtLeast(By.id("arflex-debug-m1-last"), "data-index", 0);
+        awaitText(By.id("arflex-debug-m0-target"), "sample-counter.count");
+        awaitText(By.id("arflex-debug-m1-target"), "sample-scaler.y");
+        // A smaller window: applied by the monitor's RT half, then min/max/mean arrive.
+        WebElement win = browser.findElement(By.id("arflex-debug-window"));
+        win.clear();
+        win.sendKeys("5");
+        browser.findElement(By.id("arflex-debug-window-apply")).click();
+        awaitText(By.id("arflex-debug-status"), "window applied by the RT half: 5");
+        awaitAtLeast(By.id("arflex-debug-m0-mean"), "data-index", 0);
+        double min = Double.parseDouble(browser.findElement(By.id("arflex-debug-m0-min")).getAttribute("data-value"));
+        double max = Double.parseDouble(browser.findElement(By.id("arflex-debug-m0-max")).getAttribute("data-value"));
+        assertTrue(min <= max, min + " <= " + max);
+        new WebDriverWait(browser, WAIT).until(d -> Long.parseLong(d.findElement(By.id("arflex-debug-plot")).getAttribute("data-samples")) > 2);
+        shot("16-debug-watching");
+        assertEquals(counterPid, pid("sample-counter"), "the watched counter keeps running (same pid)");
+        assertEquals(scalerPid, pid("sample-scaler"), "the watched scaler keeps running (same pid)");
+
+        // Uninstall from the same page, after its plan.
+        browser.findElement(By.id("arflex-debug-uninstall")).click();
+        assertFalse(await(By.id("arflex-plan-text")).getText().isBlank());
+        browser.findElement(By.id("arflex-debug-confirm")).click();
+        RuntimeUnderTest.awaitCondition("debug-monitor gone", WAIT, () -> instanceState("debug-monitor") == null);
+        await(By.id("arflex-debug-none"));
+        shot("17-debug-uninstalled");
+        assertEquals("ACTIVE", instanceState("sample-counter"));
+        assertEquals("ACTIVE", instanceState("sample-scaler"));
+        assertEquals(counterPid, pid("sample-counter"), "the counter was not restarted");
+        assertEquals(scalerPid, pid("sample-scaler"), "the scaler was not restarted");
+        String prefix = "arflex." + runtimeId + ".debug-monitor.";
+        RuntimeUnderTest.awaitCondition("the monitor's segments removed", WAIT, () -> {
+            try (Stream<Path> st = Files.list(Path.of("/dev/shm"))) {
+                return st.noneMatch(p -> p.getFileName().toString().startsWith(prefix));
+            } catch (IOException e) {
+                throw new java.io.UncheckedIOException(e);
+            }
+        });
+    }
+
     private static String sha256(Path p) throws IOException {
         try {
             return HexFormat.of().formatHex(MessageDigest.getInstance("SHA-256").digest(Files.readAllBytes(p)));

@@ -27,6 +27,9 @@ import org.arflex.drcr.dto.CellDTO;
 import org.arflex.drcr.dto.ContractDTO;
 import org.arflex.drcr.dto.InstanceDTO;
 import org.arflex.drcr.dto.ParamDTO;
+import org.arflex.drcr.dto.PortDTO;
+import org.arflex.drcr.dto.PortFieldDTO;
+import org.arflex.drcr.dto.PortValueDTO;
 import org.arflex.drcr.dto.StatsDTO;
 import org.osgi.framework.Bundle;
 import org.osgi.framework.BundleContext;
@@ -47,6 +50,7 @@ import org.osgi.service.component.annotations.ReferencePolicy;
 @Component(service = Backend.class, immediate = true)
 public class Backend {
     private static final Pattern NAME = Pattern.compile("[A-Za-z0-9][A-Za-z0-9._-]{0,63}");
+    private static final Pattern PORT = Pattern.compile("[a-z0-9_]{1,31}");
     private static final int MAX_STAGED = 8;
 
     @Reference(cardinality = ReferenceCardinality.OPTIONAL, policy = ReferencePolicy.DYNAMIC)
@@ -78,7 +82,7 @@ public class Backend {
         String home = System.getenv("ARFLEX_HOME");
         this.contractsDir = configured != null ? Path.of(configured)
                 : home != null ? Path.of(home, "contracts") : dataDir.resolve("contracts");
-        this.sampler = new Sampler(this::sample);
+        this.sampler = new Sampler(this::sample, this::portSample);
         cleanStaging();
     }
 
@@ -211,6 +215,146 @@ public class Backend {
         m.put("p50Ns", s.latencyP50Ns);
         m.put("p99Ns", s.latencyP99Ns);
         m.put("p999Ns", s.latencyP999Ns);
+        return m;
+    }
+
+    // ---- port values ---------------------------------------------------------------------
+
+    /** Checks a port name as the ABI allows it ({@code [a-z0-9_]{1,31}}). */
+    static void checkPort(String port) throws HttpError {
+        if (port == null || !PORT.matcher(port).matches()) {
+            throw new HttpError(400, "port: '" + port + "' is not a port name (a-z, 0-9, _; up to 31)");
+        }
+    }
+
+    /** {@code p1,p2} to a list of checked port names (none when absent). */
+    static List<String> portList(String text) throws HttpError {
+        if (text == null || text.isBlank()) {
+            return List.of();
+        }
+        String[] parts = text.split(",");
+        if (parts.length > Sampler.MAX_PORTS) {
+            throw new HttpError(400, "ports: at most " + Sampler.MAX_PORTS + " ports per stream, got " + parts.length);
+        }
+        List<String> out = new ArrayList<>();
+        for (String p : parts) {
+            checkPort(p.trim());
+            out.add(p.trim());
+        }
+        return out;
+    }
+
+    private ComponentManagement requireManagement(String name) throws HttpError {
+        return management(name).orElseThrow(
+                () -> new HttpError(404, "component '" + name + "' has no management service (not installed?)"));
+    }
+
+    /** The newest value of an output port with the type's field names, units and element types. */
+    PortValueDTO portValue(String name, String port) throws HttpError {
+        checkName(name);
+        checkPort(port);
+        try {
+            return requireManagement(name).portValue(port);
+        } catch (IllegalArgumentException e) {
+            throw new HttpError(404, e.getMessage());
+        } catch (IllegalStateException e) {
+            throw new HttpError(409, e.getMessage());
+        }
+    }
+
+    /** A port value for the stream: index, stamps and the values per field (compact). */
+    Object portSample(String name, String port) {
+        Optional<ComponentManagement> cm = management(name);
+        if (cm.isEmpty()) {
+            return Map.of("error", "component '" + name + "' is gone");
+        }
+        PortValueDTO v = cm.get().portValue(port);
+        Map<String, Object> m = new LinkedHashMap<>();
+        m.put("index", v.index);
+        m.put("stampNs", v.stampNs);
+        m.put("published", v.published);
+        Map<String, double[]> f = new LinkedHashMap<>();
+        for (PortFieldDTO d : v.fields) {
+            f.put(d.name, d.values);
+        }
+        m.put("fields", f);
+        return m;
+    }
+
+    /** Every output port of every contract in the cell: component, port, type, method. */
+    Map<String, Object> watchablePorts() throws HttpError {
+        List<Map<String, Object>> out = new ArrayList<>();
+        CellDTO c = drcr().cell();
+        for (ContractDTO k : c.contracts == null ? new ContractDTO[0] : c.contracts) {
+            for (PortDTO p : k.ports == null ? new PortDTO[0] : k.ports) {
+                if ("OUT".equals(p.direction)) {
+                    Map<String, Object> m = new LinkedHashMap<>();
+                    m.put("component", k.name);
+                    m.put("port", p.name);
+                    m.put("type", p.type);
+                    m.put("typeVersion", p.typeVersion);
+                    m.put("method", p.method);
+                    out.add(m);
+                }
+            }
+        }
+        return Map.of("ports", out);
+    }
+
+    // ---- debug monitor -------------------------------------------------------------------
+
+    private Path debugJar() throws HttpError, IOException {
+        return DebugMonitor.locate(context.getProperty(DebugMonitor.JAR_PROPERTY));
+    }
+
+    /** Where the debug-monitor jar is (or why not), and the installed monitor, if any. */
+    Map<String, Object> debugStatus() throws HttpError, IOException {
+        Map<String, Object> m = new LinkedHashMap<>();
+        try {
+            m.put("jar", debugJar().toString());
+        } catch (HttpError e) {
+            m.put("jar", null);
+            m.put("jarProblem", e.getMessage());
+        }
+        Bundle installed = null;
+        for (Bundle b : context.getBundles()) {
+            if (DebugMonitor.SYMBOLIC_NAME.equals(b.getSymbolicName())) {
+                installed = b;
+            }
+        }
+        m.put("bundleId", installed == null ? null : installed.getBundleId());
+        DrcrService d = drcr();
+        m.put("component", DebugMonitor.COMPONENT);
+        m.put("instance", d.instance(DebugMonitor.COMPONENT).orElse(null));
+        m.put("contract", d.contract(DebugMonitor.COMPONENT).orElse(null));
+        return m;
+    }
+
+    /**
+     * Builds the debug-monitor bundle for {@code targets} ({@code comp.port,...}: state ports of
+     * type arflex.Sample 1.x in the cell), stages it and returns the DRCR's plan; installed by
+     * {@code install?id=} like any staged bundle.
+     */
+    Map<String, Object> debugStage(String targets) throws HttpError, IOException {
+        List<DebugMonitor.Target> ts = DebugMonitor.targets(targets);
+        DrcrService d = drcr();
+        for (DebugMonitor.Target t : ts) {
+            ContractDTO c = d.contract(t.component()).orElseThrow(() -> new HttpError(404,
+                    "targets: no component '" + t.component() + "' in the cell"));
+            PortDTO p = Stream.of(c.ports == null ? new PortDTO[0] : c.ports)
+                    .filter(x -> "OUT".equals(x.direction) && t.port().equals(x.name)).findFirst()
+                    .orElseThrow(() -> new HttpError(404, "targets: '" + t.component() + "' has no output port '"
+                            + t.port() + "'"));
+            if (!"arflex.Sample".equals(p.type) || !"STATE".equals(p.method) || !p.typeVersion.startsWith("1.")) {
+                throw new HttpError(400, "targets: " + t + " is " + p.type + " " + p.typeVersion + " " + p.method
+                        + "; the debug monitor watches state ports of type arflex.Sample 1.x only");
+            }
+        }
+        byte[] jar = DebugMonitor.build(debugJar(), ts, parser);
+        Map<String, Object> m = planStaged(Artifacts.upload(new java.io.ByteArrayInputStream(jar),
+                "debug-monitor for " + String.join(", ", ts.stream().map(DebugMonitor.Target::toString).toList()),
+                dataDir.resolve("staging")));
+        m.put("targets", ts.stream().map(DebugMonitor.Target::toString).toList());
         return m;
     }
 

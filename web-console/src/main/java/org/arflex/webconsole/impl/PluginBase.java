@@ -136,6 +136,9 @@ abstract class PluginBase extends AbstractServlet {
             case "contracts" -> Map.of("saved", b.savedContracts());
             case "contract" -> Map.of("name", name, "xml", b.loadContract(name));
             case "plan-uninstall" -> b.planUninstall(name);
+            case "port" -> b.portValue(name, req.getParameter("port"));
+            case "ports" -> b.watchablePorts();
+            case "debug" -> b.debugStatus();
             default -> throw new HttpError(404, "no endpoint /api/" + what);
         };
     }
@@ -159,6 +162,7 @@ abstract class PluginBase extends AbstractServlet {
             case "update" -> b.update(name);
             case "validate" -> Map.of("problems", b.validate(body(req), "editor.xml"));
             case "save" -> b.saveContract(name, body(req));
+            case "debug-stage" -> b.debugStage(req.getParameter("targets"));
             default -> throw new HttpError(404, "no endpoint /api/" + what);
         };
     }
@@ -173,11 +177,17 @@ abstract class PluginBase extends AbstractServlet {
         }
     }
 
-    /** Server-sent events: one frame per sampler period for the named component. */
+    /**
+     * Server-sent events: one frame per sampler period for the named component, with the
+     * values of the output ports listed in {@code ports} (comma separated, at most
+     * {@link Sampler#MAX_PORTS}).
+     */
     private void stream(HttpServletRequest req, HttpServletResponse resp) throws IOException {
         String name = req.getParameter("name");
+        Sampler.Key key;
         try {
             Backend.checkName(name);
+            key = new Sampler.Key(name, Backend.portList(req.getParameter("ports")));
         } catch (HttpError e) {
             send(resp, 400, Map.of("error", e.getMessage()));
             return;
@@ -189,7 +199,7 @@ abstract class PluginBase extends AbstractServlet {
         }
         Sampler s = backend().sampler;
         try {
-            s.subscribe(name);
+            s.subscribe(key);
         } catch (IllegalStateException e) {
             STREAMS.decrementAndGet();
             send(resp, 503, Map.of("error", e.getMessage()));
@@ -212,7 +222,7 @@ abstract class PluginBase extends AbstractServlet {
                     line = ": idle\n\n";
                 } else {
                     seq = f.seq();
-                    Object sample = f.byComponent().get(name);
+                    Object sample = f.byKey().get(key);
                     line = "data: " + backend().json.writeValueAsString(
                             sample == null ? Map.of("gone", true) : sample) + "\n\n";
                 }
@@ -224,7 +234,7 @@ abstract class PluginBase extends AbstractServlet {
         } catch (InterruptedException e) {
             Thread.currentThread().interrupt();
         } finally {
-            s.unsubscribe(name);
+            s.unsubscribe(key);
             STREAMS.decrementAndGet();
         }
     }

@@ -2,13 +2,20 @@ package org.arflex.webconsole.impl;
 
 import java.util.HashMap;
 import java.util.LinkedHashMap;
+import java.util.LinkedHashSet;
+import java.util.List;
 import java.util.Map;
+import java.util.Set;
+import java.util.function.BiFunction;
 import java.util.function.Function;
 
 /**
  * One sampler thread for all live streams, however many browsers watch: it reads the
- * statistics of the components somebody subscribed to at a fixed rate (10 Hz) and publishes
- * one frame; each stream waits for the next frame and writes it. The thread runs only while
+ * statistics of the components somebody subscribed to, and the values of the output ports
+ * somebody watches, at a fixed rate (10 Hz), each component and each port once per period
+ * whatever the number of streams that want it, and publishes one frame; each stream waits for
+ * the next frame and writes its part. A subscription is a {@link Key}: a component and the
+ * ports of it to watch (at most {@link #MAX_PORTS}). The thread runs only while
  * there are subscribers, so an idle console costs the runtime nothing. Readers never call into
  * the DRCR themselves, so the load on the runtime does not grow with the number of clients.
  */
@@ -16,23 +23,38 @@ final class Sampler {
     /** Sampling period. */
     static final long PERIOD_MS = 100;
 
-    /** One published frame: per component, a JSON-ready map. */
-    record Frame(long seq, Map<String, Map<String, Object>> byComponent) {
+    /** Most ports one stream may watch. */
+    static final int MAX_PORTS = 16;
+
+    /** What one stream watches: a component's statistics and some of its output ports. */
+    record Key(String component, List<String> ports) {
+        Key {
+            ports = List.copyOf(new LinkedHashSet<>(ports));
+        }
+    }
+
+    /** One published frame: per subscription, a JSON-ready map. */
+    record Frame(long seq, Map<Key, Map<String, Object>> byKey) {
     }
 
     private final Function<String, Map<String, Object>> reader;
-    private final Map<String, Integer> subscribers = new HashMap<>();
+    private final BiFunction<String, String, Object> portReader;
+    private final Map<Key, Integer> subscribers = new HashMap<>();
     private Frame latest = new Frame(0, Map.of());
     private Thread thread;
     private boolean closed;
 
-    /** {@code reader} returns a component's current sample, or null when it is gone. */
-    Sampler(Function<String, Map<String, Object>> reader) {
+    /**
+     * {@code reader} returns a component's current sample, or null when it is gone;
+     * {@code portReader} the current value of one of its output ports (a JSON-ready object).
+     */
+    Sampler(Function<String, Map<String, Object>> reader, BiFunction<String, String, Object> portReader) {
         this.reader = reader;
+        this.portReader = portReader;
     }
 
     /** Adds a subscriber of {@code name}; starts the thread if it is the first one. */
-    synchronized void subscribe(String name) {
+    synchronized void subscribe(Key name) {
         if (closed) {
             throw new IllegalStateException("console is stopping");
         }
@@ -45,7 +67,7 @@ final class Sampler {
     }
 
     /** Removes a subscriber; the thread ends when none is left. */
-    synchronized void unsubscribe(String name) {
+    synchronized void unsubscribe(Key name) {
         if (subscribers.merge(name, -1, Integer::sum) <= 0) {
             subscribers.remove(name);
         }
@@ -87,15 +109,24 @@ final class Sampler {
         long seq = 0;
         long next = System.nanoTime();
         while (true) {
-            String[] names;
+            Key[] keys;
             synchronized (this) {
                 if (closed || subscribers.isEmpty()) {
                     thread = null;
                     return;
                 }
-                names = subscribers.keySet().toArray(new String[0]);
+                keys = subscribers.keySet().toArray(new Key[0]);
             }
-            Map<String, Map<String, Object>> frame = new LinkedHashMap<>();
+            // Each component and each port once, however many subscriptions share it.
+            Set<String> names = new LinkedHashSet<>();
+            Set<List<String>> ports = new LinkedHashSet<>();
+            for (Key k : keys) {
+                names.add(k.component());
+                for (String p : k.ports()) {
+                    ports.add(List.of(k.component(), p));
+                }
+            }
+            Map<String, Map<String, Object>> samples = new HashMap<>();
             for (String n : names) {
                 Map<String, Object> sample;
                 try {
@@ -104,8 +135,38 @@ final class Sampler {
                     sample = Map.of("error", String.valueOf(e.getMessage()));
                 }
                 if (sample != null) {
-                    frame.put(n, sample);
+                    samples.put(n, sample);
                 }
+            }
+            Map<List<String>, Object> values = new HashMap<>();
+            for (List<String> cp : ports) {
+                if (!samples.containsKey(cp.get(0))) {
+                    continue;
+                }
+                Object v;
+                try {
+                    v = portReader.apply(cp.get(0), cp.get(1));
+                } catch (RuntimeException e) {
+                    v = Map.of("error", String.valueOf(e.getMessage()));
+                }
+                values.put(cp, v);
+            }
+            Map<Key, Map<String, Object>> frame = new LinkedHashMap<>();
+            for (Key k : keys) {
+                Map<String, Object> sample = samples.get(k.component());
+                if (sample == null) {
+                    continue;
+                }
+                if (!k.ports().isEmpty()) {
+                    Map<String, Object> withPorts = new LinkedHashMap<>(sample);
+                    Map<String, Object> pv = new LinkedHashMap<>();
+                    for (String p : k.ports()) {
+                        pv.put(p, values.get(List.of(k.component(), p)));
+                    }
+                    withPorts.put("ports", pv);
+                    sample = withPorts;
+                }
+                frame.put(k, sample);
             }
             synchronized (this) {
                 latest = new Frame(++seq, frame);
