@@ -98,6 +98,23 @@ def machine_info(cpu):
         v = platform.version()
         preempt = "PREEMPT_RT" if "PREEMPT_RT" in v else ("PREEMPT_DYNAMIC" if "PREEMPT_DYNAMIC" in v
                                                            else ("PREEMPT" if "PREEMPT" in v else "none"))
+    # The preemption model in force: PREEMPT_DYNAMIC kernels choose it at boot (preempt=) or
+    # through debugfs; "none" means a task in a long kernel section on the measured CPU delays
+    # the wake-up of any real-time task there until it returns or reschedules.
+    dynamic = None
+    try:
+        with open("/sys/kernel/debug/sched/preempt") as f:
+            m = re.search(r"\(([a-z]+)\)", f.read())
+            dynamic = m.group(1) if m else None
+    except OSError:
+        try:
+            out = subprocess.run(["dmesg"], capture_output=True, text=True, timeout=10).stdout
+            m = re.search(r"Dynamic Preempt: ([a-z]+)", out)
+            dynamic = m.group(1) if m else None
+        except (OSError, subprocess.SubprocessError):
+            pass
+    if preempt == "PREEMPT_DYNAMIC" and dynamic:
+        preempt = f"PREEMPT_DYNAMIC, mode {dynamic}"
     # only the boot options that bear on latency (the full line may carry unrelated settings)
     keys = ("isolcpus", "nohz", "nohz_full", "rcu_nocbs", "preempt", "threadirqs", "idle", "processor.max_cstate",
             "intel_idle.max_cstate", "cpuidle", "haltpoll", "mitigations", "irqaffinity", "skew_tick", "nosmt")
@@ -125,8 +142,9 @@ def machine_info(cpu):
 
 # ---- contenders ---------------------------------------------------------------------------------
 
-def patched_probe_jar(src, dst, cpu, priority):
-    """Copy of the probe bundle with the contract's timing set to the benchmark's CPU and priority."""
+def patched_probe_jar(src, dst, cpu, priority, exclusive):
+    """Copy of the probe bundle with the contract's timing set to the benchmark's CPU, priority
+    and CPU exclusivity (timing/@exclusive, contracts SPEC 8.6)."""
     name = "OSGI-INF/arflex/latency-probe.xml"
     with zipfile.ZipFile(src) as zin, zipfile.ZipFile(dst, "w", zipfile.ZIP_DEFLATED) as zout:
         names = zin.namelist()
@@ -138,34 +156,36 @@ def patched_probe_jar(src, dst, cpu, priority):
                 text = data.decode()
                 text, n1 = re.subn(r'priority="\d+"', f'priority="{priority}"', text)
                 text, n2 = re.subn(r'cpus="[^"]*"', f'cpus="{cpu}"', text)
-                if n1 != 1 or n2 != 1:
-                    raise BenchError(f"{src}: cannot set priority/cpus in {name}")
+                text = re.sub(r'\s+exclusive="[^"]*"', "", text)
+                text, n3 = re.subn(r'(<timing\b[^>]*?)\s*/>', r'\1 exclusive="%s"/>' % str(exclusive).lower(), text)
+                if n1 != 1 or n2 != 1 or n3 != 1:
+                    raise BenchError(f"{src}: cannot set priority/cpus/exclusive in {name}")
                 data = text.encode()
             zout.writestr(info, data)
 
 
 def cpu_times(cpu):
-    """(steal, irq+softirq, total) jiffies of one CPU from /proc/stat."""
+    """(steal, irq+softirq, total, busy = user+nice+system) jiffies of one CPU from /proc/stat."""
     try:
         with open("/proc/stat") as f:
             for line in f:
                 if line.startswith(f"cpu{cpu} "):
                     v = [int(x) for x in line.split()[1:]]
-                    return v[7] if len(v) > 7 else 0, v[5] + v[6], sum(v)
+                    return v[7] if len(v) > 7 else 0, v[5] + v[6], sum(v), v[0] + v[1] + v[2]
     except OSError:
         pass
-    return 0, 0, 0
+    return 0, 0, 0, 0
 
 
 def block(fn, cpu, *args):
     """Runs one contender's block and records the bench CPU's steal and interrupt time in it
     (hypervisor steal explains the multi-millisecond outliers on a VM)."""
-    s0, i0, t0 = cpu_times(cpu)
+    s0, i0, t0, b0 = cpu_times(cpu)
     w0 = time.monotonic()
     r = fn(*args)
-    s1, i1, t1 = cpu_times(cpu)
+    s1, i1, t1, b1 = cpu_times(cpu)
     r["cpu_time"] = {"seconds": round(time.monotonic() - w0, 2), "steal_jiffies": s1 - s0,
-                     "irq_jiffies": i1 - i0, "total_jiffies": t1 - t0}
+                     "irq_jiffies": i1 - i0, "total_jiffies": t1 - t0, "busy_jiffies": b1 - b0}
     return r
 
 
@@ -334,12 +354,12 @@ class Reconfiguration(threading.Thread):
     """Every 100 ms: poll the DTO (10 Hz) and install or uninstall a dummy component (so one
     reconfiguration every 100 ms); every second: Felix update of another installed bundle."""
 
-    def __init__(self, rt, dummy_jar, update_jar):
+    def __init__(self, rt, dummy_jar, update_jar, cpu):
         super().__init__(daemon=True, name="reconfiguration")
-        self.rt, self.dummy_jar, self.update_jar = rt, dummy_jar, update_jar
+        self.rt, self.dummy_jar, self.update_jar, self.cpu = rt, dummy_jar, update_jar, cpu
         self.halt = threading.Event()
         self.counts = {"ticks": 0, "late_ticks": 0, "dto_polls": 0, "installs": 0, "uninstalls": 0,
-                       "updates": 0, "errors": 0}
+                       "updates": 0, "errors": 0, "polls_with_other_on_measured_cpu": 0}
         self.first_error = None
         self.placements = {}
         self.dummy_id = None
@@ -356,10 +376,13 @@ class Reconfiguration(threading.Thread):
             try:
                 d = self.rt.dto()
                 self.counts["dto_polls"] += 1
+                shared = False
                 for i in d.get("instances", []):  # where the admission put the churned components
                     if i.get("name") != "latency-probe" and i.get("cpu") is not None:
                         key = f"{i.get('name')}@cpu{i.get('cpu')}"
                         self.placements[key] = self.placements.get(key, 0) + 1
+                        shared |= i.get("cpu") == self.cpu
+                self.counts["polls_with_other_on_measured_cpu"] += shared
                 if self.dummy_id is None:
                     self.dummy_id = self.rt.install(self.dummy_jar)
                     self.counts["installs"] += 1
@@ -456,7 +479,8 @@ def print_table(summary, modes, obs, dur):
 def print_cpu_time(summary, modes, cpu):
     hz = os.sysconf("SC_CLK_TCK") or 100
     print()
-    print(f"CPU {cpu} time stolen by the hypervisor / spent in interrupts during each long block (ms)")
+    print(f"CPU {cpu} during each contender's long blocks: time stolen by the hypervisor / in interrupts / "
+          f"busy running tasks (user+system, ms; the contender's own share is ~2 %)")
     for mode in modes:
         parts = []
         for c in CONTENDERS:
@@ -464,7 +488,8 @@ def print_cpu_time(summary, modes, cpu):
             if isinstance(ct, dict) and "long" in ct:
                 ct = ct["long"]
             if ct:
-                parts.append(f"{c}: {ct['steal_jiffies'] * 1000 // hz} / {ct['irq_jiffies'] * 1000 // hz}"
+                busy = f" / {ct['busy_jiffies'] * 1000 // hz}" if "busy_jiffies" in ct else ""
+                parts.append(f"{c}: {ct['steal_jiffies'] * 1000 // hz} / {ct['irq_jiffies'] * 1000 // hz}{busy}"
                              f" in {ct['seconds']:.0f} s")
         la = summary[mode].get("load_average_at_end")
         print(f"  {mode:<16}" + ";  ".join(parts) + (f"  (load average {la[0]:.1f})" if la else ""))
@@ -549,6 +574,16 @@ def main():
     ap.add_argument("--update-jar", default=os.path.join(ROOT, "bundles", "sample-scaler", "target",
                                                          "org.arflex.samples.scaler-0.1.0-SNAPSHOT.jar"))
     ap.add_argument("--rid", default=f"latb{os.getpid()}", help="runtime id (shm/mq names)")
+    ap.add_argument("--shared-cpu", action="store_true",
+                    help="do not keep the measured CPU apart (the configuration before CPU reservation): "
+                         "the probe's contract is not exclusive, the runtime reserves no CPU and the JVM "
+                         "is not pinned to the other CPU")
+    ap.add_argument("--keep-work", action="store_true",
+                    help="keep the work directory (raw samples, runtime log) after a successful run")
+    ap.add_argument("--runtime-cpus", default="others",
+                    help="CPU list the runtime's JVM (and the non-RT threads of the RT halves it spawns) "
+                         "may run on: 'others' (default: every CPU but --cpu), 'all', or a list for "
+                         "taskset -c; ignored with --shared-cpu")
     a = ap.parse_args()
     if a.quick:
         a.duration = 5
@@ -590,7 +625,16 @@ def main():
     jars = os.path.join(work, "jars")
     os.makedirs(jars)
     probe_jar = os.path.join(jars, "latency-probe.jar")
-    patched_probe_jar(a.probe_jar, probe_jar, a.cpu, a.priority)
+    isolate = not a.shared_cpu and cpu_other is not None
+    if not isolate or a.runtime_cpus == "all":
+        jvm_cpus = None
+    elif a.runtime_cpus == "others":
+        jvm_cpus = ",".join(str(c) for c in range(ncpu) if c != a.cpu)
+    elif re.fullmatch(r"[0-9]+(-[0-9]+)?(,[0-9]+(-[0-9]+)?)*", a.runtime_cpus):
+        jvm_cpus = a.runtime_cpus
+    else:
+        ap.error(f"--runtime-cpus '{a.runtime_cpus}': others, all or a CPU list such as 0 or 0,2-3")
+    patched_probe_jar(a.probe_jar, probe_jar, a.cpu, a.priority, isolate)
     dummy_jar = shutil.copy(a.dummy_jar, os.path.join(jars, "dummy.jar"))
     update_jar = shutil.copy(a.update_jar, os.path.join(jars, "update.jar"))
 
@@ -599,7 +643,14 @@ def main():
     results, reconf_counts = {}, {}
     try:
         log(f"starting the runtime (id {a.rid}) from {a.runtime_dir}")
-        rt = Runtime(a.runtime_dir, work, a.rid, os.path.join(work, "runtime.log"))
+        # Kept apart (default): admission gives the measured CPU only to contracts naming it
+        # (arflex.cpus.reserved) and the probe holds it exclusively; the JVM, and with it the
+        # non-RT threads of every RT half it spawns, runs on the other CPU.
+        rt = Runtime(a.runtime_dir, work, a.rid, os.path.join(work, "runtime.log"),
+                     # arflex.cpus given: the DRCR's default is the JVM's own affinity
+                     props={"arflex.cpus": ",".join(str(c) for c in range(ncpu)),
+                            "arflex.cpus.reserved": str(a.cpu)} if isolate else None,
+                     cpus=jvm_cpus)
         for mode in modes:
             log(f"mode {mode}: {a.duration} s per contender, CPU {a.cpu}, SCHED_FIFO {a.priority}")
             load = reconf = None
@@ -611,7 +662,7 @@ def main():
                 stress_log.close()
                 time.sleep(2)
             elif mode == "reconfiguration":
-                reconf = Reconfiguration(rt, dummy_jar, update_jar)
+                reconf = Reconfiguration(rt, dummy_jar, update_jar, a.cpu)
                 reconf_t0 = time.monotonic()
                 reconf.start()
                 time.sleep(2)
@@ -681,6 +732,11 @@ def main():
            "machine": info, "seed": a.seed,
            "options": {"cpu": a.cpu, "priority": a.priority, "period_ns": PERIOD_NS, "duration_s": a.duration,
                        "observations": a.observations, "rounds": rounds, "modes": modes, "quick": a.quick, "runtime_id": a.rid,
+                       "measured_cpu_kept_apart": isolate,
+                       "isolation": ({"probe_contract": f'timing cpus="{a.cpu}" exclusive="true"',
+                                      "runtime": f"arflex.cpus.reserved={a.cpu}",
+                                      "jvm_affinity": f"taskset -c {jvm_cpus}" if jvm_cpus else "all cpus"}
+                                     if isolate else None),
                        "native_dir": a.native_dir, "runtime_dir": a.runtime_dir,
                        "stress_ng": stress_args("T", a.seed, "<work>") if "stress" in modes else None,
                        "schedule": "interleaved per mode in rounds; round r runs the contenders in the order "
@@ -698,7 +754,10 @@ def main():
            "histograms": {m: {"bin_ns": HIST_BIN_NS, "nbins": HIST_NBINS} for m in modes}}
     with open(os.path.join(a.out, "latency.json"), "w") as f:
         json.dump(doc, f, indent=1)
-    shutil.rmtree(work, ignore_errors=True)
+    if a.keep_work:
+        log(f"work files kept in {work} (--keep-work: runtime.log, raw samples)")
+    else:
+        shutil.rmtree(work, ignore_errors=True)
     print(f"\nwrote {os.path.join(a.out, 'latency.json')} and latency-<mode>.svg ({doc['elapsed_s']} s); "
           f"kernel {info['kernel']} ({info['preemption']}), {info['cpu_model']}")
 

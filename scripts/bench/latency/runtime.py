@@ -22,14 +22,17 @@ class RuntimeError_(Exception):
 
 
 class Runtime:
-    def __init__(self, assembly, workdir, rid, log_path, props=None):
+    def __init__(self, assembly, workdir, rid, log_path, props=None, cpus=None):
+        """cpus: CPU list for `taskset -c` (the JVM and, by inheritance, the RT halves' non-RT
+        threads run there; the RT threads set their own affinity from the admission)."""
         if not os.path.isfile(os.path.join(assembly, "bin", "felix.jar")):
             raise RuntimeError_(f"runtime assembly not found at {assembly} (build it: mvn -B -q -DskipTests install)")
         self.rid = rid
         self.dir = os.path.join(workdir, "runtime")
         shutil.rmtree(self.dir, ignore_errors=True)
         shutil.copytree(assembly, self.dir)
-        args = ["java", f"-Darflex.runtime.id={rid}", "-Dorg.osgi.service.http.port=0"]
+        args = (["taskset", "-c", str(cpus)] if cpus is not None else []) + [
+            "java", f"-Darflex.runtime.id={rid}", "-Dorg.osgi.service.http.port=0"]
         for k, v in (props or {}).items():
             args.append(f"-D{k}={v}")
         args += ["-jar", "bin/felix.jar"]

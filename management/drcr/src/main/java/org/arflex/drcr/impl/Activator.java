@@ -37,8 +37,9 @@ import org.osgi.util.tracker.BundleTracker;
  * undoes all of it and leaves no process or shared object behind.
  *
  * <p>Framework properties: {@code arflex.runtime.id} (default {@code rt<pid>}),
- * {@code arflex.cpus} (default all), {@code arflex.cpu.cap} (utilisation cap per CPU, default
- * 1.0), {@code arflex.memory} (default 1g), {@code arflex.network} (default 125m B/s),
+ * {@code arflex.cpus} (default all), {@code arflex.cpus.reserved} (CPUs admission gives only
+ * to components naming them in {@code timing/@cpus}; default none), {@code arflex.cpu.cap}
+ * (utilisation cap per CPU, default 1.0), {@code arflex.memory} (default 1g), {@code arflex.network} (default 125m B/s),
  * {@code arflex.ready.timeout.ms} (default 5000), {@code arflex.nomlock} (true: RT halves skip
  * mlockall, for tests with many instances).
  */
@@ -89,6 +90,11 @@ public final class Activator implements BundleActivator {
         PortTypes types = PortTypes.builtin();
         double cap = Double.parseDouble(prop(ctx, "arflex.cpu.cap", "1.0"));
         List<Integer> cpus = prop(ctx, "arflex.cpus", "").isEmpty() ? allCpus() : Commands.parseCpus(prop(ctx, "arflex.cpus", ""));
+        java.util.Set<Integer> reserved = prop(ctx, "arflex.cpus.reserved", "").isEmpty() ? java.util.Set.of()
+                : new java.util.TreeSet<>(Commands.parseCpus(prop(ctx, "arflex.cpus.reserved", "")));
+        if (!cpus.containsAll(reserved)) {
+            throw new IllegalArgumentException("arflex.cpus.reserved " + reserved + " is not within arflex.cpus " + cpus);
+        }
         long memory = Commands.parseSize(prop(ctx, "arflex.memory", "1g"));
         long network = Commands.parseSize(prop(ctx, "arflex.network", "125000000"));
         actor = new ThreadActor(log);
@@ -98,10 +104,10 @@ public final class Activator implements BundleActivator {
         // The cell is built on the actor so that the planner is only ever touched there.
         ResourceManagerImpl[] rm = new ResourceManagerImpl[1];
         cell = actor.call(() -> {
-            ResourceManagerImpl tmp = new ResourceManagerImpl(null, cap);
+            ResourceManagerImpl tmp = new ResourceManagerImpl(null, cap, reserved);
             Planner planner = new Planner(tmp.capacities(cpus, memory, network));
             Cell c = new Cell(cfg, actor, new ProcessLauncher(log), planner, log);
-            rm[0] = new ResourceManagerImpl(c, cap);
+            rm[0] = new ResourceManagerImpl(c, cap, reserved);
             return c;
         }, 10_000);
         ContractReader reader = new ContractReader(types);

@@ -17,18 +17,28 @@ public final class ResourceManagerImpl implements ResourceManager {
 
     private final Cell cell;
     private final double utilisationCap;
+    private final java.util.Set<Integer> reservedCpus;
     private volatile long wcetOverruns;
 
     public ResourceManagerImpl(Cell cell, double utilisationCap) {
+        this(cell, utilisationCap, java.util.Set.of());
+    }
+
+    /**
+     * @param reservedCpus CPUs that admission gives only to components naming them in
+     *                     {@code timing/@cpus} (framework property {@code arflex.cpus.reserved})
+     */
+    public ResourceManagerImpl(Cell cell, double utilisationCap, java.util.Set<Integer> reservedCpus) {
         this.cell = cell;
         this.utilisationCap = utilisationCap;
+        this.reservedCpus = java.util.Set.copyOf(reservedCpus);
     }
 
     /** Capacities from values (actor thread or before start). */
     public Capacities capacities(List<Integer> cpus, long memory, long network) {
         List<Capacities.Cpu> list = new ArrayList<>();
         for (int c : cpus) {
-            list.add(new Capacities.Cpu(c, utilisationCap));
+            list.add(new Capacities.Cpu(c, utilisationCap, reservedCpus.contains(c)));
         }
         return new Capacities(list, memory, network);
     }
