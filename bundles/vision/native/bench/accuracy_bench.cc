@@ -67,6 +67,8 @@ struct Args {
   bool position_only = true;
   int only = -1;       // run only this target (debugging)
   bool trace = false;  // print every measurement of the loop
+  bool diag = false;   // print per camera / per tag corner errors (board and tool)
+  bool no_loop = false;  // diagnostics only: no correction loop (error "on" not measured)
 };
 
 Eigen::Vector3d V(const arflex::sim::Vec3& v) { return Eigen::Vector3d(v[0], v[1], v[2]); }
@@ -160,7 +162,7 @@ struct RunResult {
   // Diagnostics at the uncorrected pose: the same detections with the TRUE camera poses
   // (detection-limited error), ideal corners with the calibrated cameras
   // (calibration-limited error), and the detected corners' distance to the true projections.
-  Stats vision_err_true_cams, vision_err_ideal_corners, corner_err_px;
+  Stats vision_err_true_cams, vision_err_ideal_corners, corner_err_px, board_corner_err_px;
   Stats detect_roi_ms, detect_full_ms, render_ms, estimate_ms, latency_ms, roi_fraction;
   double calib_trans_mm_max = 0, calib_rot_mdeg_max = 0, calib_rms_px_max = 0;
   long frames = 0, estimates = 0, invalid = 0;
@@ -230,11 +232,25 @@ vision::PoseEstimate Bench::Measure(bool use_roi, RunResult* r, bool diagnose) {
         if (!renderer_->TagCorners(tool_[obs[i].tag].id, &truth)) continue;
         vision::Observation& o = ideal[nideal++];
         o = obs[i];
+        double e2 = 0, emax = 0;
         for (int k = 0; k < 4; ++k) {
           double u, v;
           renderer_->Project(c, truth[k], &u, &v);
           o.px[k] = Eigen::Vector2d(u, v);
-          r->corner_err_px.Add((obs[i].px[k] - o.px[k]).norm());
+          const double e = (obs[i].px[k] - o.px[k]).norm();
+          r->corner_err_px.Add(e);
+          e2 += e * e;
+          emax = std::max(emax, e);
+        }
+        if (args_.diag) {
+          const Eigen::Vector3d centre = 0.25 * (truth[0] + truth[1] + truth[2] + truth[3]);
+          const Eigen::Vector3d normal = (truth[1] - truth[0]).cross(truth[3] - truth[0]).normalized();
+          const Eigen::Vector3d eye = renderer_->CameraPose(c).translation();
+          const double angle = std::acos(std::abs(normal.dot((eye - centre).normalized()))) * 180 / M_PI;
+          double side = 0;
+          for (int k = 0; k < 4; ++k) side += 0.25 * (o.px[(k + 1) % 4] - o.px[k]).norm();
+          std::printf("    cam %d tag %2d: side %5.1f px, view %4.1f deg, corner error rms %.3f px, max %.3f px, edge scatter %.3f px\n",
+                      c, tool_[obs[i].tag].id, side, angle, std::sqrt(e2 / 4), emax, obs[i].edge_scatter_px);
         }
       }
     }
@@ -255,6 +271,16 @@ vision::PoseEstimate Bench::Measure(bool use_roi, RunResult* r, bool diagnose) {
     };
     r->vision_err_true_cams.Add(err(true_cameras_, obs.data(), nobs));
     r->vision_err_ideal_corners.Add(err(cameras_, ideal.data(), nideal));
+    if (args_.diag) {
+      const Eigen::Vector3d t = est.pose.translation() - truth;
+      std::printf("    estimate: error %.4f mm (x %.4f y %.4f z %.4f), reported sigma %.4f mm, rms %.3f px, "
+                  "%d tags %d views; true cameras %.4f mm; ideal corners %.4f mm; ideal corners + true "
+                  "cameras %.4f mm\n",
+                  1e3 * t.norm(), 1e3 * t.x(), 1e3 * t.y(), 1e3 * t.z(),
+                  1e3 * std::sqrt(est.covariance.topLeftCorner<3, 3>().trace()), est.rms_px, est.n_tags,
+                  est.n_views, err(true_cameras_, obs.data(), nobs), err(cameras_, ideal.data(), nideal),
+                  err(true_cameras_, ideal.data(), nideal));
+    }
   }
   ++r->estimates;
   if (!est.valid) ++r->invalid;
@@ -333,6 +359,29 @@ bool Bench::Run(const std::string& name, double payload, const std::vector<int>&
     }
     const Eigen::Isometry3d truth = renderer_->CameraPose(c);
     const Eigen::Isometry3d d = truth.inverse() * cameras_[c].world_from_camera;
+    for (int i = 0; i < n; ++i) {
+      std::array<Eigen::Vector3d, 4> corners;
+      if (!renderer_->TagCorners(dets[i].id, &corners)) continue;
+      double e2 = 0, emax = 0;
+      for (int k = 0; k < 4; ++k) {
+        double u, v;
+        renderer_->Project(c, corners[k], &u, &v);
+        const double e = std::hypot(dets[i].corners[k][0] - u, dets[i].corners[k][1] - v);
+        r->board_corner_err_px.Add(e);
+        e2 += e * e;
+        emax = std::max(emax, e);
+      }
+      if (args_.diag) {
+        std::printf("  calib cam %d board tag %d: corner error rms %.3f px, max %.3f px\n", c, dets[i].id,
+                    std::sqrt(e2 / 4), emax);
+      }
+    }
+    if (args_.diag) {
+      std::printf("  calib cam %d: %d board tags, rms %.3f px, translation error %.3f mm, rotation error %.2f mdeg\n",
+                  c, n, cameras_[c].calibration_rms_px,
+                  1e3 * (truth.translation() - cameras_[c].world_from_camera.translation()).norm(),
+                  1e3 * Eigen::AngleAxisd(d.linear()).angle() * 180 / M_PI);
+    }
     r->calib_trans_mm_max = std::max(r->calib_trans_mm_max,
                                      1e3 * (truth.translation() - cameras_[c].world_from_camera.translation()).norm());
     r->calib_rot_mdeg_max = std::max(r->calib_rot_mdeg_max,
@@ -385,16 +434,43 @@ bool Bench::Run(const std::string& name, double payload, const std::vector<int>&
       cell_->SetJointReference(ref);
       cell_->Step(1);
     }
-    auto settle = [this]() {
-      for (int k = 0; k < 3000; k += 10) {
+    auto settle = [this, i]() {
+      int k = 0;
+      double v = 0;
+      for (; k < 20000; k += 10) {
         cell_->Step(10);
         const auto js = cell_->ReadJointState();
-        double v = 0;
+        v = 0;
         for (double x : js.dq) v = std::max(v, std::abs(x));
         if (k >= 300 && v < 1e-6) break;
       }
+      if (args_.diag) std::printf("  pose %d: settle %d steps, max |dq| %.2e\n", i, k, v);
     };
     settle();
+    if (args_.diag) {
+      // Is the arm static? TCP motion over one and over ten servo steps after settling.
+      const Eigen::Vector3d a = cell_->TrueTcp().translation();
+      cell_->Step(1);
+      const Eigen::Vector3d b = cell_->TrueTcp().translation();
+      cell_->Step(10);
+      const Eigen::Vector3d c = cell_->TrueTcp().translation();
+      double v = 0;
+      for (double x : cell_->ReadJointState().dq) v = std::max(v, std::abs(x));
+      std::printf("  pose %d settled: TCP moved %.4f mm in 1 step, %.4f mm in 10 steps; max |dq| %.2e rad/s\n",
+                  i, 1e3 * (b - a).norm(), 1e3 * (c - b).norm(), v);
+      const auto js = cell_->ReadJointState();
+      std::printf("    q_cmd");
+      for (int j = 0; j < 6; ++j) std::printf(" %+.4f", q_cmd[j]);
+      std::printf("\n    q    ");
+      for (int j = 0; j < 6; ++j) std::printf(" %+.4f", js.q[j]);
+      std::printf("\n    dq   ");
+      for (int j = 0; j < 6; ++j) std::printf(" %+.4f", js.dq[j]);
+      std::printf("\n    tau  ");
+      for (int j = 0; j < 6; ++j) std::printf(" %+.1f", js.tau[j]);
+      std::printf("\n    limits");
+      for (int j = 0; j < 6; ++j) std::printf(" [%+.2f %+.2f]", cell_->config().arm.links[j].lower, cell_->config().arm.links[j].upper);
+      std::printf("\n");
+    }
     const Eigen::Isometry3d true_off = cell_->TrueTcp();
     PoseRow row{};
     row.index = i;
@@ -414,7 +490,10 @@ bool Bench::Run(const std::string& name, double payload, const std::vector<int>&
     int quiet = 0;
     const int max_iterations = 30;
     int it = 0;
-    for (; it < max_iterations; ++it) {
+    if (args_.diag) {
+      std::printf("  pose %d: cold estimate %s, vision error %.4f mm\n", i, cold.reason, row.vision_err_mm);
+    }
+    for (; it < (args_.no_loop ? 0 : max_iterations); ++it) {
       const vision::PoseEstimate est = Measure(true, r, false);
       if (args_.trace) {
         const Eigen::Vector3d t = cell_->TrueTcp().translation();
@@ -497,10 +576,12 @@ void PrintRun(const RunResult& r, bool per_pose) {
               r.vision_err.Mean(), r.vision_err.Max(), r.estimates, r.invalid);
   std::printf("diagnosis at the uncorrected poses: vision error with the TRUE camera poses %.4f mm "
               "(max %.4f); with ideal corners and the calibrated cameras %.4f mm (max %.4f); "
-              "detected corner to true projection %.3f px mean, %.3f px max\n",
+              "detected corner to true projection %.3f px mean, %.3f px max (board at calibration: "
+              "%.3f px mean, %.3f px max)\n",
               r.vision_err_true_cams.Mean(), r.vision_err_true_cams.Max(),
               r.vision_err_ideal_corners.Mean(), r.vision_err_ideal_corners.Max(),
-              r.corner_err_px.Mean(), r.corner_err_px.Max());
+              r.corner_err_px.Mean(), r.corner_err_px.Max(), r.board_corner_err_px.Mean(),
+              r.board_corner_err_px.Max());
   std::printf("per camera: render %.1f ms (%.1f fps), detect full frame %.1f ms (%.1f fps), "
               "detect ROI %.1f ms (%.1f fps, ROI %.1f %% of the frame)\n",
               r.render_ms.Mean(), 1e3 / r.render_ms.Mean(), r.detect_full_ms.Mean(),
@@ -585,6 +666,14 @@ bool ParseArgs(int argc, char** argv, Args* a) {
     }
     if (k == "--trace") {
       a->trace = true;
+      continue;
+    }
+    if (k == "--diag") {
+      a->diag = true;
+      continue;
+    }
+    if (k == "--no-loop") {
+      a->no_loop = true;
       continue;
     }
     if (k == "--json" || k == "--width" || k == "--height" || k == "--poses" || k == "--noise" ||

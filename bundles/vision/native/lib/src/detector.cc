@@ -23,55 +23,113 @@ bool Sample(const uint8_t* buf, int w, int h, int stride, double x, double y, do
   return true;
 }
 
+// Distance of point p from the line through a and b.
+double LineDistance(const double* a, const double* b, const double* p) {
+  const double dx = b[0] - a[0], dy = b[1] - a[1];
+  const double len = std::sqrt(dx * dx + dy * dy);
+  return len > 0 ? std::abs((p[0] - a[0]) * dy - (p[1] - a[1]) * dx) / len : 0.0;
+}
+
 // Refines the four corners `c` (region pixel coordinates, counter-clockwise) by fitting a line
-// to each side of the border. Returns false (corners unchanged) if a side has too few edge
-// points.
-bool RefineCorners(const uint8_t* buf, int w, int h, int stride, double c[4][2]) {
+// to each side of the black border and intersecting neighbouring lines. Every pixel along a
+// side gives one edge point: the centroid of the grey-level gradient magnitude on a profile
+// across the edge. The profile stays within half a module of the edge on both sides (the
+// border and the white ring around it are one module wide; the module width ACROSS the edge
+// is measured from the opposite side, so it shrinks with foreshortening), and it is re-centred
+// on the fitted line and measured again (a truncated window that is not centred on a
+// symmetric edge pulls the centroid towards its own centre). Writes the RMS distance of the
+// edge points from their lines (largest of the four sides) to `*scatter_px`: the local
+// consistency of the edge, large where the border is too thin in the image to be resolved.
+// Returns false (corners unchanged) if a side has too few edge points.
+bool RefineCorners(const uint8_t* buf, int w, int h, int stride, double c[4][2],
+                   double* scatter_px) {
   double line[4][3];  // a x + b y = d, (a, b) unit normal
+  double reach[4];
   for (int e = 0; e < 4; ++e) {
     const double* p0 = c[e];
     const double* p1 = c[(e + 1) % 4];
     const double dx = p1[0] - p0[0], dy = p1[1] - p0[1];
     const double len = std::sqrt(dx * dx + dy * dy);
     if (len < 12.0) return false;
-    const double ux = dx / len, uy = dy / len;
-    const double nx = -uy, ny = ux;
-    // The black border is one module (1/8 of the side) wide: stay within it.
-    const double reach = std::min(3.0, 0.4 * len / 8.0);
-    const double step = 0.25;
-    double sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
-    int n = 0;
-    for (double t = 0.12 * len; t <= 0.88 * len; t += 1.0) {
-      const double bx = p0[0] + ux * t, by = p0[1] + uy * t;
-      double wsum = 0, ssum = 0, prev = 0;
-      bool ok = Sample(buf, w, h, stride, bx - nx * reach, by - ny * reach, &prev);
-      for (double s = -reach + step; ok && s <= reach + 1e-9; s += step) {
-        double v;
-        ok = Sample(buf, w, h, stride, bx + nx * s, by + ny * s, &v);
-        const double g = std::abs(v - prev);
-        wsum += g;
-        ssum += g * (s - 0.5 * step);
-        prev = v;
+    // Module width across this side: the tag's extent perpendicular to it over 8 modules.
+    const double across = std::min(LineDistance(p0, p1, c[(e + 2) % 4]),
+                                   LineDistance(p0, p1, c[(e + 3) % 4]));
+    reach[e] = std::min(3.0, 0.5 * across / 8.0);
+    if (reach[e] < 0.5) return false;  // border under a pixel wide: nothing to refine with
+    const double nx = -dy / len, ny = dx / len;
+    line[e][0] = nx;
+    line[e][1] = ny;
+    line[e][2] = nx * p0[0] + ny * p0[1];
+  }
+  double worst_scatter = 0.0;
+  const double step = 0.25;
+  for (int pass = 0; pass < 3; ++pass) {
+    double next[4][3];
+    for (int e = 0; e < 4; ++e) {
+      // The side's extent: between its corners (intersections with the neighbouring lines).
+      double ends[2][2];
+      for (int k = 0; k < 2; ++k) {
+        const double* l0 = line[(e + 3 + k) % 4];
+        const double* l1 = line[(e + k) % 4];
+        const double det = l0[0] * l1[1] - l0[1] * l1[0];
+        if (std::abs(det) < 1e-6) return false;
+        ends[k][0] = (l0[2] * l1[1] - l0[1] * l1[2]) / det;
+        ends[k][1] = (l0[0] * l1[2] - l0[2] * l1[0]) / det;
       }
-      if (!ok || wsum < 20.0) continue;  // outside the image or no edge here
-      const double off = ssum / wsum;
-      const double x = bx + nx * off, y = by + ny * off;
-      sx += x;
-      sy += y;
-      sxx += x * x;
-      syy += y * y;
-      sxy += x * y;
-      ++n;
+      const double nx = line[e][0], ny = line[e][1];
+      const double dx = ends[1][0] - ends[0][0], dy = ends[1][1] - ends[0][1];
+      const double len = std::sqrt(dx * dx + dy * dy);
+      if (len < 12.0) return false;
+      const double ux = dx / len, uy = dy / len;
+      const double r = reach[e];
+      double sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
+      int n = 0;
+      for (double t = 0.12 * len; t <= 0.88 * len; t += 1.0) {
+        // The point on the current line at parameter t.
+        const double bx = ends[0][0] + ux * t, by = ends[0][1] + uy * t;
+        const double off0 = line[e][2] - (nx * bx + ny * by);  // ~0: bx, by is on the line
+        double wsum = 0, ssum = 0, prev = 0;
+        bool ok = Sample(buf, w, h, stride, bx + nx * (off0 - r), by + ny * (off0 - r), &prev);
+        for (double s = -r + step; ok && s <= r + 1e-9; s += step) {
+          double v;
+          ok = Sample(buf, w, h, stride, bx + nx * (off0 + s), by + ny * (off0 + s), &v);
+          const double g = std::abs(v - prev);
+          wsum += g;
+          ssum += g * (s - 0.5 * step);
+          prev = v;
+        }
+        if (!ok || wsum < 20.0) continue;  // outside the image or no edge here
+        const double off = off0 + ssum / wsum;
+        const double x = bx + nx * off, y = by + ny * off;
+        sx += x;
+        sy += y;
+        sxx += x * x;
+        syy += y * y;
+        sxy += x * y;
+        ++n;
+      }
+      if (n < 6) return false;
+      const double mx = sx / n, my = sy / n;
+      const double cxx = sxx / n - mx * mx, cyy = syy / n - my * my, cxy = sxy / n - mx * my;
+      // Line direction = principal axis of the edge points; normal = the other axis, oriented
+      // as the current normal.
+      const double theta = 0.5 * std::atan2(2 * cxy, cxx - cyy);
+      double a = -std::sin(theta), b = std::cos(theta);
+      if (a * nx + b * ny < 0) {
+        a = -a;
+        b = -b;
+      }
+      next[e][0] = a;
+      next[e][1] = b;
+      next[e][2] = a * mx + b * my;
+      // Variance across the line: the smaller eigenvalue of the scatter matrix.
+      const double tr = cxx + cyy, dif = cxx - cyy;
+      const double minor = 0.5 * (tr - std::sqrt(dif * dif + 4 * cxy * cxy));
+      if (pass == 2) worst_scatter = std::max(worst_scatter, std::sqrt(std::max(0.0, minor)));
     }
-    if (n < 6) return false;
-    const double mx = sx / n, my = sy / n;
-    const double cxx = sxx / n - mx * mx, cyy = syy / n - my * my, cxy = sxy / n - mx * my;
-    // Line direction = principal axis of the edge points; normal = the other axis.
-    const double theta = 0.5 * std::atan2(2 * cxy, cxx - cyy);
-    const double a = -std::sin(theta), b = std::cos(theta);
-    line[e][0] = a;
-    line[e][1] = b;
-    line[e][2] = a * mx + b * my;
+    for (int e = 0; e < 4; ++e) {
+      for (int k = 0; k < 3; ++k) line[e][k] = next[e][k];
+    }
   }
   double out[4][2];
   for (int k = 0; k < 4; ++k) {
@@ -89,6 +147,7 @@ bool RefineCorners(const uint8_t* buf, int w, int h, int stride, double c[4][2])
     c[k][0] = out[k][0];
     c[k][1] = out[k][1];
   }
+  *scatter_px = worst_scatter;
   return true;
 }
 
@@ -199,7 +258,11 @@ int TagDetector::DetectRegion(const FrameView& frame, const Roi& roi, TagDetecti
       c[k][0] = d->p[k][0] - 0.5;
       c[k][1] = d->p[k][1] - 0.5;
     }
-    if (options_.refine_corners) RefineCorners(buf, roi.width(), roi.height(), stride, c);
+    t.refined = false;
+    t.edge_scatter_px = 0.0;
+    if (options_.refine_corners) {
+      t.refined = RefineCorners(buf, roi.width(), roi.height(), stride, c, &t.edge_scatter_px);
+    }
     for (int k = 0; k < 4; ++k) {
       t.corners[k][0] = c[k][0] + roi.x0;
       t.corners[k][1] = c[k][1] + roi.y0;

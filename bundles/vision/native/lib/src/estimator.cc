@@ -178,6 +178,7 @@ void CollectObservations(int camera, const TagDetection* dets, int ndets,
       o.camera = camera;
       o.tag = static_cast<int>(t);
       for (int c = 0; c < 4; ++c) o.px[c] = Eigen::Vector2d(dets[d].corners[c][0], dets[d].corners[c][1]);
+      o.edge_scatter_px = dets[d].edge_scatter_px;
       break;
     }
   }

@@ -34,6 +34,11 @@ struct TagDetection {
   float decision_margin = 0.0f;
   std::array<std::array<double, 2>, 4> corners{};
   std::array<double, 2> center{};
+  // Whether the corner re-fit succeeded (otherwise the corners are AprilTag's own), and the
+  // RMS distance of the re-fit's edge points from their fitted side (the worst side, px): a
+  // measure of how well the border is resolved (large for tags seen very obliquely).
+  bool refined = false;
+  double edge_scatter_px = 0.0;
 };
 
 struct DetectorOptions {

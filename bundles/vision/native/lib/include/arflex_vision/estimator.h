@@ -39,6 +39,8 @@ struct Observation {
   int camera = -1;
   int tag = -1;
   std::array<Eigen::Vector2d, 4> px;
+  // The detector's edge scatter for this tag (TagDetection::edge_scatter_px; 0 if unknown).
+  double edge_scatter_px = 0.0;
 };
 
 struct EstimatorOptions {
