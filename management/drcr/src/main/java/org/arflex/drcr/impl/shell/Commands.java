@@ -13,6 +13,8 @@ import org.arflex.drcr.dto.BindingDTO;
 import org.arflex.drcr.dto.CellDTO;
 import org.arflex.drcr.dto.InstanceDTO;
 import org.arflex.drcr.dto.ParamDTO;
+import org.arflex.drcr.dto.PortFieldDTO;
+import org.arflex.drcr.dto.PortValueDTO;
 import org.arflex.drcr.dto.ResourcesDTO;
 import org.arflex.drcr.dto.StatsDTO;
 
@@ -27,7 +29,7 @@ public final class Commands {
     /** Service property values for the Gogo registration. */
     public static final String SCOPE = "arflex";
     public static final String[] FUNCTIONS = {"list", "info", "bindings", "get", "set", "plan", "update",
-        "resources", "stats", "reset", "dto"};
+        "resources", "stats", "port", "reset", "dto"};
 
     private final DrcrService drcr;
     private final ResourceManager resources;
@@ -220,6 +222,28 @@ public final class Commands {
                     + s.latencyP99Ns + " ns, p99.9 " + s.latencyP999Ns + " ns (" + s.latencyCount + " samples, "
                     + s.latencyHistOverflow + " >= " + s.histBinNs * 2000 / 1000 + " us); exec p50 " + s.execP50Ns
                     + " ns, p99 " + s.execP99Ns + " ns, p99.9 " + s.execP999Ns + " ns");
+        });
+    }
+
+    /** The newest value of an output port (read-only peek), one line per field. */
+    public String port(String name, String port) {
+        return guard(() -> {
+            PortValueDTO v = cm(name).portValue(port);
+            String head = name + "." + port + " (" + v.type + " " + v.typeVersion + ", " + v.method.toLowerCase(java.util.Locale.ROOT)
+                    + ")";
+            if (v.index < 0) {
+                return head + ": nothing published yet";
+            }
+            StringBuilder sb = new StringBuilder(head + ": element " + v.index + ", " + v.published + " published");
+            for (PortFieldDTO f : v.fields) {
+                sb.append("\n  ").append(f.name).append(" = ");
+                for (int i = 0; i < f.values.length; i++) {
+                    sb.append(i == 0 ? "" : ", ").append(f.scalar.startsWith("f") ? Double.toString(f.values[i])
+                            : Long.toString((long) f.values[i]));
+                }
+                sb.append(f.truncated ? ", ... (" + f.count + ")" : "").append(f.unit.isEmpty() ? "" : " " + f.unit);
+            }
+            return sb.toString();
         });
     }
 

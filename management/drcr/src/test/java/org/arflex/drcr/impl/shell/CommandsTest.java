@@ -168,7 +168,29 @@ class CommandsTest {
 
         @Override
         public org.arflex.drcr.dto.PortValueDTO portValue(String port) {
-            throw new IllegalArgumentException("component 'cons' has no output port '" + port + "'");
+            if (!port.equals("y")) {
+                throw new IllegalArgumentException("component 'cons' has no output port '" + port + "'");
+            }
+            org.arflex.drcr.dto.PortValueDTO v = new org.arflex.drcr.dto.PortValueDTO();
+            v.type = "arflex.Sample";
+            v.typeVersion = "1.0";
+            v.method = "STATE";
+            v.index = 41;
+            v.published = 42;
+            org.arflex.drcr.dto.PortFieldDTO seq = new org.arflex.drcr.dto.PortFieldDTO();
+            seq.name = "seq";
+            seq.unit = "";
+            seq.scalar = "u64";
+            seq.count = 1;
+            seq.values = new double[] {42};
+            org.arflex.drcr.dto.PortFieldDTO val = new org.arflex.drcr.dto.PortFieldDTO();
+            val.name = "value";
+            val.unit = "mm";
+            val.scalar = "f64";
+            val.count = 1;
+            val.values = new double[] {-0.25};
+            v.fields = new org.arflex.drcr.dto.PortFieldDTO[] {seq, val};
+            return v;
         }
 
         @Override
@@ -208,6 +230,14 @@ class CommandsTest {
         assertEquals("error: no component 'nope'", cmd.get("nope", "gain"));
         assertEquals("error: cons: SHA-256 mismatch", cmd.update("cons"));
         assertEquals("cons: no RT half running", cmd.stats("cons"));
+    }
+
+    @Test
+    void portPrintsTheDecodedFieldsOrNamesTheMissingPort() {
+        assertEquals("cons.y (arflex.Sample 1.0, state): element 41, 42 published\n  seq = 42\n  value = -0.25 mm",
+                cmd.port("cons", "y"));
+        assertEquals("error: component 'cons' has no output port 'z'", cmd.port("cons", "z"));
+        assertEquals("error: no component 'nope'", cmd.port("nope", "y"));
     }
 
     @Test
