@@ -9,9 +9,11 @@
 // (arflex.JointRef). Recording: a preallocated buffer of kMaxPoints joint waypoints, a new one
 // whenever the reference moved more than record_step (rad, any joint) from the last one. The
 // file is written by a non-RT writer thread woken with sem_post (async-signal-safe, never
-// blocks) to $ARFLEX_DATA_DIR/program-<save_slot>.arp, atomically (temporary file + rename).
+// blocks) to <data dir>/program-<save_slot>.arp (cellkin::DataDir(): $ARFLEX_DATA_DIR, else
+// ./data, created 0700 if missing), atomically (temporary file + rename).
 #include <pthread.h>
 #include <semaphore.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <atomic>
@@ -80,6 +82,13 @@ void* Writer(void*) {
     if (n > 0) {
       p.has_start = true;
       p.start = g.points[0];
+      // First a joint motion to the first point: a replay that begins where the arm is (its
+      // measured position, e.g. where teaching ended) goes there before it follows the path.
+      arflex::cellkin::Motion m0{};
+      m0.kind = arflex::cellkin::Motion::kPtp;
+      for (int j = 0; j < 6; ++j) m0.v[j] = g.points[0][j];
+      m0.speed = 1.0;
+      p.motions.push_back(m0);
     }
     for (size_t i = 1; i < n; ++i) {
       arflex::cellkin::Motion m{};
@@ -90,8 +99,8 @@ void* Writer(void*) {
       p.motions.push_back(m);
     }
     std::string err;
-    if (g.dir.empty()) {
-      fprintf(stderr, "teach: cannot save: ARFLEX_DATA_DIR is not set\n");
+    if (mkdir(g.dir.c_str(), 0700) != 0 && errno != EEXIST) {
+      fprintf(stderr, "teach: cannot save: data directory %s: %s\n", g.dir.c_str(), strerror(errno));
       g.save_errors++;
     } else if (n < 2) {
       fprintf(stderr, "teach: nothing to save (%zu waypoint(s) recorded)\n", n);
@@ -139,10 +148,7 @@ int Configure(struct arflex_component* c, void*) {
       return -ENOENT;
     }
   }
-  const char* dir = getenv("ARFLEX_DATA_DIR");
-  g.dir = dir ? dir : "";
-  if (g.dir.empty())
-    fprintf(stderr, "teach: ARFLEX_DATA_DIR is not set: teaching works, saving will fail\n");
+  g.dir = arflex::cellkin::DataDir();
   g.points = new (std::nothrow) Q[kMaxPoints];
   if (!g.points) return -ENOMEM;
   if (sem_init(&g.sem, 0, 0) != 0) {

@@ -3,7 +3,9 @@
 //
 // Ports: out joint_ref (arflex.JointRef, state); in safety (arflex.SafetyState, optional),
 // in joint_state (arflex.JointState, optional: the first reference starts at the measured
-// position). Parameters: see the contract (src/main/resources/OSGI-INF/arflex/trajectory.xml).
+// position), in tool (arflex.ToolState, optional: lin motions move the mounted tool's centre
+// point, the flange when none is mounted); out tool_id (arflex.Sample: the id of the tool lin
+// motions are planned for, 0 = the flange). Parameters: see the contract (src/main/resources/OSGI-INF/arflex/trajectory.xml).
 //
 // Threads: configure loads every program (main thread, file I/O); start/update/safe/stop run
 // on the RT thread and only read the loaded programs: no allocation, I/O or printing there.
@@ -20,6 +22,8 @@
 #include "arflex_types/joint_ref.h"
 #include "arflex_types/joint_state.h"
 #include "arflex_types/safety_state.h"
+#include "arflex_types/sample.h"
+#include "arflex_types/tool_state.h"
 #include "cellkin.h"
 #include "trajectory_plan.h"
 
@@ -54,12 +58,17 @@ struct State {
   struct arflex_port* out = nullptr;
   struct arflex_input* in_safety = nullptr;
   struct arflex_input* in_state = nullptr;
+  struct arflex_input* in_tool = nullptr;
+  struct arflex_port* out_tool = nullptr;
+  struct arflex_tool_state tool{};
+  bool tool_seen = false;
   int p_program = -1, p_run, p_loop, p_profile, p_speed, p_accel, p_accel_max, p_lin_speed,
       p_lin_accel, p_stop_time;
   traj::Player player;
   struct arflex_safety_state safety{};
   bool safety_seen = false;
   uint64_t seq = 0;
+  uint64_t tool_seq = 0;
 } g;
 
 int Param(struct arflex_component* c, const char* name, int* idx) {
@@ -80,8 +89,17 @@ int Configure(struct arflex_component* c, void*) {
     fprintf(stderr, "trajectory: output joint_ref: %s\n", strerror(-r));
     return r;
   }
+  static const struct arflex_port_type tool_t = {ARFLEX_TYPE_TOOL_STATE_NAME, 1, 0,
+                                                 sizeof(struct arflex_tool_state)};
+  static const struct arflex_port_type sample_t = {ARFLEX_TYPE_SAMPLE_NAME, 1, 0,
+                                                   sizeof(struct arflex_sample)};
+  if ((r = arflex_component_output(c, "tool_id", ARFLEX_PORT_STATE, &sample_t, &g.out_tool)) < 0) {
+    fprintf(stderr, "trajectory: output tool_id: %s\n", strerror(-r));
+    return r;
+  }
   if ((r = arflex_component_input(c, "safety", ARFLEX_PORT_STATE, &safety_t, &g.in_safety)) < 0 ||
-      (r = arflex_component_input(c, "joint_state", ARFLEX_PORT_STATE, &state_t, &g.in_state)) < 0)
+      (r = arflex_component_input(c, "joint_state", ARFLEX_PORT_STATE, &state_t, &g.in_state)) < 0 ||
+      (r = arflex_component_input(c, "tool", ARFLEX_PORT_STATE, &tool_t, &g.in_tool)) < 0)
     return r;
   if (Param(c, "program", &g.p_program) < 0 || Param(c, "run", &g.p_run) < 0 ||
       Param(c, "loop", &g.p_loop) < 0 || Param(c, "profile", &g.p_profile) < 0 ||
@@ -97,24 +115,22 @@ int Configure(struct arflex_component* c, void*) {
     fprintf(stderr, "trajectory: %s\n", err.c_str());
     return -EINVAL;
   }
-  const char* dir = getenv("ARFLEX_DATA_DIR");
+  const std::string dir = arflex::cellkin::DataDir();
   int loaded = 1;
-  if (dir && *dir) {
-    for (int n = 1; n < kMaxPrograms; ++n) {
-      const std::string path = arflex::cellkin::ProgramPath(dir, n);
-      FILE* f = fopen(path.c_str(), "r");
-      if (!f) continue;
-      fclose(f);
-      if (!arflex::cellkin::LoadProgramFile(path, g.model, &g.programs[n], &err)) {
-        fprintf(stderr, "trajectory: bad program file: %s\n", err.c_str());
-        return -EINVAL;
-      }
-      ++loaded;
+  for (int n = 1; n < kMaxPrograms; ++n) {
+    const std::string path = arflex::cellkin::ProgramPath(dir, n);
+    FILE* f = fopen(path.c_str(), "r");
+    if (!f) continue;
+    fclose(f);
+    if (!arflex::cellkin::LoadProgramFile(path, g.model, &g.programs[n], &err)) {
+      fprintf(stderr, "trajectory: bad program file: %s\n", err.c_str());
+      return -EINVAL;
     }
+    ++loaded;
   }
   const int64_t sel = arflex_param_i64(c, g.p_program);
   fprintf(stderr, "trajectory: %d program(s) loaded (data dir %s); program %lld %s\n", loaded,
-          dir && *dir ? dir : "unset", (long long)sel,
+          dir.c_str(), (long long)sel,
           sel >= 0 && sel < kMaxPrograms && !g.programs[sel].motions.empty() ? "present"
                                                                             : "NOT present");
   return 0;
@@ -138,10 +154,45 @@ int Start(struct arflex_component* c, void*) {
   const struct arflex_ctl* ctl = arflex_component_ctl(c);
   g.player.Begin(&g.model, &g.programs[n], ctl->config.period_ns * 1e-9);
   g.safety_seen = false;
+  g.tool_seen = false;
   return 0;
 }
 
+// The mounted tool: its TCP for the lin motions that begin from now on. No tool component
+// bound, none written yet, or one that reports no tool (id 0, STATUS_NONE, a non-finite or
+// non-unit TCP) is the flange. Returns the id of the tool in use (0 = the flange).
+uint32_t TrackTool() {
+  struct arflex_tool_state t;
+  if (!arflex_input_bound(g.in_tool)) {
+    g.tool_seen = false;
+  } else if (arflex_input_state_read(g.in_tool, &t, sizeof(t), nullptr) == 1) {
+    g.tool = t;
+    g.tool_seen = true;
+  }
+  Eigen::Isometry3d tcp = Eigen::Isometry3d::Identity();
+  uint32_t id = 0;
+  if (g.tool_seen && g.tool.tool_id != 0 && g.tool.status != ARFLEX_TOOL_STATE_STATUS_NONE) {
+    const Eigen::Vector3d p(g.tool.tcp_p[0], g.tool.tcp_p[1], g.tool.tcp_p[2]);
+    const Eigen::Quaterniond r(g.tool.tcp_quat[0], g.tool.tcp_quat[1], g.tool.tcp_quat[2],
+                               g.tool.tcp_quat[3]);
+    if (p.allFinite() && r.coeffs().allFinite() && std::fabs(r.norm() - 1.0) < 1e-3 &&
+        p.norm() < 2.0) {
+      tcp.translation() = p;
+      tcp.linear() = r.normalized().toRotationMatrix();
+      id = g.tool.tool_id;
+    }
+  }
+  g.player.SetTool(tcp);
+  return id;
+}
+
 int Step(struct arflex_component* c, uint64_t release_ns, bool force_stop) {
+  struct arflex_sample tool_id;
+  tool_id.seq = ++g.tool_seq;
+  tool_id.t_ns = (int64_t)release_ns;
+  tool_id.value = (double)TrackTool();
+  int r = arflex_state_write(g.out_tool, &tool_id, sizeof(tool_id));
+  if (r < 0) return r;
   if (!g.player.initialized()) {
     struct arflex_joint_state js;
     Q q0 = g.player.program()->has_start ? g.player.program()->start : Q::Zero();

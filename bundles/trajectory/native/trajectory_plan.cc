@@ -183,7 +183,8 @@ bool Player::StartSegment(const Limits& lim) {
       }
       shape_ = PlanShape(lim.profile, rv, ra);
     } else if (m.kind == cellkin::Motion::kLin) {
-      const Eigen::Isometry3d t = model_->Tcp(q_plan_);
+      tool_ = tool_next_;  // this motion's tool, kept to its end
+      const Eigen::Isometry3d t = model_->TcpOf(q_plan_, tool_);
       p0_ = t.translation();
       r0_ = Eigen::Quaterniond(t.linear());
       p1_ = Eigen::Vector3d(m.v[0], m.v[1], m.v[2]);
@@ -237,7 +238,7 @@ void Player::Evaluate() {
     t.translation() = p0_ + s * (p1_ - p0_);
     t.linear() = r0_.slerp(s, r1_).toRotationMatrix();
     Q q = ik_q_;
-    const double err = model_->Ik(t, &q, 4);
+    const double err = model_->IkTool(t, tool_, &q, 4);
     if (err > 1e-6 || !q.allFinite()) {
       ++ik_warnings_;
       if (!q.allFinite()) q = ik_q_;

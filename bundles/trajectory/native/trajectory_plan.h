@@ -68,6 +68,13 @@ class Player {
   // Selects the program; keeps the current reference (the robot is where it was).
   void Begin(const cellkin::Model* model, const cellkin::Program* program, double dt);
   void Init(const Q& q0);  // first reference
+  // The tool whose centre point lin motions move (TCP frame in the flange frame; Identity =
+  // the flange). Default: the nominal model's tool. A lin motion takes the tool that is set
+  // when it begins and keeps it to its end, so a tool change during a motion never makes the
+  // reference jump: it applies from the next lin motion. ptp and via motions do not use it.
+  void SetTool(const Eigen::Isometry3d& flange_to_tcp) { tool_next_ = flange_to_tcp; }
+  // The tool of the current (or last) lin motion.
+  const Eigen::Isometry3d& lin_tool() const { return tool_; }
   bool initialized() const { return initialized_; }
   // One period: ramps the time rate towards target_rate (0 = hold, 1 = full speed), advances
   // the program, runs the limiter.
@@ -108,6 +115,8 @@ class Player {
   Eigen::Vector3d p0_ = Eigen::Vector3d::Zero(), p1_ = Eigen::Vector3d::Zero();  // lin
   Eigen::Quaterniond r0_ = Eigen::Quaterniond::Identity(), r1_ = Eigen::Quaterniond::Identity();
   Q ik_q_ = Q::Zero();
+  Eigen::Isometry3d tool_next_ = cellkin::Model().NominalTool();
+  Eigen::Isometry3d tool_ = tool_next_;
   bool path_ = false;
   size_t run_begin_ = 0, run_n_ = 0;  // motions [run_begin_, run_begin_ + run_n_) ; last = ptp
   double path_len_ = 0, cursor_sigma_ = 0;

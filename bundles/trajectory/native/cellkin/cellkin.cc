@@ -37,16 +37,38 @@ Eigen::Isometry3d Model::Tcp(const Q& q) const { return kin_.Tcp(ToArray(q)); }
 Eigen::Isometry3d Model::Flange(const Q& q) const { return kin_.Flange(ToArray(q)); }
 sim::Jacobian6 Model::Jacobian(const Q& q) const { return kin_.TcpJacobian(ToArray(q)); }
 
-double Model::Ik(const Eigen::Isometry3d& target, Q* q, int iters) const {
+Eigen::Isometry3d Model::NominalTool() const {
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.translation() = V3(arm_.tcp_offset);
+  return t;
+}
+
+Eigen::Isometry3d Model::TcpOf(const Q& q, const Eigen::Isometry3d& tool) const {
+  return Flange(q) * tool;
+}
+
+sim::Jacobian6 Model::JacobianOf(const Q& q, const Eigen::Isometry3d& tool) const {
+  // The nominal TCP Jacobian moved to another point of the same body: the angular rows stay,
+  // the linear velocity of a point p is v_tcp + w x (p - p_tcp).
+  sim::Jacobian6 j = Jacobian(q);
+  const Eigen::Vector3d d = TcpOf(q, tool).translation() - Tcp(q).translation();
+  Eigen::Matrix3d skew;
+  skew << 0, -d.z(), d.y(), d.z(), 0, -d.x(), -d.y(), d.x(), 0;
+  j.topRows<3>() -= skew * j.bottomRows<3>();
+  return j;
+}
+
+double Model::IkTool(const Eigen::Isometry3d& target, const Eigen::Isometry3d& tool, Q* q,
+                     int iters) const {
   double err = 0;
   for (int it = 0; it <= iters; ++it) {
-    const Eigen::Isometry3d t = Tcp(*q);
+    const Eigen::Isometry3d t = TcpOf(*q, tool);
     Eigen::Matrix<double, 6, 1> e;
     e.head<3>() = target.translation() - t.translation();
     e.tail<3>() = RotError(target.linear(), t.linear());
     err = e.head<3>().norm() + e.tail<3>().norm();
     if (it == iters || err < 1e-12) break;
-    const sim::Jacobian6 j = Jacobian(*q);
+    const sim::Jacobian6 j = JacobianOf(*q, tool);
     // Damped least squares: dq = J^T (J J^T + l^2 I)^-1 e; the damping only matters near
     // singularities (l = 1e-3).
     Eigen::Matrix<double, 6, 6> a = j * j.transpose();
@@ -55,6 +77,10 @@ double Model::Ik(const Eigen::Isometry3d& target, Q* q, int iters) const {
     *q += dq;
   }
   return err;
+}
+
+double Model::Ik(const Eigen::Isometry3d& target, Q* q, int iters) const {
+  return IkTool(target, NominalTool(), q, iters);
 }
 
 Q Model::GravityTorque(const Q& q, double payload_kg) const {
@@ -313,6 +339,11 @@ bool WriteProgramFile(const std::string& path, const Program& p, std::string* er
     return false;
   }
   return true;
+}
+
+std::string DataDir() {
+  const char* d = getenv("ARFLEX_DATA_DIR");
+  return d && *d ? std::string(d) : std::string("data");
 }
 
 std::string ProgramPath(const std::string& dir, long n) {

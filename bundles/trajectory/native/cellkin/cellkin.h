@@ -39,6 +39,17 @@ class Model {
   // Returns the remaining error: position error (m) + rotation error (rad). Never allocates.
   double Ik(const Eigen::Isometry3d& target, Q* q, int iters) const;
 
+  // The same for any tool: `tool` is the tool centre point frame in the flange frame (from an
+  // arflex.ToolState: tcp_p, tcp_quat; Identity = the flange itself). TcpOf is the TCP pose,
+  // JacobianOf its geometric Jacobian (world: linear velocity of the TCP point, angular).
+  Eigen::Isometry3d TcpOf(const Q& q, const Eigen::Isometry3d& tool) const;
+  sim::Jacobian6 JacobianOf(const Q& q, const Eigen::Isometry3d& tool) const;
+  double IkTool(const Eigen::Isometry3d& target, const Eigen::Isometry3d& tool, Q* q,
+                int iters) const;
+  // The nominal model's own tool (tcp_offset, orientation of the flange): TcpOf(q,
+  // NominalTool()) equals Tcp(q).
+  Eigen::Isometry3d NominalTool() const;
+
   // Joint torques (N m) the drives must deliver to hold the arm still at q: link masses,
   // the tool (sim::ArmParams::tool_mass at tool_com) and a payload of `payload_kg` at
   // payload_com. Same sign convention as the measured drive torques of arflex.JointState.
@@ -106,6 +117,10 @@ bool LoadProgramFile(const std::string& path, const Model& model, Program* out,
 // Writes `p` to `path` atomically (temporary file in the same directory, fsync, rename),
 // mode 0600. Returns true or false with *err.
 bool WriteProgramFile(const std::string& path, const Program& p, std::string* err);
+// Where program files live: $ARFLEX_DATA_DIR when set and not empty, else "data", relative to
+// the working directory (an RT half started by the DRCR runs in the runtime's directory, so
+// that is <runtime>/data).
+std::string DataDir();
 // "<dir>/program-<n>.arp"
 std::string ProgramPath(const std::string& dir, long n);
 

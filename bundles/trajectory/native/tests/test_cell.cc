@@ -241,7 +241,7 @@ void CaseTrajectory() {
   bool ok = WriteText(arflex::cellkin::ProgramPath(dir, 1), prog);
   std::string env = "ARFLEX_DATA_DIR=" + dir;
   char* envp[] = {const_cast<char*>(env.c_str()), nullptr};
-  int r = ok ? Make(&traj, "trajectory", kMs, {{"joint_ref", kRefT}}, TrajectoryParams(),
+  int r = ok ? Make(&traj, "trajectory", kMs, {{"joint_ref", kRefT}, {"tool_id", kSampleT}}, TrajectoryParams(),
                     "trajectory", envp)
              : -EIO;
   RemoveDir(dir);  // loaded at configure: the process does not need the file any more
@@ -391,7 +391,7 @@ void CaseForceGuard() {
   // A slower guard period (20 ms) lets the test see each of its outputs.
   r = Make(&guard, "guard", 20 * kMs, {{"safety", kST}}, GuardParams(), "force-guard");
   CHECK(r == 0, "guard: %d", r);
-  r = Make(&traj, "trajectory", kMs, {{"joint_ref", kRefT}}, TrajectoryParams(), "trajectory");
+  r = Make(&traj, "trajectory", kMs, {{"joint_ref", kRefT}, {"tool_id", kSampleT}}, TrajectoryParams(), "trajectory");
   CHECK(r == 0, "trajectory: %d", r);
   CHECK(SetI(&traj, "loop", 1) == 0, "loop");
   Q q;
@@ -615,7 +615,7 @@ void CaseTeachReplay() {
     worst_rec = std::max(worst_rec, best);
   }
   // Replay: trajectory with the saved program, no joint_state bound: starts at `start`.
-  r = Make(&traj, "trajectory", kMs, {{"joint_ref", kRefT}}, TrajectoryParams(), "trajectory", envp);
+  r = Make(&traj, "trajectory", kMs, {{"joint_ref", kRefT}, {"tool_id", kSampleT}}, TrajectoryParams(), "trajectory", envp);
   RemoveDir(dir);
   CHECK(worst_rec < 1e-4, "a waypoint is %.5f rad from the taught path", worst_rec);
   CHECK(r == 0, "trajectory: %d", r);
@@ -717,14 +717,14 @@ void CaseBadProgram() {
   char* envp[] = {const_cast<char*>(env.c_str()), nullptr};
   bool ok = WriteText(arflex::cellkin::ProgramPath(dir, 2),
                       "arflex-program 1\nptp 0 0 0 0 0 0\nptp 0 0 0 0 0 7\n");
-  int r = ok ? Make(&bad, "bad", kMs, {{"joint_ref", kRefT}}, TrajectoryParams(), "trajectory", envp)
+  int r = ok ? Make(&bad, "bad", kMs, {{"joint_ref", kRefT}, {"tool_id", kSampleT}}, TrajectoryParams(), "trajectory", envp)
              : -EIO;
   RemoveDir(dir);
   CHECK(r == -ECHILD, "a bad program file was accepted (%d)", r);
   const int st = arflex_host_exit_status(&bad);
   CHECK(WIFEXITED(st) && WEXITSTATUS(st) == ARFLEX_EXIT_CONFIGURE, "exit status 0x%x", st);
   // No data dir: only program 0; START of program 5 is refused, program 0 starts.
-  r = Make(&good, "good", kMs, {{"joint_ref", kRefT}}, TrajectoryParams(), "trajectory");
+  r = Make(&good, "good", kMs, {{"joint_ref", kRefT}, {"tool_id", kSampleT}}, TrajectoryParams(), "trajectory");
   CHECK(r == 0, "spawn: %d", r);
   CHECK(SetI(&good, "program", 5) == 0, "set program 5");
   r = arflex_host_start(&good, kCall);

@@ -369,9 +369,89 @@ static void TestBuiltin() {
          (unsigned long long)st.cycles, (unsigned long long)pl.limited_cycles(), st.max_a);
 }
 
+// Tool-aware kinematics and lin motions: TcpOf with the nominal tool equals Tcp; IkTool
+// converges for a 0.35 m tool and for the flange; a lin motion planned for a tool moves that
+// tool's centre point on the straight line; a tool change in the middle of a lin motion does
+// not change that motion (it applies from the next one), so the reference never jumps.
+static void TestTool() {
+  Model m;
+  Q q;
+  q << 0.3, 0.2, 0.5, -0.4, 0.7, 0.1;
+  CHECK((m.TcpOf(q, m.NominalTool()).matrix() - m.Tcp(q).matrix()).cwiseAbs().maxCoeff() < 1e-12,
+        "TcpOf(nominal) != Tcp");
+  Eigen::Isometry3d spindle = Eigen::Isometry3d::Identity();
+  spindle.translation() = Eigen::Vector3d(0.35, 0, 0);
+  for (const Eigen::Isometry3d& tool : {spindle, Eigen::Isometry3d(Eigen::Isometry3d::Identity())}) {
+    // Jacobian against finite differences of the TCP position
+    const arflex::sim::Jacobian6 j = m.JacobianOf(q, tool);
+    for (int k = 0; k < 6; ++k) {
+      Q a = q, b = q;
+      a[k] += 1e-7;
+      b[k] -= 1e-7;
+      const Eigen::Vector3d fd = (m.TcpOf(a, tool).translation() - m.TcpOf(b, tool).translation()) / 2e-7;
+      CHECK((fd - j.col(k).head<3>()).norm() < 1e-5, "JacobianOf column %d off by %g", k,
+            (fd - j.col(k).head<3>()).norm());
+    }
+    const Eigen::Isometry3d target = m.TcpOf(q, tool);
+    Q q2 = q + Q::Constant(0.05);
+    const double err = m.IkTool(target, tool, &q2, 20);
+    CHECK(err < 1e-9, "IkTool error %g", err);
+  }
+  // A lin motion for the spindle: its TCP (not the nominal one) ends on the target and stays
+  // on the line; the tool set mid-motion (flange) changes nothing until the next motion.
+  Program p;
+  std::string err;
+  const char* text =
+      "arflex-program 1\nstart 0 0.2 0.5 0 0.6 0\n"
+      "lin 2.0 0.3 1.2 0.70710678 0 0.70710678 0 speed 0.4\n"
+      "lin 2.0 -0.3 1.2 0.70710678 0 0.70710678 0 speed 0.4\n";
+  CHECK(arflex::cellkin::ParseProgram(text, "tool", m, &p, &err), "%s", err.c_str());
+  traj::Limits lim = traj::DefaultLimits();
+  traj::Player pl;
+  pl.Begin(&m, &p, 0.001);
+  pl.Init(p.start);
+  pl.SetTool(spindle);
+  const Eigen::Vector3d a(2.0, 0.3, 1.2), b(2.0, -0.3, 1.2);
+  const Eigen::Vector3d s0 = m.TcpOf(p.start, spindle).translation();
+  double off_line = 0, max_dq = 0;
+  Q prev = pl.q_out();
+  bool switched = false, at_a = false;
+  int cycles = 0;
+  while (!pl.done() && cycles < 100000) {
+    pl.Step(lim, 1.0, false);
+    ++cycles;
+    max_dq = std::max(max_dq, (pl.q_out() - prev).cwiseAbs().maxCoeff());
+    prev = pl.q_out();
+    if (pl.index() == 0) {  // first lin, planned for the spindle: its TCP on s0 -> a
+      const Eigen::Vector3d x = m.TcpOf(pl.q_plan(), spindle).translation();
+      const Eigen::Vector3d d = (a - s0).normalized();
+      off_line = std::max(off_line, ((x - s0) - d.dot(x - s0) * d).norm());
+      if (cycles == 500) {
+        pl.SetTool(Eigen::Isometry3d::Identity());  // tool swap in the middle of the motion
+        switched = true;
+      }
+    } else if (!at_a) {  // the first lin ended with the spindle's TCP on a
+      at_a = true;
+      CHECK((m.TcpOf(pl.q_plan(), spindle).translation() - a).norm() < 1e-6,
+            "spindle TCP ended %g m off a", (m.TcpOf(pl.q_plan(), spindle).translation() - a).norm());
+    }
+  }
+  CHECK(pl.done(), "program did not finish in %d cycles", cycles);
+  CHECK(switched && at_a, "the swap or the end of the first lin was not reached");
+  CHECK(off_line < 1e-6, "spindle TCP left the line by %g m", off_line);
+  // The second lin began after the swap: planned for the flange, which ends on b.
+  CHECK((m.Flange(pl.q_plan()).translation() - b).norm() < 1e-6, "flange ended %g m off b",
+        (m.Flange(pl.q_plan()).translation() - b).norm());
+  CHECK(pl.lin_tool().translation().norm() == 0, "the second lin did not take the new tool");
+  CHECK(pl.ik_warnings() == 0, "%llu IK warnings", (unsigned long long)pl.ik_warnings());
+  CHECK(pl.limited_cycles() == 0, "limiter acted %llu cycles", (unsigned long long)pl.limited_cycles());
+  printf("tool: spindle lin off the line %.2e m, largest step %.2e rad, %d cycles\n", off_line, max_dq,
+         cycles);
+}
+
 int main(int argc, char** argv) {
   if (argc != 2) {
-    fprintf(stderr, "usage: %s <kinematics|program|trajectory_limits|trajectory_pause|trajectory_via|trajectory_loop|builtin>\n",
+    fprintf(stderr, "usage: %s <kinematics|program|trajectory_limits|trajectory_pause|trajectory_via|trajectory_loop|builtin|tool>\n",
             argv[0]);
     return 2;
   }
@@ -383,6 +463,7 @@ int main(int argc, char** argv) {
   else if (c == "trajectory_via") TestTrajectoryVia();
   else if (c == "trajectory_loop") TestTrajectoryLoop();
   else if (c == "builtin") TestBuiltin();
+  else if (c == "tool") TestTool();
   else {
     fprintf(stderr, "unknown case '%s'\n", argv[1]);
     return 2;

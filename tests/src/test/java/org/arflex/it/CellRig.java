@@ -1,0 +1,278 @@
+package org.arflex.it;
+
+import static org.junit.jupiter.api.Assertions.assertEquals;
+import static org.junit.jupiter.api.Assertions.assertTrue;
+
+import java.io.IOException;
+import java.nio.ByteOrder;
+import java.nio.MappedByteBuffer;
+import java.nio.channels.FileChannel;
+import java.nio.file.Files;
+import java.nio.file.Path;
+import java.nio.file.StandardOpenOption;
+import java.util.ArrayList;
+import java.util.List;
+import java.util.Map;
+import java.util.concurrent.CopyOnWriteArrayList;
+import java.util.function.Consumer;
+
+/**
+ * What the cell's integration tests (ForceGuardIT, TeachIT, ToolSwapIT) share: the cell bundles'
+ * jars, installing the simulated arm with its motion path, and raw reads of the cell's state
+ * ports (arflex.JointRef, JointState, Wrench, SafetyState, Sample) from shared memory.
+ */
+final class CellRig {
+
+    private CellRig() {
+    }
+
+    static final long T = 60_000;
+
+    /** A cell bundle jar: -Darflex.it.&lt;key&gt;, else bundles/&lt;dir&gt;/target/&lt;bsn&gt;-&lt;version&gt;.jar of this tree. */
+    static Path jar(String key, String dir, String bsn) {
+        String p = System.getProperty("arflex.it." + key);
+        if (p != null) {
+            return Path.of(p);
+        }
+        Path counter = CellIT.COUNTER; // bundles/sample-counter/target/org.arflex.samples.counter-V.jar
+        String version = counter.getFileName().toString().replace("org.arflex.samples.counter-", "");
+        return counter.getParent().getParent().getParent().resolve(dir).resolve("target").resolve(bsn + "-" + version);
+    }
+
+    static final Path SIM_ROBOT = jar("simrobot", "sim-robot", "org.arflex.sim.robot");
+    static final Path TRAJECTORY = jar("trajectory", "trajectory", "org.arflex.cell.trajectory");
+    static final Path FORCE_GUARD = jar("forceguard", "force-guard", "org.arflex.cell.forceguard");
+    static final Path TEACH = jar("teach", "teach", "org.arflex.cell.teach");
+    static final Path GRIPPER = jar("gripper", "tool-gripper", "org.arflex.cell.tool.gripper");
+    static final Path SPINDLE = jar("spindle", "tool-spindle", "org.arflex.cell.tool.spindle");
+    static final Path TCP_CORRECTION = jar("tcpcorrection", "tcp-correction", "org.arflex.cell.tcpcorrection");
+
+    static void assertBuilt(Path... jars) {
+        for (Path j : jars) {
+            assertTrue(Files.isRegularFile(j), "cell bundle not built: " + j);
+        }
+    }
+
+    /**
+     * Installs and starts the simulated arm. When its contract binds {@code joint_ref} to the
+     * TCP correction (the cell's wiring: motion -> tcp-correction -> robot), the correction is
+     * installed too, so that a motion source reaches the arm; without vision it passes the
+     * reference through unchanged. Returns the names of what was installed.
+     */
+    static List<String> installArm(Runtime rt) {
+        List<String> names = new ArrayList<>();
+        rt.installAndStart(SIM_ROBOT);
+        names.add("sim-robot");
+        rt.waitUntil("sim-robot known", T, () -> rt.instance("sim-robot") != null);
+        String info = rt.cmd("arflex:info sim-robot");
+        String jr = info.lines().filter(l -> l.contains("in joint_ref")).findFirst().orElse("");
+        if (jr.contains("correction")) {
+            assertBuilt(TCP_CORRECTION);
+            rt.installAndStart(TCP_CORRECTION);
+            names.add("tcp-correction");
+        }
+        return names;
+    }
+
+    /** The input of sim-robot that carries the motion reference, as arflex:bindings prints it. */
+    static boolean armFollows(Runtime rt, String motionSource) {
+        String b = rt.cmd("arflex:bindings");
+        if (b.contains("sim-robot.joint_ref <- " + motionSource + ".joint_ref")) {
+            return true;
+        }
+        return b.contains("sim-robot.joint_ref <- tcp-correction.corrected")
+                && b.contains("tcp-correction.reference <- " + motionSource + ".joint_ref");
+    }
+
+    /** Installs a bundle without starting it; waits until the DRCR knows its instance. */
+    static long installOnly(Runtime rt, Path jar, String instance) {
+        long id = rt.install(jar);
+        rt.waitUntil(instance + " known", T, () -> rt.instance(instance) != null);
+        return id;
+    }
+
+    static void set(Runtime rt, String inst, String param, String value) {
+        String r = rt.cmd("arflex:set " + inst + " " + param + " " + value);
+        assertTrue(r.startsWith(inst + "." + param + " = "), "arflex:set " + inst + " " + param + " " + value + ": " + r);
+    }
+
+    /** Uninstalls a bundle and waits until its instance, process and ports are gone. */
+    static void uninstall(Runtime rt, long bundle, String instance, String port) {
+        assertEquals("", rt.cmd("uninstall " + bundle));
+        rt.waitUntil(instance + " gone (instance, process, port)", T, () -> {
+            Map<String, Object> i = rt.instance(instance);
+            boolean gone = i == null || "DESTROYED".equals(i.get("state"));
+            return gone && !Files.exists(rt.segment(instance, port))
+                    && Runtime.rtProcesses(rt.rid).stream().noneMatch(p -> p.contains("--instance " + instance + " "));
+        });
+    }
+
+    @SuppressWarnings("unchecked")
+    static long cycles(Runtime rt, String name) {
+        Map<String, Object> i = rt.instance(name);
+        Map<String, Object> st = i == null ? null : (Map<String, Object>) i.get("stats");
+        return st == null ? -1 : ((Number) st.get("cycles")).longValue();
+    }
+
+    /**
+     * One state port mapped read-only (rt-core ABI 1.0 §4: slot 0 header at 256, its seq odd
+     * while the writer writes, the value at 320). Every cell type starts with t_ns/seq (or
+     * seq/t_ns for arflex.Sample) followed by f64/u32 fields read by offset.
+     */
+    static final class Port implements AutoCloseable {
+        final Path path;
+        private final FileChannel ch;
+        private final MappedByteBuffer b;
+        private final int size;
+
+        Port(Path segment, int valueSize) throws IOException {
+            path = segment;
+            ch = FileChannel.open(segment, StandardOpenOption.READ);
+            b = ch.map(FileChannel.MapMode.READ_ONLY, 0, 4096);
+            b.order(ByteOrder.LITTLE_ENDIAN);
+            size = valueSize;
+        }
+
+        /** The current value's bytes (little-endian), or null (never written, or torn on every try). */
+        java.nio.ByteBuffer read() {
+            byte[] v = new byte[size];
+            for (int attempt = 0; attempt < 100; attempt++) {
+                long s1 = b.getLong(256);
+                if (s1 == 0) {
+                    return null;
+                }
+                if ((s1 & 1) != 0) {
+                    Thread.onSpinWait();
+                    continue;
+                }
+                b.get(320, v);
+                if (b.getLong(256) == s1) {
+                    return java.nio.ByteBuffer.wrap(v).order(ByteOrder.LITTLE_ENDIAN);
+                }
+            }
+            return null;
+        }
+
+        @Override
+        public void close() throws IOException {
+            ch.close();
+        }
+    }
+
+    /** arflex.JointRef: t_ns, seq, q[6]. */
+    record Ref(long tNs, long seq, double[] q) {
+        static Ref of(java.nio.ByteBuffer v) {
+            return v == null ? null : new Ref(v.getLong(0), v.getLong(8), doubles(v, 16, 6));
+        }
+    }
+
+    /** arflex.JointState: t_ns, seq, q[6], qd[6], tau[6]. */
+    record JointState(long tNs, long seq, double[] q) {
+        static JointState of(java.nio.ByteBuffer v) {
+            return v == null ? null : new JointState(v.getLong(0), v.getLong(8), doubles(v, 16, 6));
+        }
+    }
+
+    /** arflex.Wrench: t_ns, seq, force[3], torque[3]. */
+    record Wrench(long tNs, long seq, double[] force) {
+        static Wrench of(java.nio.ByteBuffer v) {
+            return v == null ? null : new Wrench(v.getLong(0), v.getLong(8), doubles(v, 16, 3));
+        }
+
+        double norm() {
+            return Math.sqrt(force[0] * force[0] + force[1] * force[1] + force[2] * force[2]);
+        }
+    }
+
+    /** arflex.SafetyState: t_ns, seq, mode u32, flags u32, power_scale, force_norm, force_limit. */
+    record Safety(long tNs, long seq, int mode, int flags, double powerScale, double forceNorm, double forceLimit) {
+        static final int NORMAL = 0;
+        static final int PROTECTIVE_STOP = 2;
+
+        static Safety of(java.nio.ByteBuffer v) {
+            return v == null ? null
+                    : new Safety(v.getLong(0), v.getLong(8), v.getInt(16), v.getInt(20), v.getDouble(24), v.getDouble(32),
+                            v.getDouble(40));
+        }
+    }
+
+    static final int REF_SIZE = 64;
+    static final int JOINT_STATE_SIZE = 160;
+    static final int WRENCH_SIZE = 64;
+    static final int SAFETY_SIZE = 48;
+    static final int SAMPLE_SIZE = 24;
+
+    static double[] doubles(java.nio.ByteBuffer v, int off, int n) {
+        double[] d = new double[n];
+        for (int i = 0; i < n; i++) {
+            d[i] = v.getDouble(off + 8 * i);
+        }
+        return d;
+    }
+
+    /** Largest |a_j - b_j|. */
+    static double maxDiff(double[] a, double[] b) {
+        double m = 0;
+        for (int j = 0; j < a.length; j++) {
+            m = Math.max(m, Math.abs(a[j] - b[j]));
+        }
+        return m;
+    }
+
+    /** KR 210-class joint speed limits the trajectory's limiter holds (rad/s). */
+    static final double[] VMAX = {Math.toRadians(123), Math.toRadians(115), Math.toRadians(112), Math.toRadians(179),
+            Math.toRadians(172), Math.toRadians(219)};
+
+    /**
+     * Polls a set of ports in a thread of its own every ~100 us (the ports change every
+     * millisecond; a value overwritten before a poll is missed, which the tests account for by
+     * checking seq gaps) and hands every new value (by seq) to its consumer.
+     */
+    static final class Recorder implements AutoCloseable {
+        private final List<Runnable> polls = new CopyOnWriteArrayList<>();
+        private final Thread thread;
+        private volatile boolean stop;
+        volatile Throwable error;
+
+        Recorder() {
+            thread = new Thread(this::run, "cell-recorder");
+            thread.setDaemon(true);
+        }
+
+        <V> void add(Port p, java.util.function.Function<java.nio.ByteBuffer, V> decode,
+                java.util.function.ToLongFunction<V> seqOf, Consumer<V> sink) {
+            long[] last = {0};
+            polls.add(() -> {
+                V v = decode.apply(p.read());
+                if (v != null && seqOf.applyAsLong(v) != last[0]) {
+                    last[0] = seqOf.applyAsLong(v);
+                    sink.accept(v);
+                }
+            });
+        }
+
+        void start() {
+            thread.start();
+        }
+
+        private void run() {
+            try {
+                while (!stop) {
+                    for (Runnable r : polls) {
+                        r.run();
+                    }
+                    // ~100 us between polls: most 1 ms values are seen without taking a core
+                    java.util.concurrent.locks.LockSupport.parkNanos(100_000);
+                }
+            } catch (Throwable t) {
+                error = t;
+            }
+        }
+
+        @Override
+        public void close() throws InterruptedException {
+            stop = true;
+            thread.join(10_000);
+        }
+    }
+}
