@@ -84,6 +84,7 @@
   const WINDOW = 300;
   let plot = null; let series = null; let source = null;
   let watched = null; // {port, field, plot, last}
+  let drawStat = () => {};
   function startStream() {
     if (typeof EventSource === 'undefined' || typeof uPlot === 'undefined') return;
     if (source) source.close();
@@ -91,7 +92,26 @@
     series = {t: [], v: keys.map(() => [])};
     const box = el('div', {class: 'arflex-plot', id: 'arflex-live-plot'});
     const counter = el('div', {id: 'arflex-live-count'}, 'waiting for samples…');
-    plots.replaceChildren(el('h2', {}, 'Live statistics (10 Hz)'), counter, box);
+    // Any other statistic of the stream (every numeric StatsDTO field) on a second plot.
+    const statSel = el('select', {id: 'arflex-stat-select'}, el('option', {value: ''}, '—'));
+    const statBox = el('div', {class: 'arflex-plot', id: 'arflex-stat-plot'});
+    let statPlot = null; let statKey = '';
+    statSel.addEventListener('change', () => {
+      statKey = statSel.value; statPlot = null; statBox.replaceChildren();
+      if (statKey) statPlot = Arflex.rollingPlot(statBox, [statKey], {height: 180});
+    });
+    plots.replaceChildren(el('h2', {}, 'Live statistics (10 Hz)'), counter, box,
+      el('p', {}, 'Plot another statistic: ', statSel), statBox);
+    drawStat = (s) => {
+      if (statSel.options.length === 1) {
+        Object.keys(s).filter(k => typeof s[k] === 'number' && k !== 't').sort()
+          .forEach(k => statSel.append(el('option', {value: k}, k)));
+      }
+      if (statPlot && typeof s[statKey] === 'number') {
+        statPlot.push(s.t / 1000, [s[statKey]]);
+        statBox.dataset.last = String(s[statKey]);
+      }
+    };
     plot = new uPlot({width: 800, height: 240, series: [{}, ...keys.map((k, n) => ({label: k.replace('Ns', ' (µs)'),
       stroke: ['#c62828', '#1565c0', '#2e7d32'][n]}))], axes: [{}, {label: 'µs'}]}, [[], ...keys.map(() => [])], box);
     source = new EventSource(Arflex.root + '/api/stream?' + new URLSearchParams(
@@ -109,6 +129,7 @@
       counter.textContent = n + ' samples; cycles ' + (s.cycles ?? '-') + ', state ' + (s.state || '') +
         ', params ' + Object.entries(s.params || {}).map(([k, v]) => k + '=' + v).join(' ');
       drawHistogram(s);
+      drawStat(s);
       for (const [k, v] of Object.entries(s.params || {})) {
         const a = document.getElementById('arflex-applied-' + k);
         if (a) a.textContent = v;

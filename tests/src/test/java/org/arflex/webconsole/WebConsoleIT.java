@@ -472,6 +472,14 @@ class WebConsoleIT {
         assertFalse(first.equals(third) && first.equals(second), "the value changes: " + first + ", " + second + ", " + third);
         new WebDriverWait(browser, WAIT).until(d -> !d.findElements(By.cssSelector("#arflex-port-plot canvas")).isEmpty());
         awaitText(By.id("arflex-port-last"), "count.value = ");
+        // Any statistic of the stream on its own plot: the cycle counter grows.
+        new WebDriverWait(browser, WAIT).until(d -> new org.openqa.selenium.support.ui.Select(
+                d.findElement(By.id("arflex-stat-select"))).getOptions().size() > 5);
+        new org.openqa.selenium.support.ui.Select(browser.findElement(By.id("arflex-stat-select"))).selectByValue("cycles");
+        By stat = By.id("arflex-stat-plot");
+        awaitAtLeast(stat, "data-samples", 1);
+        long c0 = Long.parseLong(browser.findElement(stat).getAttribute("data-last"));
+        new WebDriverWait(browser, WAIT).until(d -> Long.parseLong(d.findElement(stat).getAttribute("data-last")) > c0);
         browser.executeScript("arguments[0].scrollIntoView();", browser.findElement(By.id("arflex-ports-live")));
         shot("13-component-port-plot");
         assertEquals(pid, pid("sample-counter"), "watching a port does not disturb its producer");
