@@ -6,11 +6,16 @@ import static org.junit.jupiter.api.Assertions.assertFalse;
 import static org.junit.jupiter.api.Assertions.assertThrows;
 import static org.junit.jupiter.api.Assertions.assertTrue;
 
+import java.util.ArrayList;
+import java.util.HashMap;
 import java.util.List;
 import java.util.Map;
+import java.util.Random;
 import java.util.Set;
 import org.arflex.contract.Contract;
 import org.junit.jupiter.api.Test;
+import org.junit.jupiter.params.ParameterizedTest;
+import org.junit.jupiter.params.provider.ValueSource;
 
 /** Exclusive CPUs (contract, SPEC 8.6) and reserved CPUs (capacities). */
 class CpuReservationTest {
@@ -156,5 +161,73 @@ class CpuReservationTest {
                 C.of("later").timing(10, 10, 0.2, 50, 1).crit(1).build());
         assertFalse(a.admitted().contains("probe"));
         assertEquals(Map.of("later", 1), a.cpuAssignment());
+    }
+
+    /**
+     * Random sets on 4 CPUs with random exclusive tasks, pinned tasks and a reserved CPU: an
+     * exclusive task never shares its CPU, no task lets admission choose a reserved CPU, every
+     * task runs within its allowed CPUs, and each CPU's set stays schedulable.
+     */
+    @ParameterizedTest
+    @ValueSource(longs = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20})
+    void invariantsHoldOnRandomSets(long seed) {
+        Random rnd = new Random(seed);
+        Capacities caps = Capacities.of(4, 1.0, 512 * MIB, 0);
+        int reserved = rnd.nextInt(5); // 4: none
+        if (reserved < 4) {
+            caps = caps.withReserved(List.of(reserved));
+        }
+        Resolver r = new Resolver();
+        List<Contract> all = new ArrayList<>();
+        long[] periods = {1, 2, 5, 10, 20};
+        int n = 4 + rnd.nextInt(12);
+        for (int i = 0; i < n; i++) {
+            long t = periods[rnd.nextInt(periods.length)];
+            double c = Math.max(0.01, t * rnd.nextDouble() * 0.4);
+            List<Integer> cpus = new ArrayList<>();
+            if (rnd.nextInt(3) == 0) {
+                cpus.add(rnd.nextInt(4));
+                if (rnd.nextBoolean()) {
+                    int other = rnd.nextInt(4);
+                    if (!cpus.contains(other)) {
+                        cpus.add(other);
+                    }
+                }
+            }
+            C b = C.of("t" + i).timing(t, t, c, 1 + rnd.nextInt(90), cpus.toArray(new Integer[0]))
+                    .crit(rnd.nextInt(10));
+            Contract k = (rnd.nextInt(4) == 0 ? b.exclusive() : b).build();
+            all.add(k);
+            r.put(k);
+        }
+        AdmissionResult a = Admission.admit(r, caps, Map.of());
+        Map<Integer, List<Contract>> on = new HashMap<>();
+        for (Contract k : all) {
+            if (a.cpuOf(k.name()).isPresent()) {
+                int cpu = a.cpuOf(k.name()).getAsInt();
+                on.computeIfAbsent(cpu, x -> new ArrayList<>()).add(k);
+                if (!k.timing().cpus().isEmpty()) {
+                    assertTrue(k.timing().cpus().contains(cpu), "seed " + seed + ": " + k.name() + " on " + cpu);
+                } else {
+                    assertFalse(caps.cpu(cpu).orElseThrow().reserved(),
+                            "seed " + seed + ": " + k.name() + " let admission choose and got reserved cpu " + cpu);
+                }
+            }
+        }
+        for (var e : on.entrySet()) {
+            List<Contract> ks = e.getValue();
+            for (Contract k : ks) {
+                if (k.timing().exclusive()) {
+                    assertEquals(1, ks.size(), "seed " + seed + ": exclusive " + k.name() + " shares cpu " + e.getKey()
+                            + " with " + ks.stream().map(Contract::name).toList());
+                }
+            }
+            List<Schedulability.Task> tasks = new ArrayList<>();
+            for (Contract k : ks) {
+                tasks.add(new Schedulability.Task(k.name(), k.timing().periodNs(), k.timing().deadlineNs(),
+                        k.timing().wcetNs(), k.timing().priority()));
+            }
+            assertTrue(Schedulability.rtaTest(tasks), "seed " + seed + ": cpu " + e.getKey() + " not schedulable");
+        }
     }
 }
