@@ -7,6 +7,8 @@ every mode (interleaved, never concurrent: see docs/latency.md):
   pure C    rt-core's arflex-baseline-task (no management at all)
   cyclictest  from Debian's rt-tests (raw per-cycle values with -v -N)
 Modes: light (idle), stress (stress-ng), reconfiguration (bundle churn + DTO polling).
+The measured CPU is kept apart unless --shared-cpu: the probe holds it exclusively (contract),
+the runtime reserves it (arflex.cpus.reserved) and the JVM runs on the other CPUs.
 Writes <out>/latency.json and <out>/latency-<mode>.svg; prints Table 1 and the targets.
 """
 import argparse
