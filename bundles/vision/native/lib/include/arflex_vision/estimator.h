@@ -91,7 +91,11 @@ void CollectObservations(int camera, const TagDetection* dets, int ndets,
 
 // Extrinsic calibration of `camera` (intrinsics known) from detections of the reference
 // board `board` (tag poses in the world). Needs at least one board tag (two or more for a
-// well-conditioned pose). On success sets world_from_camera, calibrated and
+// well-conditioned pose). `dets` may hold the detections of several frames of the static
+// scene one after the other (each board tag once per frame): they are pooled into one fit,
+// which averages the sensor noise (at most kMaxObservations board sightings are used). With a
+// planar board a few metres away the camera's rotation is the weak part of the fit: every
+// board tag that the camera cannot see (e.g. hidden by the arm) makes it markedly worse. On success sets world_from_camera, calibrated and
 // calibration_rms_px and returns true; otherwise leaves the camera unchanged, sets `*error`
 // naming the reason and returns false. `estimate` (may be null) receives the fit details.
 bool CalibrateCamera(Camera* camera, const std::vector<TagModel>& board,
