@@ -253,7 +253,7 @@ def merge_baseline(runs, key, bin_ns_key="histogram_bin_ns"):
     return out
 
 
-def run_probe(rt, jar, reader, n, cpu_other, work, tag):
+def run_probe(rt, jar, reader, n, cpu, cpu_other, work, tag):
     """Installs the probe bundle, reads n samples through the reader, uninstalls it."""
     samples = os.path.join(work, f"{tag}-probe.txt")
     summary = os.path.join(work, f"{tag}-probe.json")
@@ -261,6 +261,8 @@ def run_probe(rt, jar, reader, n, cpu_other, work, tag):
     done = False
     try:
         inst = rt.wait_instance("latency-probe", "ACTIVE", timeout=60)
+        if inst.get("cpu") != cpu:
+            raise BenchError(f"admission placed the probe on CPU {inst.get('cpu')}, not the measured CPU {cpu}")
         args = ([ "taskset", "-c", str(cpu_other)] if cpu_other is not None else []) + [
             reader, "--runtime", rt.rid, "--instance", inst["name"], "--count", str(n),
             "--out", samples, "--summary", summary, "--idle-timeout-ms", "5000"]
@@ -677,7 +679,7 @@ def main():
                     for c in order:
                         log(f"  round {r + 1}/{rounds}: {c} ({n_round} cycles)")
                         if c == "probe":
-                            raw[c].append(block(run_probe, a.cpu, rt, probe_jar, reader, n_round, cpu_other,
+                            raw[c].append(block(run_probe, a.cpu, rt, probe_jar, reader, n_round, a.cpu, cpu_other,
                                                 work, f"{mode}-{r}"))
                         elif c == "pure C":
                             if short is None:
