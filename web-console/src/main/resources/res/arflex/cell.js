@@ -16,7 +16,7 @@
   const errorParam = new URLSearchParams(window.location.search).get('error') || 'tcp-correction.error';
   const preset = {component: errorParam.substring(0, errorParam.lastIndexOf('.')),
     port: errorParam.substring(errorParam.lastIndexOf('.') + 1), toggle: 'enable'};
-  let tcpStream = null; let tcpPlot = null; let tcpShown; let tcpEnabled = null;
+  let tcpStream = null; let tcpPlot = null; let tcpShown; let tcpEnabled = null; let tcpLastIndex = -1;
   function renderTcp(cell) {
     const inst = (cell.instances || []).find(i => i.name === preset.component);
     const contract = (cell.contracts || []).find(c => c.name === preset.component);
@@ -31,11 +31,13 @@
     tcpShown = key;
     if (tcpStream) { tcpStream.close(); tcpStream = null; }
     tcpPlot = null;
+    tcpLastIndex = -1;
     const head = el('h2', {}, 'Tool-centre error, with and without correction');
     if (!ok) {
       tcp.replaceChildren(head, el('p', {id: 'arflex-tcp-error-none'}, why));
       return;
     }
+    const tcpStatus = el('div', {id: 'arflex-tcp-status'});
     const toggleSpec = (inst.params || []).find(p => p.name === preset.toggle && p.mutable && p.type === 'BOOL');
     const last = el('div', {id: 'arflex-tcp-error-last'}, 'waiting for values…');
     const box = el('div', {class: 'arflex-plot', id: 'arflex-tcp-error-plot'});
@@ -43,10 +45,10 @@
       const next = tcpEnabled === 'true' ? 'false' : 'true';
       try {
         const r = await post('param', {name: preset.component, param: preset.toggle, value: next});
-        message(status, preset.component + ' ' + preset.toggle + ' applied by the RT half: ' + r.applied, 'ok');
-      } catch (e) { message(status, preset.toggle + ': ' + e.message, 'error'); }
+        message(tcpStatus, preset.component + ' ' + preset.toggle + ' applied by the RT half: ' + r.applied, 'ok');
+      } catch (e) { message(tcpStatus, preset.toggle + ': ' + e.message, 'error'); }
     }}, 'Toggle correction') : '';
-    tcp.replaceChildren(head, el('p', {}, el('code', {}, preset.component + '.' + preset.port), ' ', toggle), last, box);
+    tcp.replaceChildren(head, el('p', {}, el('code', {}, preset.component + '.' + preset.port), ' ', toggle), tcpStatus, last, box);
     if (typeof uPlot === 'undefined') return;
     // tcp-correction publishes its error in mm (an arflex.Sample carries no unit of its own).
     const unit = errorParam === 'tcp-correction.error' ? 'mm' : '';
@@ -55,16 +57,18 @@
     tcpStream = stream(preset.component, [preset.port], f => {
       if (f.gone || !f.ports) return;
       const v = f.ports[preset.port];
-      if (!v || v.error) { last.textContent = v ? 'error: ' + v.error : 'no value'; return; }
-      if (v.index < 0 || !v.fields || !Array.isArray(v.fields.value)) { last.textContent = 'nothing published yet'; return; }
-      const x = v.fields.value[0];
       tcpEnabled = toggleSpec ? String((f.params || {})[preset.toggle]) : null;
       const on = !toggleSpec || tcpEnabled === 'true';
-      tcpPlot.push(f.t / 1000, !toggleSpec ? [x] : on ? [x, null] : [null, x]);
-      last.textContent = preset.port + ' = ' + fmtNum(x) + (toggleSpec ? ', correction ' + (on ? 'on' : 'off') : '') +
-        ' (' + tcpPlot.count + ' samples)';
-      box.dataset.last = String(x);
+      const corr = toggleSpec ? ', correction ' + (on ? 'on' : 'off') : '';
       box.dataset.correction = toggleSpec ? (on ? 'on' : 'off') : '';
+      if (!v || v.error) { last.textContent = (v ? 'error: ' + v.error : 'no value') + corr; return; }
+      if (v.index < 0 || !v.fields || !Array.isArray(v.fields.value)) { last.textContent = 'nothing published yet' + corr; return; }
+      const x = v.fields.value[0];
+      if (v.index === tcpLastIndex) return; // a state port holds its last value: plot each element once
+      tcpLastIndex = v.index;
+      tcpPlot.push(f.t / 1000, !toggleSpec ? [x] : on ? [x, null] : [null, x]);
+      last.textContent = preset.port + ' = ' + fmtNum(x) + corr + ' (' + tcpPlot.count + ' samples)';
+      box.dataset.last = String(x);
     });
   }
 

@@ -563,6 +563,63 @@ class WebConsoleIT {
         });
     }
 
+    /** A cell bundle: from the assembly's cell/, else as built in bundles/<module>/target. */
+    private static Path cellJar(String module, String artifact) {
+        Path assembled = Path.of(System.getProperty("arflex.runtime.dir", "../management/runtime/target/arflex-runtime"))
+                .toAbsolutePath().normalize().resolve("cell").resolve(artifact + ".jar");
+        if (Files.isRegularFile(assembled)) {
+            return assembled;
+        }
+        Path root = Path.of(System.getProperty("arflex.root", "..")).toAbsolutePath().normalize();
+        Path built = root.resolve("bundles").resolve(module).resolve("target").resolve(artifact + "-0.1.0-SNAPSHOT.jar");
+        assertTrue(Files.isRegularFile(built), artifact + " is neither in the runtime assembly (" + assembled
+                + ") nor built (" + built + ")");
+        return built;
+    }
+
+    private static String paramValue(String component, String param) {
+        String body = rt.get("/system/console/arflex-component/api/component?name=" + component, true).body();
+        Matcher m = Pattern.compile("\"name\":\"" + Pattern.quote(param) + "\",\"type\":\"[A-Z]+\",\"value\":\"([^\"]*)\"")
+                .matcher(body);
+        return m.find() ? m.group(1) : null;
+    }
+
+    @Test
+    @Order(14)
+    void theCellPresetTogglesTheCorrectionOfTheRealTcpCorrection() throws IOException {
+        // The cell's own trajectory (role=motion, its inputs optional) and tcp-correction, from the
+        // assembly's cell/; without vision no error is measured, but the preset and its toggle work.
+        Path trajectory = cellJar("trajectory", "org.arflex.cell.trajectory");
+        Path correction = cellJar("tcp-correction", "org.arflex.cell.tcpcorrection");
+        rt.gogo("start " + trajectory.toUri());
+        rt.gogo("start " + correction.toUri());
+        RuntimeUnderTest.awaitCondition("tcp-correction Active", Duration.ofSeconds(60),
+                () -> "ACTIVE".equals(instanceState("tcp-correction")));
+        String contract = rt.get("/system/console/arflex-component/api/component?name=tcp-correction", true).body();
+        open("arflex-cell");
+        if (!contract.contains("\"name\":\"error\",\"direction\":\"OUT\"")) {
+            // A tcp-correction without the error output: the preset says so.
+            awaitText(By.id("arflex-tcp-error-none"), "has no output port error");
+            shot("18-cell-tcp-preset-no-error-port");
+            return;
+        }
+        WebElement toggle = await(By.id("arflex-tcp-toggle"));
+        By plot = By.id("arflex-tcp-error-plot");
+        String before = paramValue("tcp-correction", "enable");
+        assertEquals("true", before, "correction enabled by default");
+        new WebDriverWait(browser, WAIT).until(d -> "on".equals(d.findElement(plot).getAttribute("data-correction")));
+        awaitText(By.id("arflex-tcp-error-last"), "correction on");
+        toggle.click();
+        awaitText(By.id("arflex-tcp-status"), "enable applied by the RT half: false");
+        new WebDriverWait(browser, WAIT).until(d -> "off".equals(d.findElement(plot).getAttribute("data-correction")));
+        assertEquals("false", paramValue("tcp-correction", "enable"));
+        awaitText(By.id("arflex-tcp-error-last"), "correction off");
+        shot("18-cell-tcp-preset-correction-off");
+        browser.findElement(By.id("arflex-tcp-toggle")).click();
+        new WebDriverWait(browser, WAIT).until(d -> "on".equals(d.findElement(plot).getAttribute("data-correction")));
+        assertEquals("true", paramValue("tcp-correction", "enable"));
+    }
+
     private static String sha256(Path p) throws IOException {
         try {
             return HexFormat.of().formatHex(MessageDigest.getInstance("SHA-256").digest(Files.readAllBytes(p)));
