@@ -51,6 +51,10 @@ public final class Instance {
     volatile String hangReason;
     Actor.Cancellable restartTimer;
     volatile long measuredWcetNs;
+    /** Execution-time counters at the previous sampling of this RT half (Cell.sample). */
+    long sampledExecCount, sampledExecSum, sampledExecOver;
+    /** An isolated WCET exceedance of this instance was logged already. */
+    boolean transientWcetLogged;
     /** Known to the planner (its bundle is started); false while only INSTALLED. */
     volatile boolean planned;
 

@@ -2,7 +2,9 @@ package org.arflex.drcr.impl.runtime;
 
 import static org.junit.jupiter.api.Assertions.assertEquals;
 import static org.junit.jupiter.api.Assertions.assertFalse;
+import static org.junit.jupiter.api.Assertions.assertNotEquals;
 import static org.junit.jupiter.api.Assertions.assertNotNull;
+import static org.junit.jupiter.api.Assertions.assertSame;
 import static org.junit.jupiter.api.Assertions.assertThrows;
 import static org.junit.jupiter.api.Assertions.assertTrue;
 
@@ -14,6 +16,7 @@ import org.arflex.contract.ContractParser;
 import org.arflex.contract.PortTypes;
 import org.arflex.drcr.dto.CellDTO;
 import org.arflex.drcr.dto.InstanceDTO;
+import org.arflex.drcr.impl.abi.ControlBlock;
 import org.arflex.drcr.impl.lifecycle.ManualActor;
 import org.arflex.drcr.impl.lifecycle.State;
 import org.arflex.planner.Capacities;
@@ -103,6 +106,58 @@ class CellTest {
         CellDTO dto = Snapshots.cell(cell, null);
         assertEquals(1, dto.bindings.length);
         assertEquals("prov", dto.bindings[0].provider);
+    }
+
+    /** Execution-time counters as an RT half would report them (declared WCET 50 us). */
+    private static ControlBlock.Stats exec(long cycles, long meanNs, long maxNs, long overWcet) {
+        return new ControlBlock.Stats(cycles, 0, 0, 0, 0, maxNs, cycles, cycles * meanNs, overWcet);
+    }
+
+    private long sample() {
+        long over = actor.call(cell::sample, 0);
+        actor.runAll();
+        return over;
+    }
+
+    @Test
+    void anIsolatedWcetSpikeIsLoggedOnceAndDoesNotStopTheComponent() throws Exception {
+        install(contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us"));
+        FakeLauncher.FakeHalf h = launcher.running.get("prov");
+        h.stats = exec(1000, 20_000, 3_000_000, 1);  // one 3 ms cycle (a stall) in 1000
+        assertEquals(1, sample());
+        h.stats = exec(2000, 20_000, 3_000_000, 2);
+        sample();
+        assertEquals(State.ACTIVE, state("prov"));
+        assertSame(h, launcher.running.get("prov"), "not restarted");
+        assertEquals(1, log.stream().filter(l -> l.contains("isolated cycles")).count(), log::toString);
+        assertTrue(log.stream().noneMatch(l -> l.contains("re-planning")), log::toString);
+    }
+
+    @Test
+    void aSustainedWcetExceedanceIsReplannedAndRefusedWithTheMeasuredValue() throws Exception {
+        install(contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us"));
+        FakeLauncher.FakeHalf h = launcher.running.get("prov");
+        h.stats = exec(1000, 20_000, 30_000, 0);
+        sample();
+        h.stats = exec(2000, 40_000, 1_500_000, 40);  // 40 of the window's 1000 cycles above 50 us
+        sample();
+        assertTrue(log.stream().anyMatch(l -> l.contains("measured execution time 1500000 ns")), log::toString);
+        assertNotEquals(State.ACTIVE, state("prov"));
+        assertTrue(reason("prov").contains("measured WCET"), reason("prov"));
+        assertFalse(launcher.running.containsKey("prov"));
+    }
+
+    @Test
+    void sustainedMeansAtLeastOnePercentOfAWindowOrAMeanAboveTheWcet() {
+        assertFalse(Cell.sustainedOverWcet(50_000, 1000, 1000 * 20_000L, 9));
+        assertTrue(Cell.sustainedOverWcet(50_000, 1000, 1000 * 20_000L, 10));
+        assertFalse(Cell.sustainedOverWcet(50_000, 30, 30 * 20_000L, 2));   // a 30 Hz task: 3 cycles at least
+        assertTrue(Cell.sustainedOverWcet(50_000, 30, 30 * 20_000L, 3));
+        assertTrue(Cell.sustainedOverWcet(50_000, 1000, 1000 * 60_000L, 0)); // mean above
+        // above the histogram's 200 us the over count is an upper bound: only the mean decides
+        assertFalse(Cell.sustainedOverWcet(300_000, 1000, 1000 * 250_000L, 1000));
+        assertTrue(Cell.sustainedOverWcet(300_000, 1000, 1000 * 310_000L, 1000));
+        assertFalse(Cell.sustainedOverWcet(50_000, 0, 0, 0));
     }
 
     @Test

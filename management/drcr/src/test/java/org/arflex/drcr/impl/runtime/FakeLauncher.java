@@ -30,6 +30,8 @@ final class FakeLauncher implements RtLauncher {
         long runtimeHb;
         boolean started;
         boolean cleaned;
+        /** What stats() reports; tests set it. */
+        ControlBlock.Stats stats = new ControlBlock.Stats(0, 0, 0, 0, 0, 0, 0, 0, 0);
 
         FakeHalf(Spec s) {
             inst = s.instance();
@@ -107,7 +109,7 @@ final class FakeLauncher implements RtLauncher {
 
         @Override
         public ControlBlock.Stats stats(long wcetNs) {
-            return new ControlBlock.Stats(0, 0, 0, 0, 0, 0, 0, 0, 0);
+            return stats;
         }
 
         @Override
