@@ -14,8 +14,14 @@
 // Usage: arflex-accuracy-bench [--json FILE] [--width W --height H] [--poses N]
 //                              [--noise SIGMA] [--blur SIGMA] [--period-ms P] [--quick]
 //                              [--no-refine] [--only INDEX] [--trace] [--outlier-px PX]
-//                              [--with-orientation]
-// --quick: only the payload-0 run; --no-refine: AprilTag's corners without the edge re-fit.
+//                              [--with-orientation] [--calib-frames N] [--calib-at-home]
+//                              [--average K] [--diag] [--no-loop]
+// --quick: only the payload-0 run; --no-refine: AprilTag's corners without the edge re-fit;
+// --calib-frames: frames pooled per camera for the board calibration (8); --calib-at-home:
+// calibrate with the arm in front of the board (default: parked facing away); --average: frames
+// averaged per final update once the loop has converged (4; 1 = off); --diag: per camera / tag
+// corner errors against the simulator's projections, calibration errors, static check;
+// --no-loop: diagnostics only (no correction).
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -657,9 +663,11 @@ void PrintRun(const RunResult& r, bool per_pose) {
 void WriteJson(FILE* f, const Args& a, const std::vector<RunResult>& runs) {
   std::fprintf(f, "{\n  \"benchmark\": \"arflex-accuracy-bench\",\n");
   std::fprintf(f, "  \"config\": {\"width\": %d, \"height\": %d, \"poses\": %d, \"noise_sigma\": %g, "
-                  "\"blur_sigma\": %g, \"vision_period_ms\": %d, \"corner_refit\": %s, \"outlier_px\": %g, \"position_only\": %s},\n",
+                  "\"blur_sigma\": %g, \"vision_period_ms\": %d, \"corner_refit\": %s, \"outlier_px\": %g, \"position_only\": %s, "
+                  "\"calibration_frames\": %d, \"calibration_pose\": \"%s\", \"static_average_frames\": %d},\n",
                a.width, a.height, a.poses, a.noise, a.blur, a.period_ms, a.refine ? "true" : "false",
-               a.outlier_px, a.position_only ? "true" : "false");
+               a.outlier_px, a.position_only ? "true" : "false", a.calib_frames, a.calib_home ? "home" : "parked",
+               a.average);
   std::fprintf(f, "  \"runs\": [\n");
   for (size_t i = 0; i < runs.size(); ++i) {
     const RunResult& r = runs[i];
@@ -816,10 +824,11 @@ int main(int argc, char** argv) {
   if (args.quick) specs.resize(1);
   std::printf("arflex-accuracy-bench: %d poses, %dx%d, noise %.1f DN, blur %.1f px, vision "
               "period %d ms (simulated time), corner re-fit %s, outlier threshold %.2f px, "
-              "correcting %s\n",
+              "correcting %s; calibration: %d frames per camera, arm %s; static average %d frames\n",
               args.poses, args.width, args.height, args.noise, args.blur, args.period_ms,
               args.refine ? "on" : "off", args.outlier_px,
-              args.position_only ? "the position" : "position and orientation");
+              args.position_only ? "the position" : "position and orientation", args.calib_frames,
+              args.calib_home ? "at home" : "parked away from the board", args.average);
   std::vector<RunResult> runs;
   Bench bench(args);
   for (const Spec& s : specs) {
