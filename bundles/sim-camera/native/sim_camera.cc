@@ -16,6 +16,8 @@
 #include <arflex_types/image_frame.h>
 #include <arflex_types/joint_state.h>
 
+#include <sys/resource.h>
+
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
@@ -198,6 +200,13 @@ void Cleanup(arflex_component*, void* user) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Best-effort work yields to everything else: rendering (llvmpipe, several threads)
+  // runs at nice 19. Every thread of this process (rt-core's loop and mailbox threads, and threads libraries create later)
+  // inherits it from the main thread. Without it a cell's SCHED_OTHER work starves the
+  // runtime's heartbeat thread on a small machine, and the 1 ms components go to safe mode.
+  if (setpriority(PRIO_PROCESS, 0, 19) != 0) {
+    std::fprintf(stderr, "sim-camera: warning: setpriority(nice 19) failed: %s\n", std::strerror(errno));
+  }
   arflex_component_ops ops{};
   ops.name = "sim-camera";
   ops.user = &g_cam;

@@ -1,8 +1,11 @@
 // RT half of the `tcp-correction` component: the outer loop of the paper.
 //
 // Ports: inputs reference (state, arflex.JointRef: the trajectory's joint reference) and
-// tcp_pose (state, arflex.Pose: the vision measurement); output corrected (state,
-// arflex.JointRef) = reference + correction. Parameters (defaults when absent from the
+// tcp_pose (state, arflex.Pose: the vision measurement); outputs corrected (state,
+// arflex.JointRef) = reference + correction, error (state, arflex.Sample: the measured TCP
+// position error |desired - measured| in mm, one value per valid measurement) and correction
+// (state, arflex.Sample: the size of the applied joint correction, Euclidean norm in mrad,
+// every cycle), the last two for plots and monitors. Parameters (defaults when absent from the
 // contract): gain, max_step (rad per measurement), max_rate (rad/s), max_correction (rad),
 // enable (bool), orientation (bool).
 //
@@ -23,6 +26,7 @@ extern "C" {
 #include "arflex_tcpcorr/correction.h"
 #include "arflex_types/joint_ref.h"
 #include "arflex_types/pose.h"
+#include "arflex_types/sample.h"
 
 namespace {
 
@@ -33,6 +37,8 @@ struct TcpCorrection {
   arflex_input* reference = nullptr;
   arflex_input* pose = nullptr;
   arflex_port* out = nullptr;
+  arflex_port* error = nullptr;
+  arflex_port* size = nullptr;
   int p_gain = -1, p_step = -1, p_rate = -1, p_max = -1, p_enable = -1, p_orientation = -1;
   arflex::sim::NominalKinematics kinematics{arflex::sim::DefaultArm()};
   CorrectionLaw law{CorrectionOptions{}};
@@ -40,6 +46,7 @@ struct TcpCorrection {
   bool have_ref = false;
   uint64_t pose_seq = 0;
   uint64_t out_seq = 0;
+  uint64_t error_seq = 0;
   double dt = 0.001;
 };
 
@@ -47,6 +54,7 @@ TcpCorrection g;
 
 const arflex_port_type kRefType = {ARFLEX_TYPE_JOINT_REF_NAME, 1, 0, ARFLEX_TYPE_JOINT_REF_SIZE};
 const arflex_port_type kPoseType = {ARFLEX_TYPE_POSE_NAME, 1, 0, ARFLEX_TYPE_POSE_SIZE};
+const arflex_port_type kSampleType = {ARFLEX_TYPE_SAMPLE_NAME, 1, 0, ARFLEX_TYPE_SAMPLE_SIZE};
 
 double F64(arflex_component* c, int idx, double def) { return idx >= 0 ? arflex_param_f64(c, idx) : def; }
 bool Bool(arflex_component* c, int idx, bool def) { return idx >= 0 ? arflex_param_bool(c, idx) : def; }
@@ -68,6 +76,8 @@ int Configure(arflex_component* c, void*) {
   int r = arflex_component_input(c, "reference", ARFLEX_PORT_STATE, &kRefType, &g.reference);
   if (r == 0) r = arflex_component_input(c, "tcp_pose", ARFLEX_PORT_STATE, &kPoseType, &g.pose);
   if (r == 0) r = arflex_component_output(c, "corrected", ARFLEX_PORT_STATE, &kRefType, &g.out);
+  if (r == 0) r = arflex_component_output(c, "error", ARFLEX_PORT_STATE, &kSampleType, &g.error);
+  if (r == 0) r = arflex_component_output(c, "correction", ARFLEX_PORT_STATE, &kSampleType, &g.size);
   if (r < 0) return r;
   g.p_gain = arflex_component_param(c, "gain");
   g.p_step = arflex_component_param(c, "max_step");
@@ -111,12 +121,27 @@ int Update(arflex_component* c, void*, uint64_t) {
     Eigen::Isometry3d measured = Eigen::Isometry3d::Identity();
     measured.linear() = Eigen::Quaterniond(m.quat[0], m.quat[1], m.quat[2], m.quat[3]).normalized().toRotationMatrix();
     measured.translation() = Eigen::Vector3d(m.p[0], m.p[1], m.p[2]);
-    g.law.Update(g.kinematics.TcpJacobian(q), g.kinematics.Tcp(q), measured, m.valid != 0);
+    const Eigen::Isometry3d desired = g.kinematics.Tcp(q);
+    g.law.Update(g.kinematics.TcpJacobian(q), desired, measured, m.valid != 0);
+    const double err_mm = 1e3 * (desired.translation() - measured.translation()).norm();
+    if (m.valid != 0 && std::isfinite(err_mm)) {
+      // What vision sees of the TCP's distance from where the reference wants it (mm).
+      arflex_sample e{};
+      e.seq = ++g.error_seq;
+      e.t_ns = m.t_ns;
+      e.value = err_mm;
+      arflex_state_write(g.error, &e, sizeof(e));
+    }
   }
   const arflex::tcpcorr::Vector6d& dq = g.law.Tick(g.dt);
   arflex_joint_ref out = g.ref;
   for (int i = 0; i < 6; ++i) out.q[i] = g.ref.q[i] + dq(i);
   out.seq = ++g.out_seq;
+  arflex_sample size{};
+  size.seq = out.seq;
+  size.t_ns = out.t_ns;
+  size.value = 1e3 * dq.norm();
+  arflex_state_write(g.size, &size, sizeof(size));
   return arflex_state_write(g.out, &out, sizeof(out));
 }
 

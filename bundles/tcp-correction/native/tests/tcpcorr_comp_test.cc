@@ -23,6 +23,7 @@ extern "C" {
 #include "arflex_sim/kinematics.h"
 #include "arflex_types/joint_ref.h"
 #include "arflex_types/pose.h"
+#include "arflex_types/sample.h"
 
 namespace {
 
@@ -98,8 +99,11 @@ const Eigen::Vector3d kPlantError(1.2e-3, -0.8e-3, 0.6e-3);  // true arm vs nomi
 
 struct Rig {
   arflex_host feeder{}, corr{};
-  arflex_port out{};
-  bool out_open = false;
+  arflex_port out{}, err_out{}, size_out{};
+  bool out_open = false, err_open = false, size_open = false;
+  double first_error_mm = -1;  // the first value of the `error` output
+  double last_error_mm = -1;   // the newest one
+  double last_size_mrad = -1;  // the newest `correction` value
   arflex::sim::NominalKinematics kin{arflex::sim::DefaultArm()};
   arflex_joint_ref last{};
   uint64_t pose_seq = 0;
@@ -129,17 +133,23 @@ struct Rig {
         F64("gain", 0.6, 0.01, 1.0), F64("max_step", 2e-3, 1e-6, 0.1), F64("max_rate", kMaxRate, 1e-6, 1.0),
         F64("max_correction", 0.02, 1e-6, 0.2), Param("enable", ARFLEX_PARAM_BOOL, 1, 0, 1),
         Param("orientation", ARFLEX_PARAM_BOOL, 1, 0, 1)};
-    struct arflex_host_output co;
-    std::memset(&co, 0, sizeof(co));
-    co.port = "corrected";
-    co.spec.method = ARFLEX_PORT_STATE;
-    co.spec.type = {ARFLEX_TYPE_JOINT_REF_NAME, 1, 0, ARFLEX_TYPE_JOINT_REF_SIZE};
-    co.spec.depth = 1;
+    struct arflex_host_output co[3];
+    std::memset(co, 0, sizeof(co));
+    co[0].port = "corrected";
+    co[0].spec.method = ARFLEX_PORT_STATE;
+    co[0].spec.type = {ARFLEX_TYPE_JOINT_REF_NAME, 1, 0, ARFLEX_TYPE_JOINT_REF_SIZE};
+    co[0].spec.depth = 1;
+    co[1].port = "error";
+    co[1].spec.method = ARFLEX_PORT_STATE;
+    co[1].spec.type = {ARFLEX_TYPE_SAMPLE_NAME, 1, 0, ARFLEX_TYPE_SAMPLE_SIZE};
+    co[1].spec.depth = 1;
+    co[2] = co[1];
+    co[2].port = "correction";
     o.instance = "corr";
     o.params = p;
     o.nparams = 6;
-    o.outputs = &co;
-    o.noutputs = 1;
+    o.outputs = co;
+    o.noutputs = 3;
     r = arflex_host_create(&corr, &o);
     if (r < 0) return r;
     r = arflex_host_spawn(&corr, exe, nullptr, nullptr);
@@ -150,6 +160,13 @@ struct Rig {
     r = arflex_port_open(&out, arflex_host_output_name(&corr, "corrected"), false, false, ARFLEX_PORT_STATE, &t);
     if (r < 0) return r;
     out_open = true;
+    const arflex_port_type st = {ARFLEX_TYPE_SAMPLE_NAME, 1, 0, ARFLEX_TYPE_SAMPLE_SIZE};
+    r = arflex_port_open(&err_out, arflex_host_output_name(&corr, "error"), false, false, ARFLEX_PORT_STATE, &st);
+    if (r < 0) return r;
+    err_open = true;
+    r = arflex_port_open(&size_out, arflex_host_output_name(&corr, "correction"), false, false, ARFLEX_PORT_STATE, &st);
+    if (r < 0) return r;
+    size_open = true;
     arflex_joint_ref ref;
     std::memset(&ref, 0, sizeof(ref));
     ref.t_ns = 1;
@@ -164,6 +181,8 @@ struct Rig {
 
   ~Rig() {
     if (out_open) arflex_port_close(&out);
+    if (err_open) arflex_port_close(&err_out);
+    if (size_open) arflex_port_close(&size_out);
     arflex_host_destroy(&corr);
     arflex_host_destroy(&feeder);
   }
@@ -171,6 +190,12 @@ struct Rig {
   // Reads the newest output; checks that it never jumps. Returns true on a new value.
   bool Read() {
     arflex_joint_ref v;
+    arflex_sample e;
+    if (arflex_state_read(&err_out, &e, sizeof(e), nullptr) == 1) {
+      if (first_error_mm < 0) first_error_mm = e.value;
+      last_error_mm = e.value;
+    }
+    if (arflex_state_read(&size_out, &e, sizeof(e), nullptr) == 1) last_size_mrad = e.value;
     if (arflex_state_read(&out, &v, sizeof(v), nullptr) != 1) return false;
     if (last.seq != 0) {
       const double cycles = static_cast<double>(v.seq - last.seq);
@@ -243,6 +268,13 @@ int RunCase(const std::string& name, const char* exe) {
   CHECK(rig.Create(exe) == 0, "create/spawn/bind/start");
   err = rig.Converge(2e-6);
   CHECK(err < 2e-6, "TCP error %.3f um after the loop (from %.3f um)", 1e6 * err, 1e6 * kPlantError.norm());
+  // The `error` output: the first measurement saw the whole plant error (no correction yet);
+  // one more measurement of the converged arm shows it below 0.01 mm; `correction` is non-zero.
+  CHECK(std::abs(rig.first_error_mm - 1e3 * kPlantError.norm()) < 1e-6, "first error output %.6f mm, expected %.6f",
+        rig.first_error_mm, 1e3 * kPlantError.norm());
+  rig.Watch(100 * kMs, true, true, Eigen::Vector3d::Zero());
+  CHECK(rig.last_error_mm >= 0 && rig.last_error_mm < 0.01, "error output %.6f mm after converging", rig.last_error_mm);
+  CHECK(rig.last_size_mrad > 0.01, "correction output %.6f mrad after converging", rig.last_size_mrad);
   if (name == "hold") {
     // Vision drops out: invalid measurements far off are held, the output does not move.
     const arflex_joint_ref before = rig.last;

@@ -19,6 +19,8 @@
 
 #include <array>
 #include <atomic>
+#include <sys/resource.h>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -298,6 +300,13 @@ void Cleanup(arflex_component*, void*) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Best-effort work yields to everything else: detection (worker thread) runs at
+  // nice 19. Every thread of this process (rt-core's loop and mailbox threads, and threads libraries create later)
+  // inherits it from the main thread. Without it a cell's SCHED_OTHER work starves the
+  // runtime's heartbeat thread on a small machine, and the 1 ms components go to safe mode.
+  if (setpriority(PRIO_PROCESS, 0, 19) != 0) {
+    std::fprintf(stderr, "vision: warning: setpriority(nice 19) failed: %s\n", std::strerror(errno));
+  }
   arflex_component_ops ops{};
   ops.name = "vision";
   ops.configure = Configure;
