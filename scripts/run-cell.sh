@@ -94,7 +94,20 @@ def fk(q):
         p = [p[i] + d for i, d in enumerate(app(R, o))]
         R = mul(R, rot(a, t))
     return [p[i] + d for i, d in enumerate(app(R, (0.3, 0, 0)))]
-parts = ["%d RT halves running" % len(glob.glob("/dev/shm/arflex.%s.*.ctl" % rid))]
+ctls = glob.glob("/dev/shm/arflex.%s.*.ctl" % rid)
+parts = ["%d RT halves running" % len(ctls)]
+waiting = []
+for c in sorted(ctls):
+    try:
+        with open(c, "rb") as f:
+            f.seek(28)
+            flags = struct.unpack("<I", f.read(4))[0]
+    except OSError:
+        continue
+    if flags & 8:  # ARFLEX_FLAG_RESET_REQUIRED: safe mode until the operator's reset
+        waiting.append(c.split("/arflex.%s." % rid, 1)[1][:-4])
+if waiting:
+    parts.append("WAITING FOR AN OPERATOR RESET (safe mode): %s (arflex:reset <name>)" % " ".join(waiting))
 js = port("sim-robot", "joint_state", 160)
 if js:
     parts.append("robot seq %d" % struct.unpack_from("<Q", js, 8)[0])

@@ -1,0 +1,586 @@
+package org.arflex.it;
+
+import static org.junit.jupiter.api.Assertions.assertEquals;
+import static org.junit.jupiter.api.Assertions.assertNotNull;
+import static org.junit.jupiter.api.Assertions.assertTrue;
+
+import java.io.IOException;
+import java.nio.charset.StandardCharsets;
+import java.nio.file.Files;
+import java.nio.file.Path;
+import java.util.ArrayList;
+import java.util.Collections;
+import java.util.LinkedHashMap;
+import java.util.List;
+import java.util.Map;
+import java.util.Random;
+import java.util.Set;
+import java.util.TreeSet;
+import java.util.concurrent.atomic.AtomicReference;
+import org.junit.jupiter.api.AfterAll;
+import org.junit.jupiter.api.BeforeAll;
+import org.junit.jupiter.api.MethodOrderer;
+import org.junit.jupiter.api.Order;
+import org.junit.jupiter.api.Test;
+import org.junit.jupiter.api.TestInstance;
+import org.junit.jupiter.api.TestMethodOrder;
+
+/**
+ * The main job's cell end to end through the real runtime: the runtime assembly with
+ * {@code arflex.evaluation=true} (sim-robot publishes the simulator's ground truth, read here
+ * only), the bundles and settings of its own {@code conf/cell.gosh} installed in a shuffled
+ * (seeded) order, real RT processes, real cameras rendering 1280x1024 frames, vision, and the
+ * tcp-correction outer loop. The steps share one runtime and run in order:
+ * <ol>
+ * <li>every component of the cell reaches ACTIVE, wired as the contracts say (filters);</li>
+ * <li>the robot follows the demonstration program (its joints swing through the program's
+ * targets and settle at its last target, tracking the corrected reference);</li>
+ * <li>the TRUE static TCP error with the correction on is far below the error with it off
+ * (ratio asserted with margin; figures printed);</li>
+ * <li>vision loss at runtime: the cameras are uninstalled and reinstalled; tcp-correction,
+ * sim-robot, trajectory and vision keep their processes and keep cycling, the robot's
+ * reference never steps beyond the correction's rate limit, and the loop comes back;</li>
+ * <li>a debug monitor installed while the cell runs reads tcp-correction's internal values and
+ * is uninstalled; the rest keeps cycling.</li>
+ * </ol>
+ * Waits are conditions with deadlines; nothing is asserted on timing. The runtime's leak check
+ * ({@link Runtime#close()}) runs at the end.
+ */
+@TestInstance(TestInstance.Lifecycle.PER_CLASS)
+@TestMethodOrder(MethodOrderer.OrderAnnotation.class)
+class CellE2EIT {
+
+    /** Components conf/cell.gosh installs (the cell of the main job). */
+    static final Set<String> CELL = Set.of("force-guard", "trajectory", "tool-gripper", "sim-robot", "tcp-correction",
+            "sim-camera-0", "sim-camera-1", "sim-camera-2", "sim-camera-3", "vision", "sample-counter", "sample-scaler");
+    /** The components whose cycling is watched across structural changes. */
+    static final String[] LOOP = {"sim-robot", "trajectory", "tcp-correction", "force-guard", "vision"};
+    /** Last target of the built-in demonstration program (bundles/trajectory/native/trajectory.cc). */
+    static final double[] FINAL = {0, 0.2, 0.5, 0, 0.6, 0};
+    /** tcp-correction's max_rate (contract default), rad/s, and the servo period, s. */
+    static final double MAX_RATE = 0.01;
+    static final double PERIOD = 0.001;
+    static final long T = 60_000;
+
+    Runtime rt;
+    Path evalAssembly;
+    final Map<String, Long> bundleIds = new LinkedHashMap<>();
+    final Map<String, Path> jars = new LinkedHashMap<>();
+    final List<String> report = new ArrayList<>();
+    final Map<String, Long> pids = new LinkedHashMap<>();
+    final Map<String, Long> cycles = new LinkedHashMap<>();
+    double errOffMm = Double.NaN;
+    double errOnMm = Double.NaN;
+
+    @BeforeAll
+    void startRuntime() throws Exception {
+        // A private copy of the assembly whose configuration makes this an evaluation run.
+        Path assembly = Path.of(System.getProperty("arflex.it.runtime"));
+        evalAssembly = Path.of(System.getProperty("arflex.it.work")).resolve("cell-e2e-assembly");
+        Runtime.deleteTree(evalAssembly);
+        Runtime.copyTree(assembly, evalAssembly);
+        Files.writeString(evalAssembly.resolve("conf/config.properties"),
+                "\n# CellE2EIT: an evaluation run (ground truth of simulated robots)\narflex.evaluation=true\n",
+                StandardCharsets.UTF_8, java.nio.file.StandardOpenOption.APPEND);
+        String old = System.getProperty("arflex.it.runtime");
+        System.setProperty("arflex.it.runtime", evalAssembly.toString());
+        try {
+            rt = new Runtime("cell-e2e");
+        } finally {
+            System.setProperty("arflex.it.runtime", old);
+        }
+        raiseRuntimePriority();
+    }
+
+    @AfterAll
+    void stopRuntime() throws Exception {
+        report.add("operator resets (heartbeat losses, guard trips) during the run: " + operatorResets);
+        System.out.println("CellE2EIT report:");
+        report.forEach(r -> System.out.println("  " + r));
+        try {
+            if (rt != null) {
+                rt.close();
+            }
+        } finally {
+            Runtime.deleteTree(evalAssembly);
+        }
+    }
+
+    /**
+     * As scripts/run-cell.sh does for the main job: the runtime JVM (whose heartbeat thread the
+     * 1 ms components watch with a 100 ms timeout) runs at nice -10, above the cell's
+     * best-effort rendering and vision (nice 19). Needs root or CAP_SYS_NICE; without it the
+     * test runs at the default priority and says so.
+     */
+    void raiseRuntimePriority() throws Exception {
+        long jvm = -1;
+        try (var ds = Files.newDirectoryStream(Path.of("/proc"))) {
+            for (Path p : ds) {
+                if (!p.getFileName().toString().matches("\\d+")) {
+                    continue;
+                }
+                try {
+                    String cl = new String(Files.readAllBytes(p.resolve("cmdline")), StandardCharsets.UTF_8);
+                    if (cl.contains("-Darflex.runtime.id=" + rt.rid + "\0")) {
+                        jvm = Long.parseLong(p.getFileName().toString());
+                    }
+                } catch (IOException ignored) {
+                    // ended while we looked
+                }
+            }
+        }
+        assertTrue(jvm > 0, "runtime JVM of " + rt.rid + " not found");
+        List<String> cmd = new ArrayList<>(List.of("renice", "-n", "-10", "-p"));
+        try (var ds = Files.newDirectoryStream(Path.of("/proc/" + jvm + "/task"))) {
+            ds.forEach(t -> cmd.add(t.getFileName().toString()));
+        }
+        Process p = new ProcessBuilder(cmd).redirectErrorStream(true).start();
+        String out = new String(p.getInputStream().readAllBytes(), StandardCharsets.UTF_8);
+        report.add(p.waitFor() == 0 ? "runtime JVM " + jvm + " at nice -10 (" + (cmd.size() - 4) + " threads)"
+                : "runtime JVM left at its priority (renice: " + out.strip() + ")");
+    }
+
+    // ---- helpers --------------------------------------------------------------------------
+
+    Path seg(String inst, String port) {
+        return rt.segment(inst, port);
+    }
+
+    @SuppressWarnings("unchecked")
+    static long cyclesOf(Map<String, Object> inst) {
+        Map<String, Object> st = (Map<String, Object>) inst.get("stats");
+        return st == null ? -1 : ((Number) st.get("cycles")).longValue();
+    }
+
+    /**
+     * Components waiting for an operator reset: restarted ones (the DTO's awaitingReset) and
+     * those whose RT half latched RESET_REQUIRED itself (a moving component after a runtime
+     * heartbeat loss, the force guard after a trip; read from the control block).
+     */
+    List<String> awaitingReset() {
+        Map<String, Object> dto = rt.dto();
+        return Runtime.names(dto, i -> Boolean.TRUE.equals(i.get("awaitingReset"))
+                || (CellPorts.ctlFlags(Path.of("/dev/shm/arflex." + rt.rid + "." + i.get("name") + ".ctl"))
+                        & CellPorts.FLAG_RESET_REQUIRED) != 0);
+    }
+
+    final Map<String, Integer> operatorResets = new java.util.TreeMap<>();
+    long lastOperatorCheck;
+
+    /**
+     * The operator at the cell: at most once a second, resets what waits for a reset. On this
+     * small shared machine the runtime's heartbeat is sometimes late by more than the 1 ms
+     * components' 100 ms timeout; they then hold (safe mode) and, as they move hardware, wait
+     * for an operator's reset (a trip of the force guard too). Every reset is counted and
+     * printed in the report; the structural steps assert same pids and advancing cycle
+     * counters, which a safe-mode episode does not change.
+     */
+    void operator() {
+        long now = System.nanoTime();
+        if (now - lastOperatorCheck < 1_000_000_000L) {
+            return;
+        }
+        lastOperatorCheck = now;
+        for (String n : awaitingReset()) {
+            rt.cmd("arflex:reset " + n);
+            operatorResets.merge(n, 1, Integer::sum);
+        }
+    }
+
+    /** Records pids and cycle counters of the loop's components as the reference point. */
+    void markLoop(String step) {
+        Map<String, Object> dto = rt.dto();
+        for (String n : LOOP) {
+            Map<String, Object> i = Runtime.list(dto, "instances").stream().filter(x -> n.equals(x.get("name")))
+                    .findFirst().orElseThrow();
+            pids.put(n, ((Number) i.get("pid")).longValue());
+            cycles.put(n, cyclesOf(i));
+        }
+        report.add(step + ": pids " + pids + ", cycles " + cycles);
+    }
+
+    /** Same pids as at the mark, ACTIVE, not awaiting a reset, cycle counters past the mark. */
+    void assertLoopKeptCycling(String step) {
+        for (String n : LOOP) {
+            long before = cycles.get(n);
+            long[] now = {0};
+            rt.waitUntil(n + " cycling past " + before + " with pid " + pids.get(n) + " at '" + step + "'", T, () -> {
+                Map<String, Object> i = rt.instance(n);
+                assertEquals("ACTIVE", i.get("state"), n + " at '" + step + "'");
+                assertEquals(pids.get(n), ((Number) i.get("pid")).longValue(), n + " was restarted at '" + step + "'");
+                now[0] = cyclesOf(i);
+                return now[0] > before;
+            });
+            cycles.put(n, now[0]);
+        }
+        report.add(step + ": same pids, cycles " + cycles);
+    }
+
+    /**
+     * Polls the motion chain's ports every 2 ms on its own thread: the program's reference, the
+     * corrected reference, the joint state. Keeps the joint 1 range seen and, while armed, the
+     * largest step of the corrected reference beyond the correction's rate limit (per cycle of
+     * tcp-correction, counted by the output's seq) and whether the program's reference moved.
+     */
+    final class Recorder implements AutoCloseable {
+        final AtomicReference<String> error = new AtomicReference<>();
+        volatile double q1Min = Double.MAX_VALUE;
+        volatile double q1Max = -Double.MAX_VALUE;
+        volatile boolean armed;
+        volatile double maxExcess;
+        volatile double maxRefMove;
+        volatile long samples;
+        volatile CellPorts.Joints lastCorrected;
+        private CellPorts.Joints armedRef;
+        private final CellPorts.State ref;
+        private final CellPorts.State corrected;
+        private final CellPorts.State state;
+        private final Thread thread;
+        private volatile boolean stop;
+
+        Recorder() throws IOException {
+            ref = new CellPorts.State(seg("trajectory", "joint_ref"), CellPorts.JOINT_REF);
+            corrected = new CellPorts.State(seg("tcp-correction", "corrected"), CellPorts.JOINT_REF);
+            state = new CellPorts.State(seg("sim-robot", "joint_state"), CellPorts.JOINT_STATE);
+            thread = new Thread(this::run, "cell-e2e-recorder");
+            thread.setDaemon(true);
+            thread.start();
+        }
+
+        void arm() {
+            maxExcess = 0;
+            maxRefMove = 0;
+            armedRef = null;
+            armed = true;
+        }
+
+        private void run() {
+            CellPorts.Joints last = null;
+            while (!stop) {
+                CellPorts.Joints s = CellPorts.Joints.of(state.read(), true);
+                if (s != null) {
+                    q1Min = Math.min(q1Min, s.q()[0]);
+                    q1Max = Math.max(q1Max, s.q()[0]);
+                }
+                CellPorts.Joints c = CellPorts.Joints.of(corrected.read(), false);
+                CellPorts.Joints r = CellPorts.Joints.of(ref.read(), false);
+                if (c != null) {
+                    if (last != null && c.seq() < last.seq() && error.get() == null) {
+                        error.set("tcp-correction's output seq went back from " + last.seq() + " to " + c.seq());
+                    }
+                    if (armed && last != null && c.seq() > last.seq()) {
+                        double limit = MAX_RATE * PERIOD * (c.seq() - last.seq());
+                        maxExcess = Math.max(maxExcess, c.maxAbsDiff(last) - limit);
+                    }
+                    last = c;
+                    lastCorrected = c;
+                    samples++;
+                }
+                if (armed && r != null) {
+                    if (armedRef == null) {
+                        armedRef = r;
+                    }
+                    maxRefMove = Math.max(maxRefMove, r.maxAbsDiff(armedRef));
+                }
+                try {
+                    Thread.sleep(2); // sampling interval of a recorder, not a wait for a condition
+                } catch (InterruptedException e) {
+                    return;
+                }
+            }
+        }
+
+        @Override
+        public void close() throws Exception {
+            stop = true;
+            thread.interrupt();
+            thread.join(10_000);
+            ref.close();
+            corrected.close();
+            state.close();
+        }
+    }
+
+    /** The TRUE TCP error now (mm): the simulator's true TCP against the program's target. */
+    double trueErrorMm(CellPorts.State truth, CellPorts.State ref) {
+        CellPorts.Truth t = CellPorts.Truth.of(truth.read());
+        CellPorts.Joints r = CellPorts.Joints.of(ref.read(), false);
+        assertNotNull(t, "no ground truth");
+        assertNotNull(r, "no reference");
+        return 1e3 * NominalArm.distance(t.p(), NominalArm.tcp(r.q()));
+    }
+
+    /**
+     * Waits until the true error has settled: {@code n} consecutive new vision measurements
+     * (tcp-correction's error output) with the robot at rest, the true error after each within
+     * {@code bandMm} of the one before. Returns the mean of those true errors (mm).
+     */
+    double settledTrueError(String what, int n, double bandMm, long timeoutMs) throws IOException {
+        try (CellPorts.State truth = new CellPorts.State(seg("sim-robot", "truth"), CellPorts.TRUTH);
+                CellPorts.State ref = new CellPorts.State(seg("trajectory", "joint_ref"), CellPorts.JOINT_REF);
+                CellPorts.State js = new CellPorts.State(seg("sim-robot", "joint_state"), CellPorts.JOINT_STATE);
+                CellPorts.State err = new CellPorts.State(seg("tcp-correction", "error"), CellPorts.SAMPLE)) {
+            List<Double> run = new ArrayList<>();
+            long[] lastSeq = {-1};
+            double[] prev = {Double.NaN};
+            StringBuilder trace = new StringBuilder();
+            rt.waitUntil(what + " (" + n + " vision measurements in a row within " + bandMm + " mm)", timeoutMs, () -> {
+                operator();
+                CellPorts.Sample e = CellPorts.Sample.of(err.read());
+                long seq = e == null ? 0 : e.seq();
+                if (seq == lastSeq[0]) {
+                    return false;
+                }
+                lastSeq[0] = seq;
+                CellPorts.Joints s = CellPorts.Joints.of(js.read(), true);
+                double now = trueErrorMm(truth, ref);
+                if (trace.length() < 2000) {
+                    trace.append(String.format(" %.4f", now));
+                }
+                if (s == null || s.maxAbsVelocity() > 1e-3 || !(Math.abs(now - prev[0]) <= bandMm)) {
+                    run.clear();
+                }
+                prev[0] = now;
+                run.add(now);
+                return run.size() >= n;
+            });
+            report.add(what + ": true error after each measurement (mm):" + trace);
+            return run.stream().mapToDouble(Double::doubleValue).average().orElseThrow();
+        }
+    }
+
+    // ---- the steps ------------------------------------------------------------------------
+
+    @Test
+    @Order(1)
+    void cellInstalledInAShuffledOrderAllActiveAndWired() throws Exception {
+        List<String> gosh = Files.readAllLines(rt.dir.resolve("conf/cell.gosh"), StandardCharsets.UTF_8);
+        List<Path> toStart = new ArrayList<>();
+        List<String> settings = new ArrayList<>();
+        for (String line : gosh) {
+            String l = line.strip();
+            if (l.startsWith("start file:@CELL@/")) {
+                toStart.add(rt.dir.resolve("cell").resolve(l.substring("start file:@CELL@/".length())));
+            } else if (l.startsWith("arflex:set ")) {
+                settings.add(l);
+            } else {
+                assertTrue(l.isEmpty() || l.startsWith("#"), "cell.gosh line CellE2EIT does not know: " + l);
+            }
+        }
+        long seed = Long.getLong("arflex.it.seed", System.nanoTime());
+        Collections.shuffle(toStart, new Random(seed));
+        report.add("install order (seed " + seed + ", rerun with -Darflex.it.seed=" + seed + "): "
+                + toStart.stream().map(p -> p.getFileName().toString()).toList());
+        for (Path jar : toStart) {
+            assertTrue(Files.isRegularFile(jar), "cell bundle missing: " + jar);
+            jars.put(jar.getFileName().toString(), jar);
+            bundleIds.put(jar.getFileName().toString(), rt.installAndStart(jar));
+        }
+        for (String s : settings) {
+            String[] w = s.split("\\s+");
+            String r = rt.cmd(s);
+            assertTrue(r.startsWith(w[1] + "." + w[2] + " = "), s + ": " + r);
+        }
+        rt.awaitState("ACTIVE", 120_000, CELL.toArray(new String[0]));
+        Map<String, Object> dto = rt.dto();
+        assertEquals(new TreeSet<>(CELL), new TreeSet<>(Runtime.names(dto, i -> true)), "the cell's instances");
+        String bindings = rt.cmd("arflex:bindings");
+        for (String b : List.of("tcp-correction.reference <- trajectory.joint_ref",
+                "sim-robot.joint_ref <- tcp-correction.corrected", "tcp-correction.tcp_pose <- vision.tcp_pose",
+                "vision.cam0 <- sim-camera-0.frames", "vision.cam3 <- sim-camera-3.frames",
+                "trajectory.safety <- force-guard.safety")) {
+            assertTrue(bindings.contains(b), "binding '" + b + "' missing:\n" + bindings);
+        }
+        @SuppressWarnings("unchecked")
+        Map<String, Object> eval = (Map<String, Object>) rt.instance("sim-robot").get("evaluationSegments");
+        assertTrue(eval != null && eval.containsKey("truth"), "no ground truth segment: " + eval);
+        report.add("admitted: " + rt.cmd("arflex:resources").replace('\n', ';'));
+        // The operator's start-up check: a component that lost the runtime's heartbeat while the
+        // cell was being installed (this machine is small and shared) waits for a reset.
+        report.add("awaiting a reset after start-up: " + awaitingReset());
+        lastOperatorCheck = 0;
+        operator();
+    }
+
+    @Test
+    @Order(2)
+    void robotFollowsTheProgram() throws Exception {
+        try (Recorder rec = new Recorder()) {
+            // Replay the demonstration program (it ran once while the cell came up, maybe before
+            // the robot was wired): loop it until the joints have swung through its targets.
+            assertEquals("trajectory.loop = true", rt.cmd("arflex:set trajectory loop true"));
+            rt.waitUntil("joint 1 of the robot swinging through the program's lin targets (y = +-0.3 m)", 120_000,
+                    () -> {
+                        operator();
+                        return rec.q1Max > 0.1 && rec.q1Min < -0.1;
+                    });
+            assertEquals("trajectory.loop = false", rt.cmd("arflex:set trajectory loop false"));
+            try (CellPorts.State ref = new CellPorts.State(seg("trajectory", "joint_ref"), CellPorts.JOINT_REF);
+                    CellPorts.State js = new CellPorts.State(seg("sim-robot", "joint_state"), CellPorts.JOINT_STATE)) {
+                double[] dev = {0, 0};
+                rt.waitUntil("the program's last target reached and the robot at rest on the corrected reference", 120_000,
+                        () -> {
+                            operator();
+                            CellPorts.Joints r = CellPorts.Joints.of(ref.read(), false);
+                            CellPorts.Joints s = CellPorts.Joints.of(js.read(), true);
+                            CellPorts.Joints c = rec.lastCorrected;
+                            if (r == null || s == null || c == null) {
+                                return false;
+                            }
+                            dev[0] = r.maxAbsDiff(new CellPorts.Joints(0, 0, FINAL, null));
+                            dev[1] = s.maxAbsDiff(c);
+                            return dev[0] < 1e-6 && s.maxAbsVelocity() < 1e-3 && dev[1] < 1e-3;
+                        });
+                report.add(String.format("program: joint 1 range %.3f .. %.3f rad; at the last target the arm is %.2e rad"
+                        + " from the corrected reference", rec.q1Min, rec.q1Max, dev[1]));
+            }
+            assertEquals(null, rec.error.get());
+        }
+    }
+
+    @Test
+    @Order(3)
+    void trueErrorWithTheCorrectionIsFarBelowWithout() throws Exception {
+        try (Recorder rec = new Recorder()) {
+            // Off: the correction ramps out to exactly the program's reference.
+            assertEquals("tcp-correction.enable = false", rt.cmd("arflex:set tcp-correction enable false"));
+            try (CellPorts.State ref = new CellPorts.State(seg("trajectory", "joint_ref"), CellPorts.JOINT_REF)) {
+                rt.waitUntil("the correction ramped out", T, () -> {
+                    CellPorts.Joints r = CellPorts.Joints.of(ref.read(), false);
+                    CellPorts.Joints c = rec.lastCorrected;
+                    return r != null && c != null && c.maxAbsDiff(r) == 0.0;
+                });
+            }
+            errOffMm = settledTrueError("correction off", 3, 0.002, 90_000);
+            // On: vision measures, tcp-correction corrects.
+            assertEquals("tcp-correction.enable = true", rt.cmd("arflex:set tcp-correction enable true"));
+            double[] best = {Double.MAX_VALUE};
+            try (CellPorts.State truth = new CellPorts.State(seg("sim-robot", "truth"), CellPorts.TRUTH);
+                    CellPorts.State ref = new CellPorts.State(seg("trajectory", "joint_ref"), CellPorts.JOINT_REF)) {
+                rt.waitUntil("the true error corrected below a fifth of " + errOffMm + " mm", 120_000, () -> {
+                    operator();
+                    double e = trueErrorMm(truth, ref);
+                    best[0] = Math.min(best[0], e);
+                    return e < errOffMm / 5;
+                });
+            }
+            errOnMm = settledTrueError("correction on", 4, 0.05, 120_000);
+            double ratio = errOffMm / errOnMm;
+            report.add(String.format("TRUE static TCP error at the program's last target: off %.4f mm, on %.4f mm,"
+                    + " ratio %.1fx", errOffMm, errOnMm, ratio));
+            assertTrue(ratio >= 5, String.format("correction on %.4f mm vs off %.4f mm: ratio %.2f < 5", errOnMm, errOffMm,
+                    ratio));
+            assertEquals(null, rec.error.get());
+        }
+    }
+
+    @Test
+    @Order(4)
+    void visionLossAtRuntimeKeepsTheLoopCyclingAndTheReferenceSmooth() throws Exception {
+        String cameras = "org.arflex.sim.camera.jar";
+        assertNotNull(bundleIds.get(cameras), "cameras not installed by step 1");
+        try (Recorder rec = new Recorder();
+                CellPorts.State err = new CellPorts.State(seg("tcp-correction", "error"), CellPorts.SAMPLE)) {
+            rt.waitUntil("the recorder running", T, () -> rec.samples > 10);
+            markLoop("before vision loss");
+            rec.arm();
+            assertEquals("", rt.cmd("uninstall " + bundleIds.remove(cameras)));
+            rt.waitUntil("the cameras gone", T, () -> {
+                Map<String, Object> dto = rt.dto();
+                return Runtime.names(dto, i -> ((String) i.get("name")).startsWith("sim-camera")
+                        && !"DESTROYED".equals(i.get("state"))).isEmpty();
+            });
+            String bindings = rt.cmd("arflex:bindings");
+            assertTrue(!bindings.contains("vision.cam"), "vision still bound to a camera:\n" + bindings);
+            assertLoopKeptCycling("cameras uninstalled");
+            // No new measurement can arrive now; the loop holds while the robot keeps cycling.
+            CellPorts.Sample held = CellPorts.Sample.of(err.read());
+            long robotAt = cycles.get("sim-robot");
+            rt.waitUntil("sim-robot 2000 cycles further without cameras", T,
+                    () -> cyclesOf(rt.instance("sim-robot")) > robotAt + 2000);
+            CellPorts.Sample still = CellPorts.Sample.of(err.read());
+            assertTrue(held != null && still != null && still.seq() <= held.seq() + 1,
+                    "measurements arrived without cameras: " + held + " -> " + still);
+            assertLoopKeptCycling("vision lost, 2000 robot cycles later");
+
+            // The cameras come back: vision rebinds, measurements resume.
+            jars.put(cameras, jars.get(cameras));
+            bundleIds.put(cameras, rt.installAndStart(jars.get(cameras)));
+            rt.awaitState("ACTIVE", 120_000, "sim-camera-0", "sim-camera-1", "sim-camera-2", "sim-camera-3");
+            rt.waitUntil("vision rebound to the four cameras", T, () -> {
+                String b = rt.cmd("arflex:bindings");
+                return b.contains("vision.cam0 <- sim-camera-0.frames") && b.contains("vision.cam3 <- sim-camera-3.frames");
+            });
+            long seqBack = still.seq();
+            rt.waitUntil("vision measurements arriving again", 120_000, () -> {
+                CellPorts.Sample s = CellPorts.Sample.of(err.read());
+                return s != null && s.seq() > seqBack + 2;
+            });
+            assertLoopKeptCycling("cameras reinstalled");
+            rec.armed = false;
+            report.add(String.format("vision loss: corrected reference steps at most %.2e rad beyond the rate limit"
+                    + " (%d samples), program reference moved %.2e rad", rec.maxExcess, rec.samples, rec.maxRefMove));
+            assertTrue(rec.maxExcess <= 1e-9, "the robot's reference stepped " + rec.maxExcess + " rad beyond the rate limit");
+            assertTrue(rec.maxRefMove == 0.0, "the program's reference moved by " + rec.maxRefMove + " rad at rest");
+            assertEquals(null, rec.error.get());
+        }
+        double back = settledTrueError("correction on after vision came back", 3, 0.05, 120_000);
+        report.add(String.format("after vision came back: true error %.4f mm (off was %.4f mm)", back, errOffMm));
+        assertTrue(back <= errOffMm / 5, "true error after vision came back " + back + " mm, off was " + errOffMm + " mm");
+    }
+
+    @Test
+    @Order(5)
+    void debugMonitorInstalledReadsTheCorrectionAndIsRemovedWhileTheCellKeepsCycling() throws Exception {
+        // The shipped debug monitor watches the sample pair; an engineer's variant of its
+        // contract watches tcp-correction's error and correction instead (bundles/debug-monitor).
+        Path monitor = rt.dir.resolve("debug-monitor-tcp.jar");
+        Jars.withContract(DebugMonitorIT.DEBUGMON, monitor,
+                c -> c.replace("<bind component=\"sample-counter\" port=\"count\"/>",
+                        "<bind component=\"tcp-correction\" port=\"error\"/>")
+                        .replace("<bind component=\"sample-scaler\" port=\"y\"/>",
+                                "<bind component=\"tcp-correction\" port=\"correction\"/>"));
+        markLoop("before the debug monitor");
+        long id = rt.installAndStart(monitor);
+        rt.awaitState("ACTIVE", T, "debug-monitor");
+        String bindings = rt.cmd("arflex:bindings");
+        assertTrue(bindings.contains("debug-monitor.m0 <- tcp-correction.error"), bindings);
+        assertTrue(bindings.contains("debug-monitor.m1 <- tcp-correction.correction"), bindings);
+        assertLoopKeptCycling("debug monitor installed");
+        try (CellPorts.State m0 = new CellPorts.State(seg("debug-monitor", "m0_last"), CellPorts.SAMPLE);
+                CellPorts.State m1 = new CellPorts.State(seg("debug-monitor", "m1_last"), CellPorts.SAMPLE);
+                CellPorts.State err = new CellPorts.State(seg("tcp-correction", "error"), CellPorts.SAMPLE);
+                CellPorts.State size = new CellPorts.State(seg("tcp-correction", "correction"), CellPorts.SAMPLE)) {
+            // m0_last is a verbatim copy of tcp-correction's error output: the same seq, the same value.
+            int[] matched = {0};
+            long[] last = {-1};
+            rt.waitUntil("the monitor showing 2 vision measurements of tcp-correction", 120_000, () -> {
+                CellPorts.Sample a = CellPorts.Sample.of(m0.read());
+                CellPorts.Sample b = CellPorts.Sample.of(err.read());
+                if (a != null && b != null && a.seq() == b.seq() && a.seq() != last[0]) {
+                    assertEquals(b.value(), a.value(), 0.0, "m0_last vs tcp-correction.error of seq " + a.seq());
+                    last[0] = a.seq();
+                    matched[0]++;
+                }
+                return matched[0] >= 2;
+            });
+            CellPorts.Sample first = CellPorts.Sample.of(m1.read());
+            rt.waitUntil("the monitor following tcp-correction's correction", T, () -> {
+                CellPorts.Sample a = CellPorts.Sample.of(m1.read());
+                CellPorts.Sample b = CellPorts.Sample.of(size.read());
+                return a != null && b != null && first != null && a.seq() > first.seq() && a.seq() <= b.seq();
+            });
+            report.add("debug monitor: m0_last = tcp-correction.error (" + matched[0] + " measurements, last "
+                    + CellPorts.Sample.of(m0.read()) + "), m1_last = " + CellPorts.Sample.of(m1.read()));
+        }
+        assertLoopKeptCycling("debug monitor watching");
+        assertEquals("", rt.cmd("uninstall " + id));
+        rt.waitUntil("debug-monitor gone (instance, process, ports)", T, () -> {
+            Map<String, Object> i = rt.instance("debug-monitor");
+            boolean gone = i == null || "DESTROYED".equals(i.get("state"));
+            return gone && !Files.exists(seg("debug-monitor", "m0_last"))
+                    && Runtime.rtProcesses(rt.rid).stream().noneMatch(p -> p.contains("--instance debug-monitor"));
+        });
+        assertLoopKeptCycling("debug monitor uninstalled");
+    }
+}
