@@ -116,15 +116,9 @@ bool ResetEdge(struct arflex_component* c) {
   return edge;
 }
 
-int Update(struct arflex_component* c, void*, uint64_t release_ns) {
-  ResetEdge(c);
-  // update runs again only when RESET_REQUIRED is clear: the operator's RESET came.
-  if (g.latched && !(__atomic_load_n(&arflex_component_ctl(c)->flags, __ATOMIC_ACQUIRE) &
-                     ARFLEX_FLAG_RESET_REQUIRED)) {
-    g.latched = false;
-    g.reason = 0;
-  }
-  ReadInputs();
+// Measures the external joint torques and the contact force (sets g.force_norm) against the
+// limits; returns the reason bits of what is above a limit (0 = nothing).
+uint32_t Measure(struct arflex_component* c) {
   const double payload = arflex_param_f64(c, g.p_payload);
   uint32_t reason = 0;
   Q q;
@@ -151,6 +145,19 @@ int Update(struct arflex_component* c, void*, uint64_t release_ns) {
     }
     if (g.force_norm > arflex_param_f64(c, g.p_force)) reason |= ARFLEX_SAFETY_STATE_FLAG_FORCE_LIMIT;
   }
+  return reason;
+}
+
+int Update(struct arflex_component* c, void*, uint64_t release_ns) {
+  ResetEdge(c);
+  // update runs again only when RESET_REQUIRED is clear: the operator's RESET came.
+  if (g.latched && !(__atomic_load_n(&arflex_component_ctl(c)->flags, __ATOMIC_ACQUIRE) &
+                     ARFLEX_FLAG_RESET_REQUIRED)) {
+    g.latched = false;
+    g.reason = 0;
+  }
+  ReadInputs();
+  const uint32_t reason = Measure(c);
   if (reason && !g.latched) {
     g.latched = true;
     g.reason = reason;
@@ -164,6 +171,7 @@ int Safe(struct arflex_component* c, void*, enum arflex_safe_mode, bool) {
   struct arflex_ctl* ctl = Ctl(c);
   const uint64_t now = arflex_sys_now_ns();
   ReadInputs();
+  Measure(c);  // the stop keeps publishing the current contact force (is the contact gone?)
   if (ResetEdge(c) && g.latched) {
     g.latched = false;
     g.reason = 0;

@@ -39,18 +39,22 @@ constexpr int kMaxPrograms = 100;  // program indices 0 (built-in) .. 99
 
 // The built-in demonstration program (index 0): a loop through the work space in front of
 // the robot, joint and Cartesian motions mixed. The lin targets are reachable from the
-// preceding poses (checked by the cell.trajectory.builtin test).
+// preceding poses (checked by the cell.trajectory.builtin test). Slow on purpose: the
+// simulated arm's drives move joint 2 at about 0.19 rad/s at most (its damping); a faster
+// reference makes the arm lag and then stop abruptly, which the wrist reads as 170-410 N
+// and the force guard (150 N) rightly takes for contact. 0.08 of the joint speed limits and
+// 0.1 m/s keep the arm on the reference.
 const char kBuiltin[] =
     "arflex-program 1\n"
     "# built-in demonstration program (trajectory, index 0)\n"
     "start 0 0 0 0 0 0\n"
-    "ptp 0 0.2 0.5 0 0.6 0\n"
-    "lin 2.0 0.3 1.2 0.70710678 0 0.70710678 0 speed 0.4\n"
-    "lin 2.0 -0.3 1.2 0.70710678 0 0.70710678 0 speed 0.4\n"
-    "lin 1.7 -0.3 0.9 0.70710678 0 0.70710678 0 speed 0.4\n"
-    "ptp 0.4 0.3 0.4 0 0.8 0.2 speed 0.5\n"
+    "ptp 0 0.2 0.5 0 0.6 0 speed 0.08\n"
+    "lin 2.0 0.3 1.2 0.70710678 0 0.70710678 0 speed 0.1\n"
+    "lin 2.0 -0.3 1.2 0.70710678 0 0.70710678 0 speed 0.1\n"
+    "lin 1.7 -0.3 0.9 0.70710678 0 0.70710678 0 speed 0.1\n"
+    "ptp 0.4 0.3 0.4 0 0.8 0.2 speed 0.08\n"
     "wait 0.5\n"
-    "ptp 0 0.2 0.5 0 0.6 0\n";
+    "ptp 0 0.2 0.5 0 0.6 0 speed 0.08\n";
 
 struct State {
   Model model;
@@ -69,6 +73,7 @@ struct State {
   bool safety_seen = false;
   uint64_t seq = 0;
   uint64_t tool_seq = 0;
+  int64_t playing = 0;  // the program the player plays
 } g;
 
 int Param(struct arflex_component* c, const char* name, int* idx) {
@@ -153,6 +158,7 @@ int Start(struct arflex_component* c, void*) {
   if (n < 0 || n >= kMaxPrograms || g.programs[n].motions.empty()) return -ENOENT;
   const struct arflex_ctl* ctl = arflex_component_ctl(c);
   g.player.Begin(&g.model, &g.programs[n], ctl->config.period_ns * 1e-9);
+  g.playing = n;
   g.safety_seen = false;
   g.tool_seen = false;
   return 0;
@@ -222,13 +228,28 @@ int Step(struct arflex_component* c, uint64_t release_ns, bool force_stop) {
     else if (g.safety.mode == ARFLEX_SAFETY_STATE_MODE_LIMITED)
       rate = std::min(rate, std::max(0.0, std::min(1.0, g.safety.power_scale)));
   }
+  // Another program selected while running: taken at the next standstill (between motions,
+  // at the end, or paused), from where the arm is. One that was not loaded when the RT half
+  // started is refused (-ENOENT, counted by rt-core as an update error) and the current one
+  // goes on.
+  const int64_t want = arflex_param_i64(c, g.p_program);
+  int switch_err = 0;
+  if (want != g.playing) {
+    if (want < 0 || want >= kMaxPrograms || g.programs[want].motions.empty()) {
+      switch_err = -ENOENT;
+    } else if (g.player.at_rest()) {
+      g.player.Begin(&g.model, &g.programs[want], arflex_component_ctl(c)->config.period_ns * 1e-9);
+      g.playing = want;
+    }
+  }
   const traj::Limits lim = CurrentLimits(c);
   g.player.Step(lim, rate, arflex_param_bool(c, g.p_loop));
   struct arflex_joint_ref ref;
   ref.t_ns = (int64_t)release_ns;
   ref.seq = ++g.seq;
   for (int j = 0; j < 6; ++j) ref.q[j] = g.player.q_out()[j];
-  return arflex_state_write(g.out, &ref, sizeof(ref));
+  r = arflex_state_write(g.out, &ref, sizeof(ref));
+  return r < 0 ? r : switch_err;
 }
 
 int Update(struct arflex_component* c, void*, uint64_t release_ns) {

@@ -91,6 +91,45 @@ final class CellRig {
         return id;
     }
 
+    /**
+     * Starts the trajectory on program {@code n} of the runtime's data directory. Parameters
+     * set while a component is only Installed are reset to the contract's defaults when it
+     * starts (the DRCR today), so the program is chosen once it runs: paused at once, switched
+     * to {@code n} (taken at the standstill), resumed. {@code params}: name, value, ... set
+     * while paused. Returns the bundle id.
+     */
+    static long startTrajectory(Runtime rt, int n, String... params) throws IOException {
+        long id = rt.installAndStart(TRAJECTORY);
+        rt.awaitState("ACTIVE", T, "trajectory");
+        set(rt, "trajectory", "run", "false");
+        set(rt, "trajectory", "program", Integer.toString(n));
+        for (int i = 0; i + 1 < params.length; i += 2) {
+            set(rt, "trajectory", params[i], params[i + 1]);
+        }
+        try (Port ref = new Port(rt.segment("trajectory", "joint_ref"), REF_SIZE)) {
+            long[] still = {0, 0};
+            double[][] last = {null};
+            rt.waitUntil("the trajectory at a standstill (paused)", T, () -> {
+                Ref r = Ref.of(ref.read());
+                if (r == null) {
+                    return false;
+                }
+                if (last[0] != null && java.util.Arrays.equals(last[0], r.q())) {
+                    if (still[0] == 0) {
+                        still[0] = r.seq();
+                    }
+                    still[1] = r.seq();
+                } else {
+                    still[0] = 0;
+                }
+                last[0] = r.q();
+                return still[0] != 0 && still[1] - still[0] >= 50;
+            });
+        }
+        set(rt, "trajectory", "run", "true");
+        return id;
+    }
+
     static void set(Runtime rt, String inst, String param, String value) {
         String r = rt.cmd("arflex:set " + inst + " " + param + " " + value);
         assertTrue(r.startsWith(inst + "." + param + " = "), "arflex:set " + inst + " " + param + " " + value + ": " + r);
@@ -219,12 +258,39 @@ final class CellRig {
         return m;
     }
 
+    /** Values in arrival order, shared between the recorder thread and the test. */
+    static final class Trace<V> {
+        private final List<V> values = new ArrayList<>();
+
+        synchronized void add(V v) {
+            values.add(v);
+        }
+
+        synchronized int size() {
+            return values.size();
+        }
+
+        /** The newest value, or null. */
+        synchronized V last() {
+            return values.isEmpty() ? null : values.get(values.size() - 1);
+        }
+
+        synchronized V get(int i) {
+            return values.get(i);
+        }
+
+        /** A copy of everything so far. */
+        synchronized List<V> snapshot() {
+            return new ArrayList<>(values);
+        }
+    }
+
     /** KR 210-class joint speed limits the trajectory's limiter holds (rad/s). */
     static final double[] VMAX = {Math.toRadians(123), Math.toRadians(115), Math.toRadians(112), Math.toRadians(179),
             Math.toRadians(172), Math.toRadians(219)};
 
     /**
-     * Polls a set of ports in a thread of its own every ~100 us (the ports change every
+     * Polls a set of ports in a thread of its own every ~200 us (the ports change every
      * millisecond; a value overwritten before a poll is missed, which the tests account for by
      * checking seq gaps) and hands every new value (by seq) to its consumer.
      */
@@ -261,8 +327,8 @@ final class CellRig {
                     for (Runnable r : polls) {
                         r.run();
                     }
-                    // ~100 us between polls: most 1 ms values are seen without taking a core
-                    java.util.concurrent.locks.LockSupport.parkNanos(100_000);
+                    // ~200 us between polls: most 1 ms values are seen without taking a core
+                    java.util.concurrent.locks.LockSupport.parkNanos(200_000);
                 }
             } catch (Throwable t) {
                 error = t;
