@@ -7,7 +7,8 @@
 // (state, arflex.Sample: the size of the applied joint correction, Euclidean norm in mrad,
 // every cycle), the last two for plots and monitors. Parameters (defaults when absent from the
 // contract): gain, max_step (rad per measurement), max_rate (rad/s), max_correction (rad),
-// enable (bool), orientation (bool).
+// enable (bool), orientation (bool), max_sigma (m: a measurement whose largest position
+// standard deviation is larger is held like an invalid one).
 //
 // Every cycle: read the reference (nothing is written until one arrived); on a new tcp_pose
 // (its seq changed) update the correction law with the nominal Jacobian and the nominal TCP
@@ -15,6 +16,7 @@
 // measurement holds the correction; then ramp the applied correction towards its target at
 // max_rate and write reference + correction with the reference's time and a fresh seq.
 // Disabling ramps the correction out. Fixed-size Eigen only: update() does not allocate.
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -39,7 +41,8 @@ struct TcpCorrection {
   arflex_port* out = nullptr;
   arflex_port* error = nullptr;
   arflex_port* size = nullptr;
-  int p_gain = -1, p_step = -1, p_rate = -1, p_max = -1, p_enable = -1, p_orientation = -1;
+  int p_gain = -1, p_step = -1, p_rate = -1, p_max = -1, p_enable = -1, p_orientation = -1, p_sigma = -1;
+  double max_sigma = 2e-4;  // m: a measurement less certain than this is treated as invalid
   arflex::sim::NominalKinematics kinematics{arflex::sim::DefaultArm()};
   CorrectionLaw law{CorrectionOptions{}};
   arflex_joint_ref ref{};
@@ -68,6 +71,7 @@ void ApplyParams(arflex_component* c) {
   o.max_correction = F64(c, g.p_max, 2e-2);
   o.orientation = Bool(c, g.p_orientation, false);
   g.law.SetOptions(o);  // invalid values (outside the contract's ranges) keep the old ones
+  g.max_sigma = F64(c, g.p_sigma, 2e-4);
   const bool enable = Bool(c, g.p_enable, true);
   if (enable != g.law.enabled()) g.law.SetEnabled(enable);
 }
@@ -85,6 +89,7 @@ int Configure(arflex_component* c, void*) {
   g.p_max = arflex_component_param(c, "max_correction");
   g.p_enable = arflex_component_param(c, "enable");
   g.p_orientation = arflex_component_param(c, "orientation");
+  g.p_sigma = arflex_component_param(c, "max_sigma");
   const uint64_t period = arflex_component_ctl(c)->config.period_ns;
   g.dt = period > 0 ? period * 1e-9 : 0.001;
   ApplyParams(c);
@@ -121,10 +126,16 @@ int Update(arflex_component* c, void*, uint64_t) {
     Eigen::Isometry3d measured = Eigen::Isometry3d::Identity();
     measured.linear() = Eigen::Quaterniond(m.quat[0], m.quat[1], m.quat[2], m.quat[3]).normalized().toRotationMatrix();
     measured.translation() = Eigen::Vector3d(m.p[0], m.p[1], m.p[2]);
+    // A measurement is used only when vision says it is valid and its position is certain
+    // enough: the largest position variance against max_sigma (a single camera view gives
+    // millimetres along its line of sight; several views give hundredths).
+    const double var = std::max(m.cov[0], std::max(m.cov[1], m.cov[2]));
+    const bool certain = std::isfinite(var) && var <= g.max_sigma * g.max_sigma;
+    const bool valid = m.valid != 0 && certain;
     const Eigen::Isometry3d desired = g.kinematics.Tcp(q);
-    g.law.Update(g.kinematics.TcpJacobian(q), desired, measured, m.valid != 0);
+    g.law.Update(g.kinematics.TcpJacobian(q), desired, measured, valid);
     const double err_mm = 1e3 * (desired.translation() - measured.translation()).norm();
-    if (m.valid != 0 && std::isfinite(err_mm)) {
+    if (valid && std::isfinite(err_mm)) {
       // What vision sees of the TCP's distance from where the reference wants it (mm).
       arflex_sample e{};
       e.seq = ++g.error_seq;

@@ -104,6 +104,7 @@ struct Rig {
   double first_error_mm = -1;  // the first value of the `error` output
   double last_error_mm = -1;   // the newest one
   double last_size_mrad = -1;  // the newest `correction` value
+  double meas_var = 0;         // position variance the plant's measurements report (m^2)
   arflex::sim::NominalKinematics kin{arflex::sim::DefaultArm()};
   arflex_joint_ref last{};
   uint64_t pose_seq = 0;
@@ -223,6 +224,7 @@ struct Rig {
     p.quat[1] = quat.x();
     p.quat[2] = quat.y();
     p.quat[3] = quat.z();
+    for (int i = 0; i < 3; ++i) p.cov[i] = meas_var;
     p.valid = valid ? 1 : 0;
     p.n_views = valid ? 4 : 0;
     arflex_state_write(arflex_host_output(&feeder, "tcp_pose"), &p, sizeof(p));
@@ -281,6 +283,14 @@ int RunCase(const std::string& name, const char* exe) {
     rig.Watch(300 * kMs, true, false, Eigen::Vector3d(0.01, 0, 0));
     for (int i = 0; i < 6; ++i) {
       CHECK(rig.last.q[i] == before.q[i], "joint %d moved from %.12f to %.12f while vision was out", i,
+            before.q[i], rig.last.q[i]);
+    }
+    // Valid but uncertain measurements (1 mm standard deviation > max_sigma 0.2 mm) are held too.
+    rig.meas_var = 1e-6;
+    rig.Watch(300 * kMs, true, true, Eigen::Vector3d(0.01, 0, 0));
+    rig.meas_var = 0;
+    for (int i = 0; i < 6; ++i) {
+      CHECK(rig.last.q[i] == before.q[i], "joint %d moved from %.12f to %.12f on uncertain measurements", i,
             before.q[i], rig.last.q[i]);
     }
     // Disabled: the correction ramps out at max_rate, to exactly the reference.
