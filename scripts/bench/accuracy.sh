@@ -6,7 +6,7 @@
 #   scripts/bench/accuracy.sh [--quick] [--poses N] [--noise SIGMA] [--blur SIGMA]
 #                             [--period-ms P] [--width W --height H] [--no-refine]
 #                             [--with-orientation] [--outlier-px PX] [--only INDEX] [--trace]
-#                             [--calib-frames N] [--calib-at-home] [--average K] [--diag] [--no-loop]
+#                             [--calib-frames N] [--calib-at-home] [--average K] [--diag] [--no-loop] [--cameras LIST]
 # Uses the Maven-built native tree (target/native) or ARFLEX_NATIVE_DIR; builds the benchmark
 # there if it is missing. JSON goes to target/bench/accuracy.json. Takes 10-30 minutes on a
 # loaded 2-core machine (software rendering dominates); --quick runs only payload 0.

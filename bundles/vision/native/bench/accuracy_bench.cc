@@ -15,13 +15,13 @@
 //                              [--noise SIGMA] [--blur SIGMA] [--period-ms P] [--quick]
 //                              [--no-refine] [--only INDEX] [--trace] [--outlier-px PX]
 //                              [--with-orientation] [--calib-frames N] [--calib-at-home]
-//                              [--average K] [--diag] [--no-loop]
+//                              [--average K] [--diag] [--no-loop] [--cameras LIST]
 // --quick: only the payload-0 run; --no-refine: AprilTag's corners without the edge re-fit;
 // --calib-frames: frames pooled per camera for the board calibration (8); --calib-at-home:
 // calibrate with the arm in front of the board (default: parked facing away); --average: frames
 // averaged per final update once the loop has converged (4; 1 = off); --diag: per camera / tag
 // corner errors against the simulator's projections, calibration errors, static check;
-// --no-loop: diagnostics only (no correction).
+// --no-loop: diagnostics only (no correction); --cameras 2,3: the cameras of the --quick run.
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -72,6 +72,7 @@ struct Args {
   // from the cameras is too uncertain (tens of mdeg) to correct with; --with-orientation.
   bool position_only = true;
   int only = -1;       // run only this target (debugging)
+  std::vector<int> quick_cameras = {0, 1, 2, 3};  // cameras of the --quick run (--cameras)
   bool trace = false;  // print every measurement of the loop
   int calib_frames = 8;  // frames pooled for each camera's board calibration
   bool calib_home = false;  // calibrate with the arm at home (in front of the board)
@@ -751,7 +752,7 @@ bool ParseArgs(int argc, char** argv, Args* a) {
     }
     if (k == "--json" || k == "--width" || k == "--height" || k == "--poses" || k == "--noise" ||
         k == "--blur" || k == "--period-ms" || k == "--only" || k == "--outlier-px" ||
-        k == "--calib-frames" || k == "--average") {
+        k == "--calib-frames" || k == "--average" || k == "--cameras") {
       if (!(v = value(k.c_str()))) return false;
     } else {
       std::fprintf(stderr, "accuracy-bench: unknown argument '%s'\n", k.c_str());
@@ -760,6 +761,22 @@ bool ParseArgs(int argc, char** argv, Args* a) {
     char* end = nullptr;
     if (k == "--json") {
       a->json = v;
+      continue;
+    }
+    if (k == "--cameras") {
+      a->quick_cameras.clear();
+      for (const char* c = v; *c; ++c) {
+        if (*c == ',') continue;
+        if (*c < '0' || *c > '3') {
+          std::fprintf(stderr, "accuracy-bench: --cameras: '%s' is not a list of cameras 0-3 (e.g. 2,3)\n", v);
+          return false;
+        }
+        a->quick_cameras.push_back(*c - '0');
+      }
+      if (a->quick_cameras.empty()) {
+        std::fprintf(stderr, "accuracy-bench: --cameras needs at least one camera\n");
+        return false;
+      }
       continue;
     }
     const double x = std::strtod(v, &end);
@@ -821,7 +838,10 @@ int main(int argc, char** argv) {
       {"blocked-2", 0, {2, 3}, true, false},
       {"nominal-tool", 0, {0, 1, 2, 3}, false, false},
   };
-  if (args.quick) specs.resize(1);
+  if (args.quick) {
+    specs.resize(1);
+    specs[0].cams = args.quick_cameras;
+  }
   std::printf("arflex-accuracy-bench: %d poses, %dx%d, noise %.1f DN, blur %.1f px, vision "
               "period %d ms (simulated time), corner re-fit %s, outlier threshold %.2f px, "
               "correcting %s; calibration: %d frames per camera, arm %s; static average %d frames\n",
