@@ -8,7 +8,8 @@
 // every cycle), the last two for plots and monitors. Parameters (defaults when absent from the
 // contract): gain, max_step (rad per measurement), max_rate (rad/s), max_correction (rad),
 // enable (bool), orientation (bool), max_sigma (m: a measurement whose largest position
-// standard deviation is larger is held like an invalid one).
+// standard deviation is larger is held like an invalid one), track_tol (rad: with the optional
+// input joint_state bound, a robot further than this from the last output holds the correction).
 //
 // Every cycle: read the reference (nothing is written until one arrived); on a new tcp_pose
 // (its seq changed) update the correction law with the nominal Jacobian and the nominal TCP
@@ -27,6 +28,7 @@ extern "C" {
 #include "arflex_sim/kinematics.h"
 #include "arflex_tcpcorr/correction.h"
 #include "arflex_types/joint_ref.h"
+#include "arflex_types/joint_state.h"
 #include "arflex_types/pose.h"
 #include "arflex_types/sample.h"
 
@@ -38,10 +40,13 @@ using arflex::tcpcorr::CorrectionOptions;
 struct TcpCorrection {
   arflex_input* reference = nullptr;
   arflex_input* pose = nullptr;
+  arflex_input* robot = nullptr;  // optional: the robot's measured joints (tracking interlock)
   arflex_port* out = nullptr;
   arflex_port* error = nullptr;
   arflex_port* size = nullptr;
-  int p_gain = -1, p_step = -1, p_rate = -1, p_max = -1, p_enable = -1, p_orientation = -1, p_sigma = -1;
+  int p_gain = -1, p_step = -1, p_rate = -1, p_max = -1, p_enable = -1, p_orientation = -1, p_sigma = -1,
+      p_track = -1;
+  double track_tol = 2e-3;  // rad: a robot further than this from our output is not following
   double max_sigma = 2e-4;  // m: a measurement less certain than this is treated as invalid
   arflex::sim::NominalKinematics kinematics{arflex::sim::DefaultArm()};
   CorrectionLaw law{CorrectionOptions{}};
@@ -50,6 +55,8 @@ struct TcpCorrection {
   uint64_t pose_seq = 0;
   uint64_t out_seq = 0;
   uint64_t error_seq = 0;
+  double last_out[6] = {0, 0, 0, 0, 0, 0};  // the corrected reference written last
+  arflex_joint_state js{};                   // the robot's newest joint state (seq 0: none)
   double dt = 0.001;
 };
 
@@ -57,6 +64,7 @@ TcpCorrection g;
 
 const arflex_port_type kRefType = {ARFLEX_TYPE_JOINT_REF_NAME, 1, 0, ARFLEX_TYPE_JOINT_REF_SIZE};
 const arflex_port_type kPoseType = {ARFLEX_TYPE_POSE_NAME, 1, 0, ARFLEX_TYPE_POSE_SIZE};
+const arflex_port_type kStateType = {ARFLEX_TYPE_JOINT_STATE_NAME, 1, 0, ARFLEX_TYPE_JOINT_STATE_SIZE};
 const arflex_port_type kSampleType = {ARFLEX_TYPE_SAMPLE_NAME, 1, 0, ARFLEX_TYPE_SAMPLE_SIZE};
 
 double F64(arflex_component* c, int idx, double def) { return idx >= 0 ? arflex_param_f64(c, idx) : def; }
@@ -72,6 +80,7 @@ void ApplyParams(arflex_component* c) {
   o.orientation = Bool(c, g.p_orientation, false);
   g.law.SetOptions(o);  // invalid values (outside the contract's ranges) keep the old ones
   g.max_sigma = F64(c, g.p_sigma, 2e-4);
+  g.track_tol = F64(c, g.p_track, 2e-3);
   const bool enable = Bool(c, g.p_enable, true);
   if (enable != g.law.enabled()) g.law.SetEnabled(enable);
 }
@@ -79,6 +88,7 @@ void ApplyParams(arflex_component* c) {
 int Configure(arflex_component* c, void*) {
   int r = arflex_component_input(c, "reference", ARFLEX_PORT_STATE, &kRefType, &g.reference);
   if (r == 0) r = arflex_component_input(c, "tcp_pose", ARFLEX_PORT_STATE, &kPoseType, &g.pose);
+  if (r == 0) r = arflex_component_input(c, "joint_state", ARFLEX_PORT_STATE, &kStateType, &g.robot);
   if (r == 0) r = arflex_component_output(c, "corrected", ARFLEX_PORT_STATE, &kRefType, &g.out);
   if (r == 0) r = arflex_component_output(c, "error", ARFLEX_PORT_STATE, &kSampleType, &g.error);
   if (r == 0) r = arflex_component_output(c, "correction", ARFLEX_PORT_STATE, &kSampleType, &g.size);
@@ -90,6 +100,7 @@ int Configure(arflex_component* c, void*) {
   g.p_enable = arflex_component_param(c, "enable");
   g.p_orientation = arflex_component_param(c, "orientation");
   g.p_sigma = arflex_component_param(c, "max_sigma");
+  g.p_track = arflex_component_param(c, "track_tol");
   const uint64_t period = arflex_component_ctl(c)->config.period_ns;
   g.dt = period > 0 ? period * 1e-9 : 0.001;
   ApplyParams(c);
@@ -106,22 +117,28 @@ int Start(arflex_component* c, void*) {
   g.law = CorrectionLaw(g.law.options());
   ApplyParams(c);
   g.have_ref = false;
+  g.js = arflex_joint_state{};
   return 0;
 }
 
 int Update(arflex_component* c, void*, uint64_t) {
   ApplyParams(c);
-  arflex_joint_ref ref;
-  if (arflex_input_state_read(g.reference, &ref, sizeof(ref), nullptr) >= 0 && ref.seq != 0) {
+  // A state read returns 1 only for a value newer than the last one it returned (0: none new,
+  // the buffer untouched), so only a 1 may be used.
+  arflex_joint_ref ref{};
+  if (arflex_input_state_read(g.reference, &ref, sizeof(ref), nullptr) == 1 && ref.seq != 0) {
     g.ref = ref;
     g.have_ref = true;
   }
   if (!g.have_ref) return 0;
   arflex::sim::JointVector q;
   for (int i = 0; i < 6; ++i) q[i] = g.ref.q[i];
-  arflex_pose m;
+  arflex_joint_state js{};
+  if (arflex_input_state_read(g.robot, &js, sizeof(js), nullptr) == 1 && js.seq != 0) g.js = js;
+  if (!arflex_input_bound(g.robot)) g.js.seq = 0;  // no robot: no interlock
+  arflex_pose m{};
   uint64_t seq = 0;
-  if (arflex_input_state_read(g.pose, &m, sizeof(m), &seq) >= 0 && m.seq != 0 && m.seq != g.pose_seq) {
+  if (arflex_input_state_read(g.pose, &m, sizeof(m), &seq) == 1 && m.seq != 0 && m.seq != g.pose_seq) {
     g.pose_seq = m.seq;
     Eigen::Isometry3d measured = Eigen::Isometry3d::Identity();
     measured.linear() = Eigen::Quaterniond(m.quat[0], m.quat[1], m.quat[2], m.quat[3]).normalized().toRotationMatrix();
@@ -131,7 +148,15 @@ int Update(arflex_component* c, void*, uint64_t) {
     // millimetres along its line of sight; several views give hundredths).
     const double var = std::max(m.cov[0], std::max(m.cov[1], m.cov[2]));
     const bool certain = std::isfinite(var) && var <= g.max_sigma * g.max_sigma;
-    const bool valid = m.valid != 0 && certain;
+    // Tracking interlock: when the robot's measured joints are bound and it is not where our
+    // last output asked it to be (safe mode, a hold, a protective stop, still moving), a
+    // measurement says nothing about the correction: holding it avoids winding the correction
+    // up against a robot that does not move (it would jump when the robot follows again).
+    bool tracking = true;
+    if (g.out_seq != 0 && g.js.seq != 0) {
+      for (int i = 0; i < 6; ++i) tracking = tracking && std::abs(g.js.q[i] - g.last_out[i]) <= g.track_tol;
+    }
+    const bool valid = m.valid != 0 && certain && tracking;
     const Eigen::Isometry3d desired = g.kinematics.Tcp(q);
     g.law.Update(g.kinematics.TcpJacobian(q), desired, measured, valid);
     const double err_mm = 1e3 * (desired.translation() - measured.translation()).norm();
@@ -153,6 +178,7 @@ int Update(arflex_component* c, void*, uint64_t) {
   size.t_ns = out.t_ns;
   size.value = 1e3 * dq.norm();
   arflex_state_write(g.size, &size, sizeof(size));
+  for (int i = 0; i < 6; ++i) g.last_out[i] = out.q[i];
   return arflex_state_write(g.out, &out, sizeof(out));
 }
 

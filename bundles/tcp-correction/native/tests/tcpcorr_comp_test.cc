@@ -22,6 +22,7 @@ extern "C" {
 }
 #include "arflex_sim/kinematics.h"
 #include "arflex_types/joint_ref.h"
+#include "arflex_types/joint_state.h"
 #include "arflex_types/pose.h"
 #include "arflex_types/sample.h"
 
@@ -111,7 +112,7 @@ struct Rig {
   double max_jump_excess = 0;  // largest step beyond max_rate * period * cycles
 
   int Create(const char* exe) {
-    struct arflex_host_output fo[2];
+    struct arflex_host_output fo[3];
     std::memset(fo, 0, sizeof(fo));
     fo[0].port = "reference";
     fo[0].spec.method = ARFLEX_PORT_STATE;
@@ -121,13 +122,17 @@ struct Rig {
     fo[1].spec.method = ARFLEX_PORT_STATE;
     fo[1].spec.type = {ARFLEX_TYPE_POSE_NAME, 1, 0, ARFLEX_TYPE_POSE_SIZE};
     fo[1].spec.depth = 1;
+    fo[2].port = "joint_state";
+    fo[2].spec.method = ARFLEX_PORT_STATE;
+    fo[2].spec.type = {ARFLEX_TYPE_JOINT_STATE_NAME, 1, 0, ARFLEX_TYPE_JOINT_STATE_SIZE};
+    fo[2].spec.depth = 1;
     arflex_host_opts o;
     std::memset(&o, 0, sizeof(o));
     o.runtime = rid;
     o.instance = "feeder";
     o.config = Config();
     o.outputs = fo;
-    o.noutputs = 2;
+    o.noutputs = 3;
     int r = arflex_host_create(&feeder, &o);
     if (r < 0) return r;
     arflex_param_slot p[6] = {
@@ -292,6 +297,22 @@ int RunCase(const std::string& name, const char* exe) {
     for (int i = 0; i < 6; ++i) {
       CHECK(rig.last.q[i] == before.q[i], "joint %d moved from %.12f to %.12f on uncertain measurements", i,
             before.q[i], rig.last.q[i]);
+    }
+    // Tracking interlock: the robot's joints bound and 10 mrad away from the output (a robot
+    // holding in safe mode): valid, certain measurements 10 mm off are held too.
+    {
+      arflex_joint_state js;
+      std::memset(&js, 0, sizeof(js));
+      js.seq = 1;
+      for (int i = 0; i < 6; ++i) js.q[i] = before.q[i] + 0.01;
+      arflex_state_write(arflex_host_output(&rig.feeder, "joint_state"), &js, sizeof(js));
+      CHECK(arflex_host_bind(&rig.corr, "joint_state", arflex_host_output_name(&rig.feeder, "joint_state"), 2 * kSec) == 0,
+            "BIND joint_state");
+      rig.Watch(300 * kMs, true, true, Eigen::Vector3d(0.01, 0, 0));
+      for (int i = 0; i < 6; ++i) {
+        CHECK(rig.last.q[i] == before.q[i], "joint %d moved from %.12f to %.12f while the robot did not follow", i,
+              before.q[i], rig.last.q[i]);
+      }
     }
     // Disabled: the correction ramps out at max_rate, to exactly the reference.
     CHECK(arflex_host_set_param(&rig.corr, "enable", 0, nullptr, 2 * kSec) == 0, "SET_PARAM enable");
