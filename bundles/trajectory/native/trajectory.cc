@@ -238,7 +238,7 @@ int Step(struct arflex_component* c, uint64_t release_ns, bool force_stop) {
     if (want < 0 || want >= kMaxPrograms || g.programs[want].motions.empty()) {
       switch_err = -ENOENT;
     } else if (g.player.at_rest()) {
-      g.player.Begin(&g.model, &g.programs[want], arflex_component_ctl(c)->config.period_ns * 1e-9);
+      g.player.Switch(&g.programs[want]);
       g.playing = want;
     }
   }

@@ -75,6 +75,16 @@ void Player::Begin(const cellkin::Model* model, const cellkin::Program* program,
   q_plan_prev_ = q_plan_;
 }
 
+void Player::Switch(const cellkin::Program* program) {
+  prog_ = program;
+  done_ = false;
+  active_ = false;
+  path_ = false;
+  idx_ = 0;
+  tau_ = 0;
+  q_plan_prev_ = q_plan_;
+}
+
 void Player::Init(const Q& q0) {
   q_plan_ = q_plan_prev_ = q_out_ = ik_q_ = q0;
   v_out_.setZero();

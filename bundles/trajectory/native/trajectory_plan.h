@@ -85,9 +85,15 @@ class Player {
   const Q& q_plan() const { return q_plan_; }
   const cellkin::Program* program() const { return prog_; }
   bool done() const { return done_; }
-  // At a standstill: between two motions, at the end of the program, or paused (time rate 0)
-  // with the output at rest. A program switch waits for this.
-  bool at_rest() const { return (!active_ || done_ || rate_ == 0) && v_out_.cwiseAbs().maxCoeff() < 1e-9; }
+  // At a standstill of the plan: between two motions or at the end of the program (every
+  // motion ends at rest), or paused (time rate 0) with the output at rest. A program switch
+  // waits for this.
+  bool at_rest() const {
+    return !active_ || done_ || (rate_ == 0 && v_out_.cwiseAbs().maxCoeff() < 1e-9);
+  }
+  // Plays another program from the current plan position; unlike Begin it keeps the output
+  // and its velocity, so the limiter goes on smoothly. Call it only at_rest().
+  void Switch(const cellkin::Program* program);
   size_t index() const { return idx_; }
   uint64_t ik_warnings() const { return ik_warnings_; }
   uint64_t limited_cycles() const { return limited_cycles_; }

@@ -187,7 +187,7 @@ int SetI(struct arflex_host* h, const char* n, int64_t v) {
 }
 
 std::vector<struct arflex_param_slot> TrajectoryParams() {
-  return {PI("program", 0, 0, 99, false),      PB("run", true, true),
+  return {PI("program", 0, 0, 99, true),       PB("run", true, true),
           PB("loop", false, true),             PI("profile", 0, 0, 1, true),
           PD("speed", 1, 0.01, 1, true),       PD("accel", 3, 0.1, 50, true),
           PD("accel_max", 20, 0.1, 200, true), PD("lin_speed", 0.25, 0.001, 2, true),
@@ -307,6 +307,62 @@ void CaseTrajectory() {
          s.size(), (unsigned long long)pairs, worst);
   CHECK(pairs > 200, "only %llu consecutive cycle pairs observed", (unsigned long long)pairs);
   CHECK(worst <= 1.0 + 1e-9, "a joint moved %.4f x vmax*dt in one cycle", worst);
+  CHECK(arflex_host_stop(&traj, kCall) == 0, "stop");
+}
+
+// A program selected while running is taken at the next standstill: the running joint motion
+// of program 1 ends on its target, then program 2 plays from there; program 1's second
+// motion never starts. Every consecutive pair of cycles within the speed limits.
+void CaseProgramSwitch() {
+  static struct arflex_host traj;
+  const std::string dir = MakeDataDir();
+  CHECK(!dir.empty(), "mkdtemp");
+  bool ok = WriteText(arflex::cellkin::ProgramPath(dir, 1),
+                      "arflex-program 1\nstart 0 0 0 0 0 0\nptp 0.3 0 0 0 0 0 speed 0.3\n"
+                      "ptp 0.6 0 0 0 0 0 speed 0.3\n") &&
+            WriteText(arflex::cellkin::ProgramPath(dir, 2),
+                      "arflex-program 1\nptp 0.3 0.3 0 0 0 0 speed 0.3\n");
+  std::string env = "ARFLEX_DATA_DIR=" + dir;
+  char* envp[] = {const_cast<char*>(env.c_str()), nullptr};
+  int r = ok ? Make(&traj, "trajectory", kMs, {{"joint_ref", kRefT}, {"tool_id", kSampleT}}, TrajectoryParams(),
+                    "trajectory", envp)
+             : -EIO;
+  RemoveDir(dir);
+  CHECK(r == 0, "create/spawn trajectory: %d", r);
+  CHECK(SetI(&traj, "program", 1) == 0 && arflex_host_start(&traj, kCall) == 0, "start program 1");
+  Reader rd;
+  CHECK(rd.Open(&traj, "joint_ref", &kRefT) == 0, "open joint_ref");
+  bool switched = false;
+  double max_q0 = 0, q0_at_q1 = -1;
+  uint64_t stable = 0;
+  Q last = Q::Zero();
+  const uint64_t deadline = Now() + kWait;
+  while (Now() < deadline) {
+    struct arflex_joint_ref ref;
+    uint64_t seq;
+    if (rd.Read(&ref, &seq) != 1) {
+      sched_yield();
+      continue;
+    }
+    Q q;
+    for (int j = 0; j < 6; ++j) q[j] = ref.q[j];
+    max_q0 = std::max(max_q0, q[0]);
+    if (!switched && q[0] > 0.05) {  // in the middle of program 1's first motion
+      CHECK(SetI(&traj, "program", 2) == 0, "set program 2 while running");
+      switched = true;
+    }
+    if (q0_at_q1 < 0 && q[1] > 1e-6) q0_at_q1 = q[0];  // program 2 began
+    stable = (q - last).norm() == 0 ? stable + 1 : 0;
+    last = q;
+    if (std::fabs(q[1] - 0.3) < 1e-12 && stable > 50) break;
+  }
+  printf("program_switch: program 2 began at q1 = %.9f (program 1's first target 0.3), q1 max %.9f\n",
+         q0_at_q1, max_q0);
+  CHECK(switched, "program 1 never moved");
+  CHECK(std::fabs(last[1] - 0.3) < 1e-12, "program 2 did not reach its target (q2 = %g)", last[1]);
+  CHECK(std::fabs(q0_at_q1 - 0.3) < 1e-9, "program 2 began before program 1's motion ended (q1 = %g)",
+        q0_at_q1);
+  CHECK(max_q0 <= 0.3 + 1e-9, "program 1's second motion started (q1 reached %g)", max_q0);
   CHECK(arflex_host_stop(&traj, kCall) == 0, "stop");
 }
 
@@ -737,7 +793,7 @@ void CaseBadProgram() {
 
 int main(int argc, char** argv) {
   if (argc != 3) {
-    fprintf(stderr, "usage: %s <trajectory|bad_program|force_guard|teach_replay|tools> <bin dir>\n", argv[0]);
+    fprintf(stderr, "usage: %s <trajectory|program_switch|bad_program|force_guard|teach_replay|tools> <bin dir>\n", argv[0]);
     return 2;
   }
   bindir = argv[2];
@@ -748,6 +804,7 @@ int main(int argc, char** argv) {
   else if (c == "teach_replay") CaseTeachReplay();
   else if (c == "tools") CaseTools();
   else if (c == "bad_program") CaseBadProgram();
+  else if (c == "program_switch") CaseProgramSwitch();
   else {
     fprintf(stderr, "unknown case '%s'\n", argv[1]);
     return 2;
