@@ -723,9 +723,16 @@ void CaseTeachReplay() {
 // One tool provider after the other behind the same consumer code: the same port type, the
 // consumer's reader opens either; each follows the command from the same command segment.
 void CaseTools() {
-  static struct arflex_host script, grip, spin;
+  static struct arflex_host script, grip, spin, traj;
   int r = Make(&script, "script", kMs, {{"command", kSampleT}}, {}, nullptr);
   CHECK(r == 0, "script: %d", r);
+  // The consumer the cell has: trajectory's tool input, bound to each tool in turn (the
+  // DRCR's rebinding); its tool_id output tells which tool lin motions are planned for.
+  r = Make(&traj, "trajectory", kMs, {{"joint_ref", kRefT}, {"tool_id", kSampleT}}, TrajectoryParams(),
+           "trajectory");
+  CHECK(r == 0 && arflex_host_start(&traj, kCall) == 0, "trajectory: %d", r);
+  Reader tid;
+  CHECK(tid.Open(&traj, "tool_id", &kSampleT) == 0, "open tool_id");
   struct arflex_sample cmd;
   memset(&cmd, 0, sizeof(cmd));
   cmd.seq = 1;
@@ -756,6 +763,20 @@ void CaseTools() {
     CHECK(ready, "%s never reached the commanded level", exes[i]);
     CHECK(s.tool_id == ids[i] && s.mass > 0 && s.tcp_quat[0] == 1.0, "%s state", exes[i]);
     printf("%s: tool_id %u, level %.2f, mass %.1f kg\n", exes[i], s.tool_id, s.command, s.mass);
+    CHECK(arflex_host_bind(&traj, "tool", arflex_host_output_name(tools[i], "tool"), kCall) == 0,
+          "bind trajectory.tool to %s", exes[i]);
+    // trajectory reports the mounted tool's id, then 0 (the flange) once it is unbound
+    for (const uint32_t want : {ids[i], 0u}) {
+      struct arflex_sample v;
+      bool seen = false;
+      const uint64_t d2 = Now() + kWait;
+      while (!seen && Now() < d2) {
+        if (tid.Read(&v, &seq) == 1 && v.value == (double)want) seen = true;
+        else sched_yield();
+      }
+      CHECK(seen, "trajectory's tool_id never showed %u with %s", want, exes[i]);
+      if (want != 0) CHECK(arflex_host_unbind(&traj, "tool", kCall) == 0, "unbind");
+    }
     CHECK(arflex_host_shutdown(tools[i], kCall) == 0 && arflex_host_wait_exit(tools[i], 5 * kSec) == 0,
           "shutdown %s", exes[i]);
   }
