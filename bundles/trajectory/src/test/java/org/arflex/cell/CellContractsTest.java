@@ -70,6 +70,15 @@ class CellContractsTest {
         // A tool's optional command input must not pick up an unrelated arflex.Sample source.
         assertTrue(!filterOf("tool-gripper", "command").matches(sampleSource));
         assertTrue(!filterOf("tool-spindle", "command").matches(sampleSource));
+        // trajectory's tool input takes either tool (a swap rebinds it), never a motion source.
+        for (String tool : List.of("tool-gripper", "tool-spindle")) {
+            assertTrue(filterOf("trajectory", "tool").matches(load(tool).attributes()), "trajectory.tool must bind " + tool);
+        }
+        assertTrue(!filterOf("trajectory", "tool").matches(load("teach").attributes()));
+        PortSpec in = load("trajectory").port("tool").orElseThrow();
+        PortSpec out = load("tool-gripper").port("tool").orElseThrow();
+        assertEquals(out.type(), in.type());
+        assertTrue(in.optional(), "trajectory runs without a tool (the flange)");
     }
 
     private static Filter filterOf(String component, String port) throws Exception {
