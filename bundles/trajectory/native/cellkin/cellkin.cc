@@ -343,7 +343,11 @@ bool WriteProgramFile(const std::string& path, const Program& p, std::string* er
 
 std::string DataDir() {
   const char* d = getenv("ARFLEX_DATA_DIR");
-  return d && *d ? std::string(d) : std::string("data");
+  if (d && *d) return d;
+  // Absolute, so that messages name the file unambiguously.
+  char cwd[4096];
+  if (getcwd(cwd, sizeof(cwd))) return std::string(cwd) + "/data";
+  return "data";
 }
 
 std::string ProgramPath(const std::string& dir, long n) {

@@ -117,9 +117,9 @@ bool LoadProgramFile(const std::string& path, const Model& model, Program* out,
 // Writes `p` to `path` atomically (temporary file in the same directory, fsync, rename),
 // mode 0600. Returns true or false with *err.
 bool WriteProgramFile(const std::string& path, const Program& p, std::string* err);
-// Where program files live: $ARFLEX_DATA_DIR when set and not empty, else "data", relative to
-// the working directory (an RT half started by the DRCR runs in the runtime's directory, so
-// that is <runtime>/data).
+// Where program files live: $ARFLEX_DATA_DIR when set and not empty, else <working
+// directory>/data (an RT half started by the DRCR runs in the runtime's directory, so that is
+// <runtime>/data), as an absolute path. Not for the RT thread (getcwd).
 std::string DataDir();
 // "<dir>/program-<n>.arp"
 std::string ProgramPath(const std::string& dir, long n);

@@ -155,6 +155,32 @@ class TeachIT {
         }
     }
 
+    /**
+     * A bad program file in the data directory: the trajectory's RT half refuses to start and
+     * the DRCR's reason carries its {@code file:line: what} (here a joint target outside the
+     * limits on line 3); nothing of it is left running.
+     */
+    @Test
+    void aBadProgramFileIsReportedWithFileAndLine() throws Exception {
+        CellRig.assertBuilt(CellRig.TRAJECTORY);
+        try (Runtime rt = new Runtime("teach-badprogram")) {
+            Files.createDirectories(rt.dir.resolve("data"));
+            Files.writeString(rt.dir.resolve("data/program-3.arp"),
+                    "arflex-program 1\nptp 0 0.2 0.5 0 0.6 0\nptp 0 0.2 0.5 0 0.6 9\n");
+            long id = rt.installAndStart(CellRig.TRAJECTORY);
+            String[] reason = {""};
+            rt.waitUntil("the trajectory's start refused naming program-3.arp:3", T, () -> {
+                var i = rt.instance("trajectory");
+                reason[0] = i == null ? "" : String.valueOf(i.get("failureReason"));
+                return reason[0].contains("program-3.arp:3:");
+            });
+            System.out.println("TeachIT: bad program reported as: " + reason[0].lines().filter(l -> l.contains("program-3.arp"))
+                    .findFirst().orElse(reason[0]));
+            assertTrue(reason[0].contains("joint 6"), reason[0]);
+            assertEquals("", rt.cmd("uninstall " + id));
+        }
+    }
+
     /** The joint vectors of a program written by teach: start, then every ptp/via target. */
     static List<double[]> readWaypoints(Path p) throws java.io.IOException {
         List<double[]> l = new ArrayList<>();
