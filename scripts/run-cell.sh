@@ -141,6 +141,17 @@ await_drcr() {
   done
 }
 
+await_active() {
+  local deadline=$((SECONDS + 60))
+  until grep -q "arflex: $1 ACTIVE" "$LOG"; do
+    if [ $SECONDS -ge $deadline ]; then
+      echo "echo 'arflex run: $1 is not ACTIVE after 60 s; its settings in conf/cell.gosh are skipped'"
+      return 1
+    fi
+    sleep 0.2
+  done
+}
+
 commands() {
   await_drcr || { echo "stop 0"; return; }
   echo "echo 'ARFLEX runtime up; installing the cell (conf/cell.gosh)'"
@@ -150,6 +161,11 @@ commands() {
   while IFS= read -r line || [ -n "$line" ]; do
     case "$line" in
       "#"*|"") ;;
+      arflex:set\ *)
+        # A parameter is set on the running component: a value set before its bundle's start
+        # has been processed is replaced by the contract's defaults when it starts.
+        await_active "$(set -- $line; echo "$2")"
+        printf '%s\n' "$line" ;;
       *) printf '%s\n' "${line//@CELL@/$RUNTIME_DIR/cell}" ;;
     esac
   done < conf/cell.gosh

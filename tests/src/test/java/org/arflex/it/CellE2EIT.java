@@ -376,12 +376,15 @@ class CellE2EIT {
             jars.put(jar.getFileName().toString(), jar);
             bundleIds.put(jar.getFileName().toString(), rt.installAndStart(jar));
         }
+        rt.awaitState("ACTIVE", 120_000, CELL.toArray(new String[0]));
+        // Settings go to the running components (as scripts/run-cell.sh does): a value set
+        // before a bundle's start has been processed is replaced by the contract's defaults.
         for (String s : settings) {
             String[] w = s.split("\\s+");
             String r = rt.cmd(s);
             assertTrue(r.startsWith(w[1] + "." + w[2] + " = "), s + ": " + r);
+            assertEquals(Double.parseDouble(w[3]), Double.parseDouble(rt.cmd("arflex:get " + w[1] + " " + w[2])), 0.0, s);
         }
-        rt.awaitState("ACTIVE", 120_000, CELL.toArray(new String[0]));
         Map<String, Object> dto = rt.dto();
         assertEquals(new TreeSet<>(CELL), new TreeSet<>(Runtime.names(dto, i -> true)), "the cell's instances");
         String bindings = rt.cmd("arflex:bindings");
