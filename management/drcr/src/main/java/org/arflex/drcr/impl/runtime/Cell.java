@@ -173,9 +173,9 @@ public final class Cell {
                 return false;
             }
             if (!existing.planned) {
+                existing.params = Instance.carried(existing.contract, existing.params, c);
                 existing.contract = c;
                 existing.policy = new RestartPolicy(c.fault(), actor.clock());
-                existing.params = Instance.defaults(c);
                 changed();
             }
             return true;
@@ -242,10 +242,10 @@ public final class Cell {
             inst = new Instance(c, bundleId, exe, actor, log);
             instances.put(c.name(), inst);
         } else {
+            inst.params = Instance.carried(inst.contract, inst.params, c);
             inst.contract = c;
             inst.executable = exe;
             inst.policy = new RestartPolicy(c.fault(), actor.clock());
-            inst.params = Instance.defaults(c);
             if (replace) {
                 closeOutputs(inst);
             }

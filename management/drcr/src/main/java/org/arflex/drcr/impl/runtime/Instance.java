@@ -76,4 +76,32 @@ public final class Instance {
         }
         return p;
     }
+
+    /**
+     * The parameters for contract {@code c} when it takes over from {@code old}: a value set
+     * before (by {@code arflex:set} while only installed, or in the running version) is kept
+     * for a property of the same name and type whose range still holds it; everything else
+     * takes the new contract's default.
+     */
+    static long[] carried(Contract old, long[] oldParams, Contract c) {
+        long[] p = defaults(c);
+        for (int i = 0; i < p.length; i++) {
+            PropertySpec ps = c.properties().get(i);
+            for (int j = 0; j < old.properties().size() && j < oldParams.length; j++) {
+                PropertySpec o = old.properties().get(j);
+                if (o.name().equals(ps.name()) && o.type() == ps.type() && inRange(ps, oldParams[j])) {
+                    p[i] = oldParams[j];
+                }
+            }
+        }
+        return p;
+    }
+
+    private static boolean inRange(PropertySpec ps, long bits) {
+        double v = switch (ps.type()) {
+            case DOUBLE -> Double.longBitsToDouble(bits);
+            case INT, BOOL -> bits;
+        };
+        return !Double.isNaN(v) && ps.min().map(m -> v >= m).orElse(true) && ps.max().map(m -> v <= m).orElse(true);
+    }
 }

@@ -342,6 +342,35 @@ class CellTest {
     }
 
     @Test
+    void parametersSetWhileInstalledAreKeptWhenTheComponentStarts() throws Exception {
+        Contract c = parse(contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us"));
+        assertTrue(actor.call(() -> cell.register(c, 7), 0));
+        assertEquals("3.5", actor.call(() -> cell.setParam("prov", "gain", "3.5"), 0));
+        assertEquals("2", actor.call(() -> cell.setParam("prov", "mode", "2"), 0));
+        assertTrue(actor.call(() -> cell.install(c, 7, Path.of("/x/prov")), 0));
+        assertEquals(State.ACTIVE, state("prov"));
+        FakeLauncher.FakeHalf h = launcher.running.get("prov");
+        assertEquals(Double.doubleToLongBits(3.5), h.params[0], "gain as set, not the default 2.0");
+        assertEquals(2, h.params[1]);
+        assertEquals("3.5", actor.call(() -> cell.getParam("prov", "gain"), 0));
+    }
+
+    @Test
+    void anUpdateKeepsSetValuesItsRangesStillHoldAndDefaultsTheRest() throws Exception {
+        String v1 = contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us");
+        install(v1);
+        actor.call(() -> cell.setParam("prov", "gain", "5"), 0);
+        // version 1.1.0: gain now at most 3 (5 no longer fits), mode unchanged
+        Contract v2 = parse(v1.replace("version=\"1.0.0\"", "version=\"1.1.0\"").replace("max=\"10\"", "max=\"3\""));
+        long id = "prov".hashCode();
+        assertTrue(actor.call(() -> cell.install(v2, id, Path.of("/x/prov")), 0), log::toString);
+        actor.runAll();
+        assertEquals(State.ACTIVE, state("prov"));
+        assertEquals("2", actor.call(() -> cell.getParam("prov", "gain"), 0).replace(".0", ""), "out of the new range: default");
+        assertEquals("1", actor.call(() -> cell.getParam("prov", "mode"), 0));
+    }
+
+    @Test
     void nameOwnedByAnotherBundleIsRefused() throws Exception {
         install(contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us"));
         Contract c = parse(contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us"));
