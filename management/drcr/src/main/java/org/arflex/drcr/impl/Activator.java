@@ -122,8 +122,24 @@ public final class Activator implements BundleActivator {
         // The shell finds management services in the registry, as any other client does.
         regs.add(ctx.registerService(Commands.class, new Commands(services, rm[0], services, name -> lookup(ctx, name),
                 (id, location) -> felixUpdate(ctx, id, location)), shell));
+        // The runtime heartbeat is what keeps the RT halves out of safe mode: its thread runs at a
+        // low SCHED_FIFO priority (below every component, above all ordinary load) so that a
+        // busy machine cannot starve it past a 100 ms heartbeat timeout.
+        int hbPriority = Integer.parseInt(prop(ctx, "arflex.heartbeat.priority", "1"));
+        if (hbPriority < 0 || hbPriority > 98) {
+            throw new IllegalArgumentException("arflex.heartbeat.priority " + hbPriority + " is not in 0..98 (0: no SCHED_FIFO)");
+        }
         ticker = new ScheduledThreadPoolExecutor(1, r -> {
-            Thread t = new Thread(r, "arflex-drcr-heartbeat");
+            Thread t = new Thread(() -> {
+                if (hbPriority > 0) {
+                    String why = Posix.fifoThisThread(hbPriority);
+                    if (why != null) {
+                        log.accept("arflex: heartbeat thread stays SCHED_OTHER (SCHED_FIFO " + hbPriority + " refused: "
+                                + why + "); a loaded machine may delay heartbeats");
+                    }
+                }
+                r.run();
+            }, "arflex-drcr-heartbeat");
             t.setDaemon(true);
             return t;
         });

@@ -69,6 +69,36 @@ public interface Posix extends Library {
 
     int kill(int pid, int sig) throws LastErrorException;
 
+    int SCHED_FIFO = 1;
+    long SYS_GETTID = 186;  // x86-64
+
+    long syscall(long number) throws LastErrorException;
+
+    int sched_setscheduler(int pid, int policy, SchedParam param) throws LastErrorException;
+
+    /** struct sched_param. */
+    @Structure.FieldOrder({"sched_priority"})
+    class SchedParam extends Structure {
+        public int sched_priority;
+    }
+
+    /**
+     * Puts the calling thread under SCHED_FIFO at {@code priority}.
+     *
+     * @return null when done, else why not (errno text)
+     */
+    static String fifoThisThread(int priority) {
+        try {
+            int tid = (int) LIBC.syscall(SYS_GETTID);
+            SchedParam p = new SchedParam();
+            p.sched_priority = priority;
+            LIBC.sched_setscheduler(tid, SCHED_FIFO, p);
+            return null;
+        } catch (LastErrorException e) {
+            return describe(e);
+        }
+    }
+
     /** struct timespec on x86-64. */
     @Structure.FieldOrder({"tv_sec", "tv_nsec"})
     class Timespec extends Structure {
