@@ -94,7 +94,7 @@
         el('td', {}, el('a', {href: pageUrl('arflex-component', {name: i.name})}, i.name)),
         el('td', {class: 'arflex-state-cell'}, stateBadge(i.state)),
         el('td', {}, i.targetState || ''),
-        el('td', {class: 'arflex-reason'}, i.failureReason || (i.awaitingReset ? 'waiting for operator reset' : '')),
+        el('td', {class: 'arflex-reason'}, i.failureReason || (i.awaitingReset ? 'waiting for operator reset (safe mode)' : (i.safeMode ? 'safe mode' : ''))),
         el('td', {}, String(i.restarts) + ' (' + i.restartsLeft + ' left)'),
         el('td', {}, i.pid ? String(i.pid) : ''),
         el('td', {}, i.cpu >= 0 ? String(i.cpu) : ''),

@@ -18,8 +18,14 @@ public class InstanceDTO {
     public long pid;
     /** CPU admission placed the task on, or -1. */
     public int cpu;
-    /** True when the RT half waits for an operator reset before driving outputs. */
+    /**
+     * True when the RT half waits for an operator reset before driving outputs: restarted while
+     * it moves hardware, or (since 0.4.0) latched by the RT half itself, e.g. after the runtime
+     * heartbeat was lost.
+     */
     public boolean awaitingReset;
+    /** Since 0.4.0: the RT half runs its safe hook instead of its update (heartbeat lost or reset required). */
+    public boolean safeMode;
     /** Id of the bundle that carries the contract. */
     public long bundleId;
     /** The wires of this instance's inputs. */

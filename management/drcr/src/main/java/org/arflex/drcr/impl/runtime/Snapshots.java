@@ -110,7 +110,9 @@ public final class Snapshots {
         RtHalf half = i.half;
         d.pid = half != null ? half.pid() : 0;
         d.cpu = i.cpu;
-        d.awaitingReset = i.awaitingReset;
+        int flags = half != null ? half.flags() : 0;
+        d.awaitingReset = i.awaitingReset || (flags & ControlBlock.FLAG_RESET_REQUIRED) != 0;
+        d.safeMode = (flags & ControlBlock.FLAG_SAFE_ACTIVE) != 0;
         d.evaluationSegments = new java.util.TreeMap<>(i.evaluationSegments);
         d.bundleId = i.bundleId;
         List<BindingDTO> bs = new ArrayList<>();

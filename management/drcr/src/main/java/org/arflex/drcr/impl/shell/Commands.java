@@ -90,7 +90,7 @@ public final class Commands {
         sb.append('\n');
         sb.append("  pid ").append(i.pid == 0 ? "-" : i.pid).append(", cpu ").append(i.cpu < 0 ? "-" : i.cpu)
                 .append(", restarts ").append(i.restarts).append(" (").append(i.restartsLeft).append(" left)")
-                .append(i.awaitingReset ? ", awaiting operator reset" : "").append('\n');
+                .append(i.awaitingReset ? ", awaiting operator reset" : "").append(i.safeMode ? ", safe mode" : "").append('\n');
         sb.append("  timing: ").append(c.taskType).append(" period ").append(c.periodNs).append(" ns, deadline ")
                 .append(c.deadlineNs).append(" ns, wcet ").append(c.wcetNs).append(" ns, priority ").append(c.priority).append('\n');
         sb.append("  fault: ").append(c.restart).append(" intensity ").append(c.intensity).append("/").append(c.windowMs)

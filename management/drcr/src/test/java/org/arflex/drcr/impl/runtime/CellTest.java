@@ -371,6 +371,21 @@ class CellTest {
     }
 
     @Test
+    void theDtoShowsAResetLatchedByTheRtHalfItselfAndItsSafeMode() throws Exception {
+        install(contract("prov", PROVIDER_PORTS, PERMANENT, true, 5, "50us"));
+        FakeLauncher.FakeHalf h = launcher.running.get("prov");
+        InstanceDTO d = Snapshots.instance(cell, "prov").orElseThrow();
+        assertFalse(d.awaitingReset);
+        assertFalse(d.safeMode);
+        // the RT half lost the runtime heartbeat: it latched RESET_REQUIRED and runs its safe hook
+        h.flags = ControlBlock.FLAG_RESET_REQUIRED | ControlBlock.FLAG_SAFE_ACTIVE;
+        d = Snapshots.instance(cell, "prov").orElseThrow();
+        assertTrue(d.awaitingReset);
+        assertTrue(d.safeMode);
+        assertEquals("ACTIVE", d.state);
+    }
+
+    @Test
     void nameOwnedByAnotherBundleIsRefused() throws Exception {
         install(contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us"));
         Contract c = parse(contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us"));

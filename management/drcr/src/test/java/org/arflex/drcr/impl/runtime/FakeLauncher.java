@@ -30,6 +30,8 @@ final class FakeLauncher implements RtLauncher {
         long runtimeHb;
         boolean started;
         boolean cleaned;
+        /** What flags() reports (control block flags); tests set it. */
+        int flags;
         /** What stats() reports; tests set it. */
         ControlBlock.Stats stats = new ControlBlock.Stats(0, 0, 0, 0, 0, 0, 0, 0, 0);
 
@@ -94,7 +96,7 @@ final class FakeLauncher implements RtLauncher {
 
         @Override
         public int flags() {
-            return 0;
+            return flags;
         }
 
         @Override
