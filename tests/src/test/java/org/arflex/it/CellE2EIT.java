@@ -89,7 +89,7 @@ class CellE2EIT {
         } finally {
             System.setProperty("arflex.it.runtime", old);
         }
-        raiseRuntimePriority();
+        report.add(rt.renice(-10));
     }
 
     @AfterAll
@@ -106,40 +106,6 @@ class CellE2EIT {
         }
     }
 
-    /**
-     * As scripts/run-cell.sh does for the main job: the runtime JVM (whose heartbeat thread the
-     * 1 ms components watch with a 100 ms timeout) runs at nice -10, above the cell's
-     * best-effort rendering and vision (nice 19). Needs root or CAP_SYS_NICE; without it the
-     * test runs at the default priority and says so.
-     */
-    void raiseRuntimePriority() throws Exception {
-        long jvm = -1;
-        try (var ds = Files.newDirectoryStream(Path.of("/proc"))) {
-            for (Path p : ds) {
-                if (!p.getFileName().toString().matches("\\d+")) {
-                    continue;
-                }
-                try {
-                    String cl = new String(Files.readAllBytes(p.resolve("cmdline")), StandardCharsets.UTF_8);
-                    if (cl.contains("-Darflex.runtime.id=" + rt.rid + "\0")) {
-                        jvm = Long.parseLong(p.getFileName().toString());
-                    }
-                } catch (IOException ignored) {
-                    // ended while we looked
-                }
-            }
-        }
-        assertTrue(jvm > 0, "runtime JVM of " + rt.rid + " not found");
-        List<String> cmd = new ArrayList<>(List.of("renice", "-n", "-10", "-p"));
-        try (var ds = Files.newDirectoryStream(Path.of("/proc/" + jvm + "/task"))) {
-            ds.forEach(t -> cmd.add(t.getFileName().toString()));
-        }
-        Process p = new ProcessBuilder(cmd).redirectErrorStream(true).start();
-        String out = new String(p.getInputStream().readAllBytes(), StandardCharsets.UTF_8);
-        report.add(p.waitFor() == 0 ? "runtime JVM " + jvm + " at nice -10 (" + (cmd.size() - 4) + " threads)"
-                : "runtime JVM left at its priority (renice: " + out.strip() + ")");
-    }
-
     // ---- helpers --------------------------------------------------------------------------
 
     Path seg(String inst, String port) {
@@ -150,18 +116,6 @@ class CellE2EIT {
     static long cyclesOf(Map<String, Object> inst) {
         Map<String, Object> st = (Map<String, Object>) inst.get("stats");
         return st == null ? -1 : ((Number) st.get("cycles")).longValue();
-    }
-
-    /**
-     * Components waiting for an operator reset: restarted ones (the DTO's awaitingReset) and
-     * those whose RT half latched RESET_REQUIRED itself (a moving component after a runtime
-     * heartbeat loss, the force guard after a trip; read from the control block).
-     */
-    List<String> awaitingReset() {
-        Map<String, Object> dto = rt.dto();
-        return Runtime.names(dto, i -> Boolean.TRUE.equals(i.get("awaitingReset"))
-                || (CellPorts.ctlFlags(Path.of("/dev/shm/arflex." + rt.rid + "." + i.get("name") + ".ctl"))
-                        & CellPorts.FLAG_RESET_REQUIRED) != 0);
     }
 
     final Map<String, Integer> operatorResets = new java.util.TreeMap<>();
@@ -181,7 +135,7 @@ class CellE2EIT {
             return;
         }
         lastOperatorCheck = now;
-        for (String n : awaitingReset()) {
+        for (String n : CellRig.awaitingReset(rt)) {
             rt.cmd("arflex:reset " + n);
             operatorResets.merge(n, 1, Integer::sum);
         }
@@ -354,19 +308,9 @@ class CellE2EIT {
     @Test
     @Order(1)
     void cellInstalledInAShuffledOrderAllActiveAndWired() throws Exception {
-        List<String> gosh = Files.readAllLines(rt.dir.resolve("conf/cell.gosh"), StandardCharsets.UTF_8);
-        List<Path> toStart = new ArrayList<>();
-        List<String> settings = new ArrayList<>();
-        for (String line : gosh) {
-            String l = line.strip();
-            if (l.startsWith("start file:@CELL@/")) {
-                toStart.add(rt.dir.resolve("cell").resolve(l.substring("start file:@CELL@/".length())));
-            } else if (l.startsWith("arflex:set ")) {
-                settings.add(l);
-            } else {
-                assertTrue(l.isEmpty() || l.startsWith("#"), "cell.gosh line CellE2EIT does not know: " + l);
-            }
-        }
+        CellRig.Gosh gosh = CellRig.cellGosh(rt);
+        List<Path> toStart = new ArrayList<>(gosh.starts());
+        List<String> settings = gosh.settings();
         long seed = Long.getLong("arflex.it.seed", System.nanoTime());
         Collections.shuffle(toStart, new Random(seed));
         report.add("install order (seed " + seed + ", rerun with -Darflex.it.seed=" + seed + "): "
@@ -400,7 +344,7 @@ class CellE2EIT {
         report.add("admitted: " + rt.cmd("arflex:resources").replace('\n', ';'));
         // The operator's start-up check: a component that lost the runtime's heartbeat while the
         // cell was being installed (this machine is small and shared) waits for a reset.
-        report.add("awaiting a reset after start-up: " + awaitingReset());
+        report.add("awaiting a reset after start-up: " + CellRig.awaitingReset(rt));
         lastOperatorCheck = 0;
         operator();
     }

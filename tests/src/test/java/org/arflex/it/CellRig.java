@@ -74,6 +74,38 @@ final class CellRig {
         return names;
     }
 
+    /** What the runtime's conf/cell.gosh (the main job's cell) starts and sets, in its order. */
+    record Gosh(List<Path> starts, List<String> settings) {
+    }
+
+    /** Reads the runtime's conf/cell.gosh; a line of another kind than start/arflex:set/comment fails. */
+    static Gosh cellGosh(Runtime rt) throws IOException {
+        List<Path> starts = new ArrayList<>();
+        List<String> settings = new ArrayList<>();
+        for (String line : Files.readAllLines(rt.dir.resolve("conf/cell.gosh"), java.nio.charset.StandardCharsets.UTF_8)) {
+            String l = line.strip();
+            if (l.startsWith("start file:@CELL@/")) {
+                starts.add(rt.dir.resolve("cell").resolve(l.substring("start file:@CELL@/".length())));
+            } else if (l.startsWith("arflex:set ")) {
+                settings.add(l);
+            } else {
+                assertTrue(l.isEmpty() || l.startsWith("#"), "cell.gosh line not understood: " + l);
+            }
+        }
+        return new Gosh(starts, settings);
+    }
+
+    /**
+     * Components waiting for an operator reset: restarted ones (the DTO's awaitingReset) and
+     * those whose RT half latched RESET_REQUIRED itself (a moving component after a runtime
+     * heartbeat loss, the force guard after a trip; read from the control block).
+     */
+    static List<String> awaitingReset(Runtime rt) {
+        return Runtime.names(rt.dto(), i -> Boolean.TRUE.equals(i.get("awaitingReset"))
+                || (CellPorts.ctlFlags(Path.of("/dev/shm/arflex." + rt.rid + "." + i.get("name") + ".ctl"))
+                        & CellPorts.FLAG_RESET_REQUIRED) != 0);
+    }
+
     /** The input of sim-robot that carries the motion reference, as arflex:bindings prints it. */
     static boolean armFollows(Runtime rt, String motionSource) {
         String b = rt.cmd("arflex:bindings");

@@ -87,8 +87,12 @@ final class Runtime implements AutoCloseable {
             // the fresh build replaces the assembly's copy (same file name) or joins it
             Files.copy(j, dir.resolve("bundle").resolve(j.getFileName()), StandardCopyOption.REPLACE_EXISTING);
         }
+        // The tests' RT halves skip mlockall (many runtimes one after the other on a small
+        // machine); a benchmark that measures the cell as the main job runs it sets
+        // arflex.it.mlock=true.
+        boolean mlock = Boolean.getBoolean("arflex.it.mlock");
         ProcessBuilder pb = new ProcessBuilder(Path.of(System.getProperty("java.home"), "bin", "java").toString(),
-                "-Darflex.runtime.id=" + rid, "-Darflex.nomlock=true", "-Dorg.osgi.service.http.port=0",
+                "-Darflex.runtime.id=" + rid, "-Darflex.nomlock=" + !mlock, "-Dorg.osgi.service.http.port=0",
                 "-jar", "bin/felix.jar").directory(dir.toFile());
         process = pb.start();
         stdin = new OutputStreamWriter(process.getOutputStream(), StandardCharsets.UTF_8);
@@ -255,6 +259,45 @@ final class Runtime implements AutoCloseable {
         }
         fail("timed out after " + timeoutMs + " ms waiting for " + what + (last != null ? " (last error " + last + ")" : "")
                 + "\n--- arflex:list\n" + state + "\n--- runtime output\n" + tail());
+    }
+
+    /** The pid of this runtime's JVM (found by its runtime id on the command line). */
+    long jvmPid() throws IOException {
+        try (DirectoryStream<Path> ds = Files.newDirectoryStream(Path.of("/proc"))) {
+            for (Path p : ds) {
+                if (!p.getFileName().toString().matches("\\d+")) {
+                    continue;
+                }
+                try {
+                    String cl = new String(Files.readAllBytes(p.resolve("cmdline")), StandardCharsets.UTF_8);
+                    if (cl.contains("-Darflex.runtime.id=" + rid + "\0")) {
+                        return Long.parseLong(p.getFileName().toString());
+                    }
+                } catch (IOException ignored) {
+                    // ended while we looked
+                }
+            }
+        }
+        fail("runtime JVM of " + rid + " not found");
+        return -1;
+    }
+
+    /**
+     * As scripts/run-cell.sh does for the main job: every thread of the runtime JVM (whose
+     * heartbeat the 1 ms components watch with a 100 ms timeout) to {@code nice}, above the
+     * cell's best-effort rendering and vision (nice 19). Needs root or CAP_SYS_NICE; without it
+     * the JVM keeps its priority. Returns a line saying which.
+     */
+    String renice(int nice) throws IOException, InterruptedException {
+        long jvm = jvmPid();
+        List<String> cmd = new ArrayList<>(List.of("renice", "-n", Integer.toString(nice), "-p"));
+        try (DirectoryStream<Path> ds = Files.newDirectoryStream(Path.of("/proc/" + jvm + "/task"))) {
+            ds.forEach(t -> cmd.add(t.getFileName().toString()));
+        }
+        Process p = new ProcessBuilder(cmd).redirectErrorStream(true).start();
+        String o = new String(p.getInputStream().readAllBytes(), StandardCharsets.UTF_8);
+        return p.waitFor() == 0 ? "runtime JVM " + jvm + " at nice " + nice + " (" + (cmd.size() - 4) + " threads)"
+                : "runtime JVM left at its priority (renice: " + o.strip() + ")";
     }
 
     /** An output port segment of an instance of this runtime. */

@@ -458,8 +458,16 @@ public final class Cell {
         inst.evaluationSegments = Map.of();
     }
 
+    /**
+     * The control block's configuration of an instance. A service (best effort, SCHED_OTHER, no
+     * deadline) does not lock its memory: locking buys it nothing, and locking and unlocking a
+     * large process (a MuJoCo/OSMesa camera, 256 MiB) at its start and exit stalled the 1 ms
+     * components of the cell for several periods each time (./arflex bench cell, docs/DECISIONS.md D8).
+     */
     static ControlBlock.Config controlConfig(Contract c, int cpu, boolean noMlock) {
-        int flags = (c.movesHardware() ? ControlBlock.CFG_MOVES_HARDWARE : 0) | (noMlock ? ControlBlock.CFG_NO_MLOCK : 0);
+        boolean service = c.taskType() == Contract.TaskType.SERVICE;
+        int flags = (c.movesHardware() ? ControlBlock.CFG_MOVES_HARDWARE : 0)
+                | (noMlock || service ? ControlBlock.CFG_NO_MLOCK : 0);
         int taskType = switch (c.taskType()) {
             case PERIODIC -> 0;
             case SPORADIC -> 1;

@@ -320,6 +320,18 @@ class CellTest {
     }
 
     @Test
+    void aServiceDoesNotLockItsMemoryAPeriodicTaskDoes() throws Exception {
+        String periodic = contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us");
+        Contract p = parse(periodic);
+        Contract s = parse(periodic.replace("task=\"periodic\"", "task=\"service\"").replace(" priority=\"80\"", ""));
+        assertEquals(Contract.TaskType.SERVICE, s.taskType());
+        assertEquals(0, Cell.controlConfig(p, 1, false).cfgFlags() & ControlBlock.CFG_NO_MLOCK);
+        assertEquals(ControlBlock.CFG_NO_MLOCK, Cell.controlConfig(s, 1, false).cfgFlags() & ControlBlock.CFG_NO_MLOCK);
+        assertEquals(0, Cell.controlConfig(s, 1, false).priority());
+        assertEquals(ControlBlock.CFG_NO_MLOCK, Cell.controlConfig(p, 1, true).cfgFlags() & ControlBlock.CFG_NO_MLOCK);
+    }
+
+    @Test
     void installedBundleShowsInstalledUntilStartedAndAfterStopped() throws Exception {
         Contract c = parse(contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us"));
         assertTrue(actor.call(() -> cell.register(c, 7), 0));
