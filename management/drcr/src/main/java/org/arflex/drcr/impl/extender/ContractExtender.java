@@ -160,9 +160,7 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
         String why = label(bundle) + " stopped";
         List<Contract> cs = t.contracts;
         cell.actor().call(() -> {
-            for (String n : names) {
-                cell.uninstall(n, why);
-            }
+            cell.uninstall(names, why);
             // the bundle is still installed: its components show as INSTALLED again
             for (Contract c : cs) {
                 if (names.contains(c.name())) {

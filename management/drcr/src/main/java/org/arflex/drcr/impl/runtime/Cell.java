@@ -261,24 +261,50 @@ public final class Cell {
 
     /** Removes a component for good: stops it (and what depends on it), removes its objects. */
     public void uninstall(String name, String why) {
+        uninstall(List.of(name), why);
+    }
+
+    /**
+     * Removes components for good (a bundle's, or all of them) in one plan: what depends on
+     * them stops or is rewired once, and their own halves stop side by side (as a plan's stops
+     * do), then their objects are removed.
+     */
+    public void uninstall(List<String> names, String why) {
         actor.checkThread();
-        Instance inst = instances.get(name);
-        if (inst == null) {
-            return;
-        }
-        inst.life.target(State.DESTROYED);
-        cancelRestart(inst);
-        if (inst.planned) {
-            try {
-                execute(planner.apply(Change.uninstall(name)));
-            } catch (RuntimeException e) {
-                log.accept("arflex: planner failed on uninstall of " + name + ": " + e);
+        List<Instance> going = new ArrayList<>();
+        for (String name : names) {
+            Instance inst = instances.get(name);
+            if (inst != null) {
+                inst.life.target(State.DESTROYED);
+                cancelRestart(inst);
+                going.add(inst);
             }
         }
-        stopHalf(inst, why);
-        closeOutputs(inst);
-        inst.life.to(State.DESTROYED, why);
-        instances.remove(name);
+        if (going.isEmpty()) {
+            return;
+        }
+        String[] planned = going.stream().filter(i -> i.planned).map(i -> i.name).toArray(String[]::new);
+        if (planned.length > 0) {
+            try {
+                execute(planner.apply(Change.uninstall(planned)));
+            } catch (RuntimeException e) {
+                log.accept("arflex: planner failed on uninstall of " + String.join(", ", planned) + ": " + e);
+            }
+        }
+        List<Stopping> stopping = new ArrayList<>();
+        for (Instance inst : going) {
+            Stopping st = detach(inst);
+            if (st != null) {
+                stopping.add(st);
+            }
+        }
+        stopping.forEach(this::settle);
+        stopping.forEach(st -> finish(st, why));
+        for (Instance inst : going) {
+            closeOutputs(inst);
+            inst.life.to(State.DESTROYED, why);
+            instances.remove(inst.name);
+        }
         changed();
     }
 
@@ -287,9 +313,7 @@ public final class Cell {
         actor.checkThread();
         List<String> names = new ArrayList<>(instances.keySet());
         java.util.Collections.reverse(names);
-        for (String n : names) {
-            uninstall(n, why);
-        }
+        uninstall(names, why);
     }
 
     /** Names of the components that bundle {@code bundleId} installed. */
@@ -330,13 +354,23 @@ public final class Cell {
         for (Plan.Action a : plan.rebinds()) {
             rebind(instances.get(a.component()), plan.wiringOf(a.component()), false, a.reason());
         }
+        // The plan's stops in three sweeps, so that their waits overlap: every half to stop is
+        // detached and its inputs unbound, then each is given its cycles to run its safe
+        // behaviour (counted from the unbind, so the waits run side by side), then each is
+        // stopped and shut down in the plan's stop order.
+        List<Stopping> stopping = new ArrayList<>();
         for (String name : plan.stopOrder()) {
             Instance inst = instances.get(name);
-            if (inst != null) {
-                String why = plan.inactiveAfter().getOrDefault(name,
-                        plan.action(name).map(Plan.Action::reason).orElse("stopped by plan"));
-                stopHalf(inst, why);
+            Stopping s = inst == null ? null : detach(inst);
+            if (s != null) {
+                stopping.add(s);
             }
+        }
+        stopping.forEach(this::settle);
+        for (Stopping s : stopping) {
+            String name = s.inst().name;
+            finish(s, plan.inactiveAfter().getOrDefault(name,
+                    plan.action(name).map(Plan.Action::reason).orElse("stopped by plan")));
         }
         // Every output segment of every component about to start exists before the first one
         // starts: a member of a start group (a cycle) binds to its partners' outputs at once.
@@ -546,11 +580,27 @@ public final class Cell {
     }
 
     private void stopHalf(Instance inst, String why) {
+        Stopping s = detach(inst);
+        if (s != null) {
+            settle(s);
+            finish(s, why);
+        }
+    }
+
+    /** An RT half on its way out: detached from its instance, its inputs unbound. */
+    private record Stopping(Instance inst, RtHalf half, long cycles, boolean hadInputs) {
+    }
+
+    /**
+     * First step of a stop: the half is detached (its exit is expected from here and ignored by
+     * onExit), unwatched, and its inputs are unbound. Returns null when nothing runs.
+     */
+    private Stopping detach(Instance inst) {
         RtHalf half = inst.half;
         if (half == null) {
-            return;
+            return null;
         }
-        inst.half = null; // from here its exit is expected and ignored by onExit
+        inst.half = null;
         monitor.unwatch(half);
         for (String port : List.copyOf(inst.bound.keySet())) {
             try {
@@ -559,15 +609,25 @@ public final class Cell {
                 log.accept("arflex: " + inst.name + ": " + e.getMessage());
             }
         }
-        if (!inst.bound.isEmpty()) {
-            // Let the RT thread see the lost inputs and run its safe behaviour before STOP.
-            long periods = 3 * inst.contract.timing().periodNs() / 1_000_000L;
-            if (!half.awaitCycles(2, Math.max(100, periods))) {
-                log.accept("arflex: " + inst.name + ": no RT cycle after UNBIND; stopping anyway");
+        boolean had = !inst.bound.isEmpty();
+        return new Stopping(inst, half, had ? half.cycles() : -1, had);
+    }
+
+    /** Second step: the RT thread sees the lost inputs and runs its safe behaviour before STOP. */
+    private void settle(Stopping s) {
+        if (s.hadInputs()) {
+            long periods = 3 * s.inst().contract.timing().periodNs() / 1_000_000L;
+            if (!s.half().awaitCycles(s.cycles(), 2, Math.max(100, periods))) {
+                log.accept("arflex: " + s.inst().name + ": no RT cycle after UNBIND; stopping anyway");
             }
         }
+    }
+
+    /** Last step: STOP, SHUTDOWN, the process gone. */
+    private void finish(Stopping s, String why) {
+        Instance inst = s.inst();
         inst.bound.clear();
-        half.shutdown(cfg.shutdownMs());
+        s.half().shutdown(cfg.shutdownMs());
         inst.cpu = -1;
         if (inst.life.state() == State.ACTIVE) {
             inst.life.to(State.UNSATISFIED, why);

@@ -218,9 +218,18 @@ public final class ProcessLauncher implements RtLauncher {
         }
 
         @Override
-        public boolean awaitCycles(int n, long timeoutMs) {
+        public synchronized long cycles() {
+            if (cleaned) {
+                return -1;
+            }
+            ControlBlock.Stats s = ctl.stats(0);
+            return s == null ? -1 : s.cycles();
+        }
+
+        @Override
+        public boolean awaitCycles(long since, int n, long timeoutMs) {
             long deadline = System.nanoTime() + timeoutMs * 1_000_000L;
-            long first = -1;
+            long first = since;
             while (System.nanoTime() - deadline < 0 && process.isAlive()) {
                 synchronized (this) {
                     if (cleaned || ctl.state() != ControlBlock.STATE_RUNNING) {

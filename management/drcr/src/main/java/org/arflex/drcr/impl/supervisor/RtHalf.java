@@ -23,13 +23,17 @@ public interface RtHalf {
     /** UNBIND input {@code port}. */
     void unbind(String port) throws IOException;
 
+    /** Cycles the RT loop has completed so far (from its statistics), or -1 when unknown. */
+    long cycles();
+
     /**
-     * Waits until the RT loop completed {@code n} more cycles (so a change such as an UNBIND
-     * reached the RT thread and its safe behaviour ran), at most {@code timeoutMs}.
+     * Waits until the RT loop completed {@code n} more cycles than {@code since} (a value of
+     * {@link #cycles()} read after a change such as an UNBIND; -1: from now), so the change
+     * reached the RT thread and its safe behaviour ran; at most {@code timeoutMs}.
      *
      * @return false on timeout or when the half is not running
      */
-    boolean awaitCycles(int n, long timeoutMs);
+    boolean awaitCycles(long since, int n, long timeoutMs);
 
     /** START the RT loop. */
     void start() throws IOException;

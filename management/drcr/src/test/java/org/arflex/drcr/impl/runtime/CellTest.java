@@ -320,6 +320,35 @@ class CellTest {
     }
 
     @Test
+    void componentsUninstalledTogetherStopSideBySide() throws Exception {
+        install(contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us"));
+        install(contract("cons", CONSUMER_PORTS, PERMANENT, false, 3, "50us"));
+        install(contract("cons2", CONSUMER_PORTS.replace("\"z\"", "\"z2\""), PERMANENT, false, 3, "50us"));
+        assertEquals(State.ACTIVE, state("cons"));
+        assertEquals(State.ACTIVE, state("cons2"));
+        launcher.events.clear();
+        // As a bundle with two components is stopped: both in one call.
+        assertTrue(actor.call(() -> {
+            cell.uninstall(List.of("cons", "cons2"), "bundle stopped");
+            return true;
+        }, 0));
+        List<String> ev = launcher.events;
+        for (String c : List.of("cons", "cons2")) {
+            assertTrue(ev.contains(c + " UNBIND x") && ev.contains(c + " AWAIT 2") && ev.contains(c + " SHUTDOWN"), ev.toString());
+            assertTrue(cell.instance(c).isEmpty(), c + " still known");
+        }
+        // Every input unbound before the first wait, every wait before the first shutdown: the
+        // two waits for the consumers' safe behaviour run side by side, not one after the other.
+        int lastUnbind = Math.max(ev.indexOf("cons UNBIND x"), ev.indexOf("cons2 UNBIND x"));
+        int firstAwait = Math.min(ev.indexOf("cons AWAIT 2"), ev.indexOf("cons2 AWAIT 2"));
+        int lastAwait = Math.max(ev.indexOf("cons AWAIT 2"), ev.indexOf("cons2 AWAIT 2"));
+        int firstShutdown = Math.min(ev.indexOf("cons SHUTDOWN"), ev.indexOf("cons2 SHUTDOWN"));
+        assertTrue(lastUnbind < firstAwait && lastAwait < firstShutdown, ev.toString());
+        assertEquals(State.ACTIVE, state("prov"));
+        assertTrue(launcher.running.keySet().equals(java.util.Set.of("prov")), launcher.running.keySet().toString());
+    }
+
+    @Test
     void aServiceDoesNotLockItsMemoryAPeriodicTaskDoes() throws Exception {
         String periodic = contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us");
         Contract p = parse(periodic);

@@ -61,7 +61,12 @@ final class FakeLauncher implements RtLauncher {
         }
 
         @Override
-        public boolean awaitCycles(int n, long timeoutMs) {
+        public long cycles() {
+            return started ? 0 : -1;
+        }
+
+        @Override
+        public boolean awaitCycles(long since, int n, long timeoutMs) {
             events.add(inst + " AWAIT " + n);
             return started;
         }
