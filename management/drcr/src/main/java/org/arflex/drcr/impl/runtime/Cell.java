@@ -593,7 +593,9 @@ public final class Cell {
 
     /**
      * First step of a stop: the half is detached (its exit is expected from here and ignored by
-     * onExit), unwatched, and its inputs are unbound. Returns null when nothing runs.
+     * onExit, a hang by onHang) and its inputs are unbound. It stays watched, so the runtime
+     * heartbeat goes on while it settles: a slow component (cameras at 500 ms) must not see the
+     * runtime lost and latch safe mode on its way out. Returns null when nothing runs.
      */
     private Stopping detach(Instance inst) {
         RtHalf half = inst.half;
@@ -601,7 +603,6 @@ public final class Cell {
             return null;
         }
         inst.half = null;
-        monitor.unwatch(half);
         for (String port : List.copyOf(inst.bound.keySet())) {
             try {
                 half.unbind(port);
@@ -627,6 +628,7 @@ public final class Cell {
     private void finish(Stopping s, String why) {
         Instance inst = s.inst();
         inst.bound.clear();
+        monitor.unwatch(s.half());
         s.half().shutdown(cfg.shutdownMs());
         inst.cpu = -1;
         if (inst.life.state() == State.ACTIVE) {

@@ -349,6 +349,37 @@ class CellTest {
     }
 
     @Test
+    void aStoppingComponentKeepsTheRuntimeHeartbeatWhileItSettles() throws Exception {
+        install(contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us"));
+        install(contract("cons", CONSUMER_PORTS, PERMANENT, false, 3, "50us"));
+        FakeLauncher.FakeHalf prov = launcher.running.get("prov");
+        FakeLauncher.FakeHalf cons = launcher.running.get("cons");
+        long[] seen = new long[1];
+        // A slow consumer settles longer than its heartbeat timeout (100 ms here) after UNBIND.
+        cons.duringAwait = () -> {
+            nowNs += 300_000_000L;
+            prov.rtHb = nowNs;
+            cell.monitor().check(nowNs);
+            seen[0] = cons.runtimeHb;
+        };
+        assertTrue(actor.call(() -> {
+            cell.uninstall("cons", "bundle stopped");
+            return true;
+        }, 0));
+        actor.runAll();
+        assertEquals(nowNs, seen[0], "runtime heartbeat written while the stopping half settles");
+        assertFalse(launcher.events.contains("cons SIGKILL"), launcher.events.toString());
+        assertTrue(launcher.events.contains("cons SHUTDOWN"), launcher.events.toString());
+        nowNs += 300_000_000L;
+        prov.rtHb = nowNs;
+        cell.monitor().check(nowNs);
+        actor.runAll();
+        assertEquals(seen[0], cons.runtimeHb, "no heartbeat into a half that is gone");
+        assertEquals(State.ACTIVE, state("prov"));
+        assertEquals(1, cell.monitor().size(), "only prov watched");
+    }
+
+    @Test
     void aServiceDoesNotLockItsMemoryAPeriodicTaskDoes() throws Exception {
         String periodic = contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us");
         Contract p = parse(periodic);

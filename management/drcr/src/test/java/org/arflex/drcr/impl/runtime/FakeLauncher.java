@@ -29,6 +29,8 @@ final class FakeLauncher implements RtLauncher {
         long rtHb;
         long runtimeHb;
         boolean started;
+        /** Runs while the cell waits for this half's cycles (what happens meanwhile). */
+        Runnable duringAwait = () -> { };
         boolean cleaned;
         /** What flags() reports (control block flags); tests set it. */
         int flags;
@@ -68,6 +70,7 @@ final class FakeLauncher implements RtLauncher {
         @Override
         public boolean awaitCycles(long since, int n, long timeoutMs) {
             events.add(inst + " AWAIT " + n);
+            duringAwait.run();
             return started;
         }
 
