@@ -179,15 +179,43 @@ def cpu_times(cpu):
     return 0, 0, 0, 0
 
 
+# Inter-processor interrupts that other CPUs send to the measured one: a TLB shootdown when a
+# process with a thread on it changes its page tables elsewhere, a function call, a reschedule.
+IPI_KINDS = ("TLB", "CAL", "RES", "IWI")
+
+
+def cpu_interrupts(cpu):
+    """{kind: count} of the inter-processor interrupts received by one CPU (/proc/interrupts)."""
+    out = {}
+    try:
+        with open("/proc/interrupts") as f:
+            cols = f.readline().split()
+            if f"CPU{cpu}" not in cols:
+                return out
+            i = cols.index(f"CPU{cpu}")
+            for line in f:
+                name, _, rest = line.partition(":")
+                name = name.strip()
+                if name in IPI_KINDS:
+                    out[name] = int(rest.split()[i])
+    except (OSError, ValueError, IndexError):
+        pass
+    return out
+
+
 def block(fn, cpu, *args):
     """Runs one contender's block and records the bench CPU's steal and interrupt time in it
-    (hypervisor steal explains the multi-millisecond outliers on a VM)."""
+    (hypervisor steal explains the multi-millisecond outliers on a VM) and the inter-processor
+    interrupts it received (what the rest of the machine made it do)."""
     s0, i0, t0, b0 = cpu_times(cpu)
+    q0 = cpu_interrupts(cpu)
     w0 = time.monotonic()
     r = fn(*args)
     s1, i1, t1, b1 = cpu_times(cpu)
+    q1 = cpu_interrupts(cpu)
     r["cpu_time"] = {"seconds": round(time.monotonic() - w0, 2), "steal_jiffies": s1 - s0,
                      "irq_jiffies": i1 - i0, "total_jiffies": t1 - t0, "busy_jiffies": b1 - b0}
+    r["cpu_time"].update({f"ipi_{k.lower()}": q1[k] - q0[k] for k in IPI_KINDS if k in q0 and k in q1})
     return r
 
 
@@ -349,8 +377,18 @@ def run_cyclictest(n, cpu, prio, cpu_other, work, tag):
 
 # ---- load -----------------------------------------------------------------------------------------
 
+def expand_cpus(spec):
+    """'0,2-3' -> [0, 2, 3]."""
+    out = []
+    for part in spec.split(","):
+        lo, _, hi = part.partition("-")
+        out += range(int(lo), int(hi or lo) + 1)
+    return out
+
+
 def stress_args(seconds, seed, work):
-    return ["stress-ng", "--cpu", "2", "--vm", "1", "--vm-bytes", "256M", "--hdd", "1", "--hdd-bytes", "64M",
+    # every CPU, the measured one included, whatever the benchmark's own affinity
+    return ["taskset", "-c", f"0-{os.cpu_count() - 1}", "stress-ng", "--cpu", "2", "--vm", "1", "--vm-bytes", "256M", "--hdd", "1", "--hdd-bytes", "64M",
             "--temp-path", work, "--seed", str(seed), "--timeout", f"{seconds}s", "--quiet"]
 
 
@@ -497,6 +535,18 @@ def print_cpu_time(summary, modes, cpu):
                              f" in {ct['seconds']:.0f} s")
         la = summary[mode].get("load_average_at_end")
         print(f"  {mode:<16}" + ";  ".join(parts) + (f"  (load average {la[0]:.1f})" if la else ""))
+    print(f"CPU {cpu}: inter-processor interrupts received during each contender's long blocks "
+          f"({' / '.join(k for k in IPI_KINDS)}: TLB shootdowns, function calls, reschedules, IRQ work)")
+    for mode in modes:
+        parts = []
+        for c in CONTENDERS:
+            ct = (summary[mode].get(c) or {}).get("cpu_time")
+            if isinstance(ct, dict) and "long" in ct:
+                ct = ct["long"]
+            if ct and "ipi_tlb" in ct:
+                parts.append(f"{c}: " + " / ".join(str(ct.get(f"ipi_{k.lower()}", "-")) for k in IPI_KINDS))
+        if parts:
+            print(f"  {mode:<16}" + ";  ".join(parts))
 
 
 def targets(summary, modes):
@@ -638,6 +688,12 @@ def main():
         jvm_cpus = a.runtime_cpus
     else:
         ap.error(f"--runtime-cpus '{a.runtime_cpus}': others, all or a CPU list such as 0 or 0,2-3")
+    if jvm_cpus:
+        # The benchmark itself (reconfiguration thread, DTO polls, sample parsing) stays off the
+        # measured CPU too: unpinned, it ran there 2-3 % of the time in slices of 20 us and more,
+        # system calls that delay a wake-up on a kernel without preemption. Its children inherit
+        # this; the contenders set their own affinity, stress-ng is given every CPU back.
+        os.sched_setaffinity(0, {int(c) for c in expand_cpus(jvm_cpus)})
     patched_probe_jar(a.probe_jar, probe_jar, a.cpu, a.priority, isolate)
     dummy_jar = shutil.copy(a.dummy_jar, os.path.join(jars, "dummy.jar"))
     update_jar = shutil.copy(a.update_jar, os.path.join(jars, "update.jar"))
