@@ -518,6 +518,14 @@ def print_table(summary, modes, obs, dur):
                       f"{fmt(lg['max']):>11}{fmt(s['overruns']):>9}")
 
 
+def long_cpu_time(summary, mode, c):
+    """The cpu_time record of a contender's long blocks in one mode (None if absent)."""
+    ct = (summary[mode].get(c) or {}).get("cpu_time")
+    if isinstance(ct, dict) and "long" in ct:
+        ct = ct["long"]
+    return ct
+
+
 def print_cpu_time(summary, modes, cpu):
     hz = os.sysconf("SC_CLK_TCK") or 100
     print()
@@ -526,9 +534,7 @@ def print_cpu_time(summary, modes, cpu):
     for mode in modes:
         parts = []
         for c in CONTENDERS:
-            ct = (summary[mode].get(c) or {}).get("cpu_time")
-            if isinstance(ct, dict) and "long" in ct:
-                ct = ct["long"]
+            ct = long_cpu_time(summary, mode, c)
             if ct:
                 busy = f" / {ct['busy_jiffies'] * 1000 // hz}" if "busy_jiffies" in ct else ""
                 parts.append(f"{c}: {ct['steal_jiffies'] * 1000 // hz} / {ct['irq_jiffies'] * 1000 // hz}{busy}"
@@ -538,13 +544,8 @@ def print_cpu_time(summary, modes, cpu):
     print(f"CPU {cpu}: inter-processor interrupts received during each contender's long blocks "
           f"({' / '.join(k for k in IPI_KINDS)}: TLB shootdowns, function calls, reschedules, IRQ work)")
     for mode in modes:
-        parts = []
-        for c in CONTENDERS:
-            ct = (summary[mode].get(c) or {}).get("cpu_time")
-            if isinstance(ct, dict) and "long" in ct:
-                ct = ct["long"]
-            if ct and "ipi_tlb" in ct:
-                parts.append(f"{c}: " + " / ".join(str(ct.get(f"ipi_{k.lower()}", "-")) for k in IPI_KINDS))
+        parts = [f"{c}: " + " / ".join(str(ct.get(f"ipi_{k.lower()}", "-")) for k in IPI_KINDS)
+                 for c in CONTENDERS if (ct := long_cpu_time(summary, mode, c)) and "ipi_tlb" in ct]
         if parts:
             print(f"  {mode:<16}" + ";  ".join(parts))
 
