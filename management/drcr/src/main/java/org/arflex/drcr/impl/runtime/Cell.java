@@ -579,14 +579,6 @@ public final class Cell {
                 + "; spawn to READY " + (tLaunched - t0) / 1000 + " us, bind+start " + (t1 - tLaunched) / 1000 + " us)");
     }
 
-    private void stopHalf(Instance inst, String why) {
-        Stopping s = detach(inst);
-        if (s != null) {
-            settle(s);
-            finish(s, why);
-        }
-    }
-
     /** An RT half on its way out: detached from its instance, its inputs unbound. */
     private record Stopping(Instance inst, RtHalf half, long cycles, boolean hadInputs) {
     }
