@@ -24,6 +24,8 @@ public final class ProcessLauncher implements RtLauncher {
     /** Mailbox call timeout. */
     static final long CALL_TIMEOUT_MS = 2_000;
     private static final int TAIL_LINES = 8;
+    /** How long an RT half that reported FAILED may take to exit by itself before it is killed. */
+    private static final long FAILED_EXIT_GRACE_MS = 500;
 
     private final Consumer<String> log;
 
@@ -102,10 +104,21 @@ public final class ProcessLauncher implements RtLauncher {
                 String why = !p.isAlive() ? "exited with status " + exitOf(p)
                         : st == ControlBlock.STATE_FAILED ? "reported FAILED" : "not READY within " + spec.readyTimeoutMs() + " ms";
                 int err = ctl.exitStatus();
-                half.kill();
                 try {
+                    // The RT half prints why (a program file's file:line, say) before it sets
+                    // FAILED and exits. A kill closes the output pipe with whatever the pump
+                    // has not read yet, so one that failed is given a moment to exit by itself
+                    // and its output is read to the end first.
+                    if (st == ControlBlock.STATE_FAILED || !p.isAlive()) {
+                        p.waitFor(FAILED_EXIT_GRACE_MS, TimeUnit.MILLISECONDS);
+                        if (!p.isAlive()) {
+                            half.awaitOutput(1000);
+                        }
+                    }
+                    half.kill();
                     p.waitFor(2, TimeUnit.SECONDS);
                 } catch (InterruptedException e) {
+                    half.kill();
                     Thread.currentThread().interrupt();
                 }
                 half.cleanup();
@@ -141,6 +154,7 @@ public final class ProcessLauncher implements RtLauncher {
         private final ControlBlock ctl;
         private final Mailbox mb;
         private final Deque<String> tail = new ArrayDeque<>();
+        private Thread pump;
         private final CompletableFuture<Exit> exit;
         private volatile boolean stopping;
         // Guards the mapping: readers on the heartbeat thread must never touch an unmapped
@@ -174,7 +188,15 @@ public final class ProcessLauncher implements RtLauncher {
                 }
             }, "arflex-rt-" + inst);
             t.setDaemon(true);
+            pump = t;
             t.start();
+        }
+
+        /** Waits up to {@code ms} for the output pump to reach the end of the pipe (the process exited). */
+        void awaitOutput(long ms) throws InterruptedException {
+            if (pump != null) {
+                pump.join(ms);
+            }
         }
 
         String tailText() {
