@@ -15,6 +15,7 @@ struct probe_out {
 	uint64_t in_value;      /* last value read on input 'in' */
 	uint64_t in_reads;
 	uint64_t in_bound;
+	uint64_t in_binding;    /* arflex_input_binding */
 };
 
 static const struct arflex_port_type out_type = { "test.ProbeOut", 1, 0,
@@ -103,6 +104,7 @@ static int update(struct arflex_component *c, void *user, uint64_t release_ns)
 		pr.o.in_reads++;
 	}
 	pr.o.in_bound = arflex_input_bound(pr.in);
+	pr.o.in_binding = arflex_input_binding(pr.in);
 	g2 = arflex_param_i64(c, pr.gain);
 	if (g1 != g2)
 		pr.o.torn++;

@@ -23,7 +23,7 @@ extern char **environ;
 struct probe_out {
 	uint64_t updates, safe_calls, safe_firsts;
 	int64_t gain;
-	uint64_t torn, in_value, in_reads, in_bound;
+	uint64_t torn, in_value, in_reads, in_bound, in_binding;
 };
 
 static const struct arflex_port_type value_type = { "test.Value", 1, 0, sizeof(uint64_t) };
@@ -133,6 +133,14 @@ static bool safe_above(const struct probe_out *o, uint64_t n) { return o->safe_c
 static bool gain_is(const struct probe_out *o, uint64_t g) { return o->gain == (int64_t)g; }
 static bool in_is(const struct probe_out *o, uint64_t v) { return o->in_value == v; }
 static bool unbound(const struct probe_out *o, uint64_t v) { (void)v; return !o->in_bound; }
+static bool binding_is(const struct probe_out *o, uint64_t b) { return o->in_binding == b; }
+static uint64_t binding_of(struct arflex_host *h)
+{
+	struct probe_out o;
+
+	assert_true(read_out(h, &o));
+	return o.in_binding;
+}
 
 static void spawn_ready(struct arflex_host *h)
 {
@@ -396,7 +404,7 @@ static void bind_and_unbind_while_running(void **state)
 	struct arflex_port_spec spec = { .method = ARFLEX_PORT_STATE, .type = value_type };
 	struct arflex_host h;
 	char feed_name[ARFLEX_OBJ_NAME_SIZE], missing[ARFLEX_OBJ_NAME_SIZE];
-	uint64_t v;
+	uint64_t v, b1, b2, b3;
 
 	(void)state;
 	setup_ids("bind");
@@ -411,25 +419,34 @@ static void bind_and_unbind_while_running(void **state)
 	assert_int_equal(arflex_state_write(&feed, &v, sizeof(v)), 0);
 	assert_int_equal(arflex_host_start(&h, T_CALL), 0);
 	assert_true(wait_out(&h, in_is, 41, false));
+	b1 = binding_of(&h);
+	assert_true(b1 != 0);
 	assert_int_equal(arflex_host_unbind(&h, "in", T_CALL), 0);
 	assert_true(wait_out(&h, unbound, 0, false));
+	assert_true(wait_out(&h, binding_is, 0, false)); /* unbound: binding 0 */
 	assert_int_equal(arflex_host_unbind(&h, "in", T_CALL), -ENOTCONN);
-	/* bound while running: picked up at a cycle boundary */
+	/* bound while running: picked up at a cycle boundary; the same provider bound again is
+	 * another binding (it may have restarted) */
 	assert_int_equal(arflex_host_bind(&h, "in", feed_name, T_CALL), 0);
 	v = 42;
 	assert_int_equal(arflex_state_write(&feed, &v, sizeof(v)), 0);
 	assert_true(wait_out(&h, in_is, 42, false));
-	/* rebinding replaces the old binding */
+	b2 = binding_of(&h);
+	assert_true(b2 != 0 && b2 != b1);
+	/* rebinding replaces the old binding, without an unbind in between */
 	assert_int_equal(arflex_host_bind(&h, "in", feed_name, T_CALL), 0);
 	v = 43;
 	assert_int_equal(arflex_state_write(&feed, &v, sizeof(v)), 0);
 	assert_true(wait_out(&h, in_is, 43, false));
+	b3 = binding_of(&h);
+	assert_true(b3 != 0 && b3 != b2 && b3 != b1);
 	/* errors */
 	assert_int_equal(arflex_host_bind(&h, "in", missing, T_CALL), -ENOENT);
 	assert_int_equal(arflex_host_bind(&h, "in", arflex_host_output_name(&h, "out"), T_CALL),
 			 -EPROTOTYPE);
 	assert_int_equal(arflex_host_bind(&h, "nope", feed_name, T_CALL), -ENOENT);
 	assert_true(wait_out(&h, in_is, 43, false)); /* still bound to the feed */
+	assert_int_equal(binding_of(&h), b3);          /* a refused bind is not a binding */
 	shutdown_ok(&h);
 	arflex_host_destroy(&h);
 	assert_int_equal(arflex_port_destroy(&feed), 0);

@@ -66,6 +66,7 @@ enum Param {
   kPushForce, kPushDirX, kPushDirY, kPushDirZ, kPushDurationMs,
   kObstacleEnable, kObstacleX, kObstacleY, kObstacleZ,
   kGuideForce, kGuideDx, kGuideDy, kGuideDz, kGuideDurationMs,
+  kRefAcquireTol,
   kParamCount
 };
 struct ParamInfo {
@@ -84,7 +85,13 @@ const ParamInfo kParams[kParamCount] = {
     {"guide_force_n", 0, 'd'},    {"guide_dx", 0.0, 'd'},
     {"guide_dy", 0.2, 'd'},       {"guide_dz", 0.0, 'd'},
     {"guide_duration_ms", 2000, 'd'},
+    {"ref_acquire_tol", 0.05, 'd'},
 };
+
+// A step of up to ref_acquire_tol (0.05 rad) taken by the servo at once puts hundreds of
+// newtons on the tool (the force guard trips at 150 N); over 0.5 s with a quintic the peak
+// acceleration is 5.77 * 0.05 / 0.25 = 1.15 rad/s^2 (about 60 N on the 25 kg tool at 2 m).
+constexpr double kBlendSeconds = 0.5;
 
 struct Robot {
   std::unique_ptr<Cell> cell;
@@ -104,6 +111,16 @@ struct Robot {
   uint64_t seq = 0;
   bool safe = false;
   JointVector q_ref = kHome;
+  // Reference acquisition: the servo follows joint_ref only once a value from the current
+  // binding came within ref_acquire_tol of the measured arm (see Update).
+  uint32_t ref_binding = 0;
+  bool acquired = false;
+  bool refusing = false;  // refusals in this episode counted once
+  // Blend-in after an acquisition: the servo follows ref - blend_offset * (1 - s(t)), s a
+  // quintic from 0 to 1 over kBlendSeconds of simulated time, so the offset between the held
+  // pose and the acquired reference is taken up smoothly instead of as a step.
+  JointVector blend_offset{};
+  double blend_t = kBlendSeconds;  // simulated seconds since the acquisition; >= kBlendSeconds: done
 };
 
 Robot g_robot;
@@ -241,6 +258,15 @@ bool ReferenceValid(const Cell& cell, const double* q) {
   return true;
 }
 
+// True when @q is within @tol (rad) of the measured joints on every axis.
+bool NearArm(const Cell& cell, const double* q, double tol) {
+  const arflex::sim::JointState js = cell.ReadJointState();
+  for (int i = 0; i < kNumJoints; ++i) {
+    if (!(std::fabs(q[i] - js.q[i]) <= tol)) return false;
+  }
+  return true;
+}
+
 int Configure(arflex_component* c, void* user) {
   Robot& r = *static_cast<Robot*>(user);
   for (int p = 0; p < kParamCount; ++p) r.idx[p] = arflex_component_param(c, kParams[p].name);
@@ -298,6 +324,8 @@ int Configure(arflex_component* c, void* user) {
 
 int Start(arflex_component* c, void* user) {
   Robot& r = *static_cast<Robot*>(user);
+  r.acquired = false;  // after STOP/START the reference must meet the arm again
+  r.refusing = false;
   ApplyParams(c, r);
   return 0;
 }
@@ -309,14 +337,42 @@ int Update(arflex_component* c, void* user, uint64_t release_ns) {
   arflex_joint_ref ref;
   const int got = arflex_input_state_read(r.joint_ref, &ref, sizeof(ref), nullptr);
   int ret = 0;
+  // A new provider (or the same one restarted, or none) must first meet the arm: its
+  // reference is followed once a value lies within ref_acquire_tol of the measured joints on
+  // every axis. Until then the arm holds and the provider is expected to come to it (the
+  // trajectory restarts its program from the measured pose when it gets a new robot). A real
+  // controller refuses a reference that is not where the arm is in the same way: following it
+  // would drive the arm there as fast as the servo can.
+  const uint32_t binding = arflex_input_binding(r.joint_ref);
+  if (binding != r.ref_binding) {
+    r.ref_binding = binding;
+    r.acquired = false;
+    r.refusing = false;
+  }
   if (got == 1) {
-    if (ReferenceValid(*r.cell, ref.q)) {
-      for (int i = 0; i < kNumJoints; ++i) r.q_ref[i] = ref.q[i];
-    } else {
+    if (!ReferenceValid(*r.cell, ref.q)) {
       ret = -ERANGE;  // refused: non-finite or outside the joint limits; keep the last one
+    } else if (!r.acquired && !NearArm(*r.cell, ref.q, P(c, r, kRefAcquireTol))) {
+      if (!r.refusing) ret = -ERANGE;  // counted once per episode, not every cycle
+      r.refusing = true;
+    } else {
+      if (!r.acquired) {  // the offset from what the servo held to the acquired reference
+        for (int i = 0; i < kNumJoints; ++i) r.blend_offset[i] = ref.q[i] - r.q_ref[i];
+        r.blend_t = 0;
+      }
+      r.acquired = true;
+      r.refusing = false;
+      for (int i = 0; i < kNumJoints; ++i) r.q_ref[i] = ref.q[i];
     }
   }
-  r.cell->SetJointReference(r.q_ref);
+  JointVector servo = r.q_ref;
+  if (r.blend_t < kBlendSeconds) {
+    const double u = r.blend_t / kBlendSeconds;
+    const double rest = 1.0 - u * u * u * (10.0 + u * (-15.0 + 6.0 * u));  // 1 - quintic
+    for (int i = 0; i < kNumJoints; ++i) servo[i] -= r.blend_offset[i] * rest;
+    r.blend_t += P(c, r, kStepsPerPeriod) * r.cell->timestep();
+  }
+  r.cell->SetJointReference(servo);
   const int pub = StepAndPublish(c, r, release_ns);
   return ret < 0 ? ret : pub;
 }
@@ -329,6 +385,7 @@ int Safe(arflex_component* c, void* user, arflex_safe_mode /*mode*/, bool first)
   if (first) {
     const arflex::sim::JointState js = r.cell->ReadJointState();
     r.q_ref = js.q;
+    r.blend_t = kBlendSeconds;  // holding: no blend in progress
     r.cell->SetJointReference(r.q_ref);
     r.cell->SetCorrection(JointVector{});
   }

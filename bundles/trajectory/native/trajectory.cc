@@ -3,8 +3,9 @@
 //
 // Ports: out joint_ref (arflex.JointRef, state); in safety (arflex.SafetyState, optional),
 // in joint_state (arflex.JointState, optional: the first reference starts at the measured
-// position), in tool (arflex.ToolState, optional: lin motions move the mounted tool's centre
-// point, the flange when none is mounted); out tool_id (arflex.Sample: the id of the tool lin
+// position; a robot bound later somewhere else restarts the program from there), in tool
+// (arflex.ToolState, optional: lin motions move the mounted tool's centre point, the flange
+// when none is mounted); out tool_id (arflex.Sample: the id of the tool lin
 // motions are planned for, 0 = the flange). Parameters: see the contract (src/main/resources/OSGI-INF/arflex/trajectory.xml).
 //
 // Threads: configure loads every program (main thread, file I/O); start/update/safe/stop run
@@ -74,7 +75,21 @@ struct State {
   uint64_t seq = 0;
   uint64_t tool_seq = 0;
   int64_t playing = 0;  // the program the player plays
+  uint32_t state_binding = 0;  // joint_state binding the output last met the arm on
+  uint64_t away_since = 0;     // release time since which the idle output is away from the arm
 } g;
+
+// A robot measured further than this from the output when it is (re)bound makes the program
+// start over from the measured pose. Below sim-robot's ref_acquire_tol (0.05 rad), so that a
+// robot which refuses the output as too far always gets a trajectory that comes to it.
+constexpr double kResyncTol = 0.005;  // rad, any joint
+// Idle (program ended, or held between motions) with the arm measured further than this from
+// the output for kAwayNs: the arm is not following (its robot has no reference input yet, or
+// refuses this one; sim-robot's ref_acquire_tol is the same 0.05 rad) and the output moves to
+// the arm, so that the next motion starts there. A following arm settles well inside it, and
+// tcp-correction's correction (arm = output + correction) is clamped at 0.02 rad.
+constexpr double kAwayTol = 0.05;        // rad, any joint
+constexpr uint64_t kAwayNs = 1000000000;  // 1 s
 
 int Param(struct arflex_component* c, const char* name, int* idx) {
   *idx = arflex_component_param(c, name);
@@ -199,16 +214,41 @@ int Step(struct arflex_component* c, uint64_t release_ns, bool force_stop) {
   tool_id.value = (double)TrackTool();
   int r = arflex_state_write(g.out_tool, &tool_id, sizeof(tool_id));
   if (r < 0) return r;
-  if (!g.player.initialized()) {
-    struct arflex_joint_state js;
-    Q q0 = g.player.program()->has_start ? g.player.program()->start : Q::Zero();
-    if (arflex_input_bound(g.in_state) &&
-        arflex_input_state_read(g.in_state, &js, sizeof(js), nullptr) == 1) {
-      for (int j = 0; j < 6; ++j) q0[j] = js.q[j];
-    } else if (arflex_input_bound(g.in_state)) {
-      return 0;  // wait for the first measurement before commanding anything
+  // The arm: the first reference starts where it is; and a robot that appears later, or is
+  // replaced or restarted (another joint_state binding), somewhere else than the output, makes
+  // the program start over from where that arm is (from its first motion, at rest), instead
+  // of the reference pulling the arm across to where the program had got to.
+  struct arflex_joint_state js;
+  const bool measured = arflex_input_state_read(g.in_state, &js, sizeof(js), nullptr) == 1;
+  Q qm;
+  for (int j = 0; j < 6; ++j) qm[j] = measured ? js.q[j] : 0.0;
+  const bool arm = measured && qm.allFinite();
+  const uint32_t binding = arflex_input_binding(g.in_state);
+  if (arm && binding != 0 && binding != g.state_binding) {
+    g.state_binding = binding;
+    if (!g.player.initialized()) {
+      g.player.Init(qm);
+    } else if ((qm - g.player.q_out()).cwiseAbs().maxCoeff() > kResyncTol) {
+      g.player.Begin(&g.model, &g.programs[g.playing], arflex_component_ctl(c)->config.period_ns * 1e-9);
+      g.player.Init(qm);
     }
-    g.player.Init(q0);
+  }
+  if (!g.player.initialized()) {
+    if (arflex_input_bound(g.in_state)) return 0;  // wait for the first measurement
+    g.player.Init(g.player.program()->has_start ? g.player.program()->start : Q::Zero());
+  }
+  // An idle output the arm has stayed away from (kAwayTol, kAwayNs) moves to the arm.
+  if (!arflex_input_bound(g.in_state) || !g.player.idle()) {
+    g.away_since = 0;
+  } else if (arm) {
+    if ((qm - g.player.q_out()).cwiseAbs().maxCoeff() <= kAwayTol) {
+      g.away_since = 0;
+    } else if (g.away_since == 0) {
+      g.away_since = release_ns;
+    } else if (release_ns - g.away_since >= kAwayNs) {
+      g.player.Init(qm);
+      g.away_since = 0;
+    }
   }
   struct arflex_safety_state s;
   if (arflex_input_bound(g.in_safety)) {

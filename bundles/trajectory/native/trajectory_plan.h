@@ -91,6 +91,9 @@ class Player {
   bool at_rest() const {
     return !active_ || done_ || (rate_ == 0 && v_out_.cwiseAbs().maxCoeff() < 1e-9);
   }
+  // Not in a motion: the program has ended, or is held between two motions (run = false).
+  // Init() then moves the output without cutting a motion short.
+  bool idle() const { return !active_ || done_; }
   // Plays another program from the current plan position; unlike Begin it keeps the output
   // and its velocity, so the limiter goes on smoothly. Call it only at_rest().
   void Switch(const cellkin::Program* program);

@@ -129,6 +129,12 @@ ARFLEX_API bool arflex_param_bool(const struct arflex_component *c, int idx);
 
 /** True while an input has a provider. */
 ARFLEX_API bool arflex_input_bound(const struct arflex_input *in);
+/** Which binding the input is on: 0 while unbound, else a number that is different for every
+ *  BIND or REBIND the RT thread has taken (also when the same provider is bound again after
+ *  an unbind). A change means "another provider, or the same one restarted": a consumer that
+ *  must not carry state across providers (a motion source following the measured arm, a
+ *  robot accepting a reference) compares it with the one it last saw. */
+ARFLEX_API uint32_t arflex_input_binding(const struct arflex_input *in);
 /** arflex_state_read on the bound provider; -ENOTCONN when unbound. */
 ARFLEX_API int arflex_input_state_read(struct arflex_input *in, void *out, size_t len,
 				       uint64_t *seq);

@@ -30,6 +30,7 @@ struct arflex_input {
 	struct arflex_port *retired;  /* RT -> mailbox: to unmap */
 	uint32_t pend_seq;            /* mailbox: requests posted */
 	uint32_t done_seq;            /* RT: requests taken */
+	uint32_t binding;             /* RT: providers taken (arflex_input_binding) */
 	bool bound;                   /* mailbox thread's view */
 };
 
@@ -128,6 +129,11 @@ void arflex_component_require_reset(struct arflex_component *c)
 bool arflex_input_bound(const struct arflex_input *in)
 {
 	return in->cur != NULL;
+}
+
+uint32_t arflex_input_binding(const struct arflex_input *in)
+{
+	return in->cur ? in->binding : 0;
 }
 
 int arflex_input_state_read(struct arflex_input *in, void *out, size_t len, uint64_t *seq)
@@ -255,6 +261,8 @@ static void take_bindings(struct arflex_component *c)
 			continue;
 		STORE(&in->retired, in->cur);
 		in->cur = p == &unbind_marker ? NULL : p;
+		if (in->cur)
+			in->binding++;
 		STORE(&in->done_seq, LOAD(&in->pend_seq));
 	}
 }
@@ -451,6 +459,8 @@ static int post_binding(struct arflex_component *c, struct arflex_input *in,
 	if (!c->running) {
 		close_binding(in->cur);
 		in->cur = p == &unbind_marker ? NULL : p;
+		if (in->cur)
+			in->binding++;
 		return 0;
 	}
 	seq = LOAD(&in->pend_seq) + 1;

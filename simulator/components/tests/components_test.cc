@@ -129,6 +129,7 @@ std::vector<arflex_param_slot> RobotParams(int64_t steps_per_period) {
       ParamF("guide_dy", 0.2, -1, 1, true),
       ParamF("guide_dz", 0, -1, 1, true),
       ParamF("guide_duration_ms", 2000, 1, 60000, true),
+      ParamF("ref_acquire_tol", 0.05, 0.001, 0.5, true),
   };
 }
 
@@ -222,6 +223,18 @@ class SimComponents : public ::testing::Test {
     ASSERT_EQ(arflex_port_create(&ref_, name, &spec), 0);
     ref_name_ = name;
   }
+  // Writes the home pose (where the arm starts) and waits until the robot has run two
+  // periods after it, so that it has read it: the reference is acquired (ref_acquire_tol)
+  // and the next values are followed wherever they go.
+  void AcquireAtHome(arflex_port* js_port) {
+    arflex_joint_state js{};
+    uint64_t first = 0;  // seq of the first state read after the write
+    WriteReference(kHome);
+    ASSERT_TRUE(WaitFor([&] {
+      if (arflex_state_read(js_port, &js, sizeof(js), nullptr) == 1 && first == 0) first = js.seq;
+      return first != 0 && js.seq > first + 2;
+    }));
+  }
   void WriteReference(const double q[6]) {
     static uint64_t seq = 0;
     arflex_joint_ref r{};
@@ -293,6 +306,7 @@ TEST_F(SimComponents, RobotFollowsJointReference) {
 
   const double target[6] = {0.15, 0.45, 0.35, 0.2, 0.7, 0.3};
   ASSERT_EQ(arflex_host_bind(&robot_, "joint_ref", ref_name_.c_str(), kCall), 0);
+  AcquireAtHome(&js_port);  // acquisition: the first reference meets the arm
   WriteReference(target);
   const bool reached = WaitFor([&] {
     if (!Latest(&js_port, &js, &have)) return false;
@@ -320,6 +334,94 @@ TEST_F(SimComponents, RobotFollowsJointReference) {
   EXPECT_EQ(arflex_host_stop(&robot_, kCall), 0);
   arflex_port_close(&js_port);
   arflex_port_close(&wr_port);
+  Shutdown(&robot_);
+}
+
+// Reference acquisition (ref_acquire_tol): a provider's reference is followed only once a
+// value lies near the measured arm; a far one is refused (the arm holds, one update error per
+// episode) until the provider comes to the arm. Every new binding starts over, even to the same
+// provider (it may have restarted elsewhere on its program).
+TEST_F(SimComponents, RobotAcquiresOnlyAReferenceNearTheArm) {
+  CreateRobot(1 * kMs, 1, false);
+  CreateReference();
+  arflex_port js_port;
+  OpenReader(&robot_, "joint_state", ARFLEX_PORT_STATE, &kJointStateType, &js_port);
+  ASSERT_EQ(arflex_host_start(&robot_, kCall), 0);
+  arflex_joint_state js{};
+  bool have = false;
+  arflex_stats st;
+  auto errors = [&] {
+    EXPECT_EQ(arflex_ctl_stats_read(robot_.ctl, &st), 0);
+    return st.update_errors;
+  };
+  // Let `periods` robot periods pass; returns the largest distance of any joint from home.
+  auto hold_for = [&](uint64_t periods) {
+    double worst = 0;
+    EXPECT_TRUE(WaitFor([&] { return Latest(&js_port, &js, &have); }));
+    const uint64_t seq0 = js.seq;
+    EXPECT_TRUE(WaitFor([&] {
+      arflex_joint_state v;
+      if (arflex_state_read(&js_port, &v, sizeof(v), nullptr) == 1) {
+        js = v;
+        for (int i = 0; i < 6; ++i) worst = std::max(worst, std::fabs(v.q[i] - kHome[i]));
+      }
+      return js.seq > seq0 + periods;
+    }));
+    return worst;
+  };
+  const uint64_t e0 = errors();
+  ASSERT_EQ(arflex_host_bind(&robot_, "joint_ref", ref_name_.c_str(), kCall), 0);
+  // 0.3 rad away on joint 1, written every cycle for 300 periods: refused, the arm holds, one
+  // error for the whole episode.
+  double far[6] = {0.3, 0.5, 0.3, 0.0, 0.8, 0.0};
+  const uint64_t t_end = Now() + 300 * kMs;
+  double worst = 0;
+  while (Now() < t_end) {
+    WriteReference(far);
+    worst = std::max(worst, hold_for(1));
+  }
+  EXPECT_LT(worst, 1e-3) << "the arm moved towards a reference it had not acquired";
+  EXPECT_EQ(errors(), e0 + 1) << "one refusal episode";
+  // Within ref_acquire_tol (0.05 rad): acquired, taken up smoothly (a quintic over 0.5 s:
+  // peak speed 1.875 * 0.015 / 0.5 = 0.056 rad/s; the servo taking the 15 mrad step at once
+  // reaches several times that), then followed; then a far target is followed too.
+  const double near_arm[6] = {0.015, 0.5, 0.3, 0.0, 0.8, 0.0};
+  WriteReference(near_arm);
+  double peak_qd = 0;
+  ASSERT_TRUE(WaitFor([&] {
+    arflex_joint_state v;
+    if (arflex_state_read(&js_port, &v, sizeof(v), nullptr) == 1) {
+      js = v;
+      peak_qd = std::max(peak_qd, std::fabs(v.qd[0]));
+    }
+    return std::fabs(js.q[0] - 0.015) < 1e-4;
+  }));
+  printf("acquisition of a reference 15 mrad from the arm: peak joint speed %.4f rad/s\n", peak_qd);
+  EXPECT_LT(peak_qd, 0.07) << "the offset was not blended in";
+  WriteReference(far);
+  ASSERT_TRUE(WaitFor([&] { return Latest(&js_port, &js, &have) && std::fabs(js.q[0] - 0.3) < 1e-3; }));
+  EXPECT_EQ(errors(), e0 + 1);
+  // Unbound, the provider moves on to home; bound again (another binding of the same
+  // provider): the arm is at 0.3, the reference 0.3 away: refused again, a new episode.
+  ASSERT_EQ(arflex_host_unbind(&robot_, "joint_ref", kCall), 0);
+  WriteReference(kHome);
+  ASSERT_EQ(arflex_host_bind(&robot_, "joint_ref", ref_name_.c_str(), kCall), 0);
+  ASSERT_TRUE(WaitFor([&] { return errors() == e0 + 2; })) << "errors " << errors() - e0;
+  hold_for(200);
+  EXPECT_NEAR(js.q[0], 0.3, 1e-3) << "held at the last acquired reference";
+  // A larger tolerance (mutable) lets the same reference in.
+  SetF(&robot_, "ref_acquire_tol", 0.5);
+  WriteReference(kHome);
+  ASSERT_TRUE(WaitFor([&] { return Latest(&js_port, &js, &have) && std::fabs(js.q[0]) < 1e-3; }));
+  // STOP/START: acquisition again.
+  SetF(&robot_, "ref_acquire_tol", 0.05);
+  EXPECT_EQ(arflex_host_stop(&robot_, kCall), 0);
+  ASSERT_EQ(arflex_host_start(&robot_, kCall), 0);
+  WriteReference(far);
+  ASSERT_TRUE(WaitFor([&] { return errors() == e0 + 3; })) << "errors " << errors() - e0;
+  EXPECT_LT(hold_for(200), 1e-3);
+  EXPECT_EQ(arflex_host_stop(&robot_, kCall), 0);
+  arflex_port_close(&js_port);
   Shutdown(&robot_);
 }
 
@@ -496,6 +598,7 @@ TEST_F(SimComponents, RobotSafeHookHoldsPosition) {
   ASSERT_EQ(arflex_host_bind(&robot_, "joint_ref", ref_name_.c_str(), kCall), 0);
   // A motion is under way when the runtime's heartbeat stops: the arm must stop where it is.
   const double far[6] = {0.9, 0.5, 0.3, 0.0, 0.8, 0.0};
+  AcquireAtHome(&js_port);
   WriteReference(far);
   arflex_joint_state js{};
   arflex_sim_ground_truth g{};

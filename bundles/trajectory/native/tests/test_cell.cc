@@ -367,6 +367,124 @@ void CaseProgramSwitch() {
 }
 
 
+// A robot that appears while the trajectory plays (joint_state bound late, as when the
+// trajectory is installed first), somewhere else than the output: the program starts over from
+// the measured pose (no reference pulling the arm across), at rest, within the limits, and
+// plays to its end. Bound again to a robot that followed the output (the same robot rewired):
+// the program goes on where it was.
+void CaseLateRobot() {
+  static struct arflex_host script, traj;
+  const std::string dir = MakeDataDir();
+  CHECK(!dir.empty(), "mkdtemp");
+  bool ok = WriteText(arflex::cellkin::ProgramPath(dir, 1),
+                      "arflex-program 1\nstart 0 0 0 0 0 0\nptp 0.5 0 0 0 0 0 speed 0.3\n"
+                      "ptp 0.5 0.3 0 0 0 0 speed 0.3\n");
+  std::string env = "ARFLEX_DATA_DIR=" + dir;
+  char* envp[] = {const_cast<char*>(env.c_str()), nullptr};
+  int r = ok ? Make(&script, "script", kMs, {{"joint_state", kJsT}}, {}, nullptr) : -EIO;
+  CHECK(r == 0, "script: %d", r);
+  r = Make(&traj, "trajectory", kMs, {{"joint_ref", kRefT}, {"tool_id", kSampleT}}, TrajectoryParams(),
+           "trajectory", envp);
+  RemoveDir(dir);
+  CHECK(r == 0, "create/spawn trajectory: %d", r);
+  CHECK(SetI(&traj, "program", 1) == 0 && arflex_host_start(&traj, kCall) == 0, "start program 1");
+  Reader rd;
+  CHECK(rd.Open(&traj, "joint_ref", &kRefT) == 0, "open joint_ref");
+  const double deg = M_PI / 180;
+  const double vmax[6] = {123 * deg, 115 * deg, 112 * deg, 179 * deg, 172 * deg, 219 * deg};
+  struct arflex_port* js_out = arflex_host_output(&script, "joint_state");
+  uint64_t js_seq = 0;
+  auto write_js = [&](const Q& q) {
+    struct arflex_joint_state js;
+    memset(&js, 0, sizeof(js));
+    js.t_ns = (int64_t)Now();
+    js.seq = ++js_seq;
+    for (int j = 0; j < 6; ++j) js.q[j] = q[j];
+    arflex_state_write(js_out, &js, sizeof(js));
+  };
+  Q robot;
+  robot << -0.2, 0.4, 0.3, 0.1, 0.8, -0.1;  // where the late robot's arm is
+  Q q = Q::Zero(), last = Q::Zero();
+  uint64_t seq = 0, last_seq = 0, stable = 0;
+  int phase = 0;  // 0 unbound, 1 bound far (restart expected), 2 rebound while following
+  double jump = -1, worst = 0, q2_min_after_rebind = 1e9, q1_min_phase1 = 1e9;
+  const uint64_t deadline = Now() + kWait;
+  while (Now() < deadline) {
+    struct arflex_joint_ref ref;
+    if (rd.Read(&ref, &seq) != 1) {
+      sched_yield();
+      continue;
+    }
+    for (int j = 0; j < 6; ++j) q[j] = ref.q[j];
+    const bool consecutive = last_seq && seq == last_seq + 1;
+    if (phase == 0 && q[0] > 0.1) {  // in the middle of the first motion: the robot appears
+      write_js(robot);
+      CHECK(arflex_host_bind(&traj, "joint_state", arflex_host_output_name(&script, "joint_state"), kCall) == 0,
+            "bind joint_state");
+      phase = 1;
+    } else if (phase == 1) {
+      if (jump < 0) {
+        if ((q - robot).cwiseAbs().maxCoeff() < 1e-3) jump = (q - last).cwiseAbs().maxCoeff();  // restarted
+      } else {
+        q1_min_phase1 = std::min(q1_min_phase1, q[0]);
+        for (int j = 0; consecutive && j < 6; ++j) worst = std::max(worst, std::fabs(q[j] - last[j]) / (vmax[j] * 1e-3));
+        write_js(q);  // the robot follows from now on
+        if (std::fabs(q[0] - 0.5) < 1e-12 && q[1] > 0.05) {  // in the second motion: the same robot rewired
+          CHECK(arflex_host_bind(&traj, "joint_state", arflex_host_output_name(&script, "joint_state"), kCall) == 0,
+                "bind joint_state again");
+          phase = 2;
+        }
+      }
+    } else if (phase == 2) {
+      write_js(q);
+      for (int j = 0; consecutive && j < 6; ++j) worst = std::max(worst, std::fabs(q[j] - last[j]) / (vmax[j] * 1e-3));
+      q2_min_after_rebind = std::min(q2_min_after_rebind, q[1]);
+      stable = (q - last).norm() == 0 ? stable + 1 : 0;
+      if (std::fabs(q[1] - 0.3) < 1e-12 && stable > 50) break;
+    }
+    last = q;
+    last_seq = seq;
+  }
+  printf("late_robot: output jumped %.3f rad to the arm when it appeared; then max |dq| per cycle %.3f of vmax*dt; "
+         "q2 after the rewiring >= %.4f\n", jump, worst, q2_min_after_rebind);
+  CHECK(phase == 2, "phase %d reached (the program did not restart from the arm and play on)", phase);
+  CHECK(jump > 0.1, "the output did not start over at the robot's pose (step %g)", jump);
+  CHECK(q1_min_phase1 >= robot[0] - 1e-9, "the restarted program went below the arm's q1 (%g)", q1_min_phase1);
+  CHECK(worst <= 1.0 + 1e-9, "a joint moved %.4f x vmax*dt in one cycle after the restart", worst);
+  CHECK(q2_min_after_rebind > 0.05 - 1e-3, "the program restarted when the following robot was rewired (q2 %g)",
+        q2_min_after_rebind);
+  CHECK(std::fabs(last[1] - 0.3) < 1e-12 && std::fabs(last[0] - 0.5) < 1e-12, "did not end on the last target");
+  // The program has ended. An arm that stays 30 mrad away (inside the 50 mrad tolerance: a
+  // corrected arm sits up to 20 mrad off) for 1.5 s leaves the output where it is; one that
+  // stays 80 mrad away (its robot does not follow) for 1 s gets the output moved to it.
+  auto hold_arm = [&](const Q& arm, uint64_t ns, Q* out) {
+    const uint64_t end = Now() + ns;
+    while (Now() < end) {
+      write_js(arm);
+      struct arflex_joint_ref ref;
+      if (rd.Read(&ref, &seq) == 1)
+        for (int j = 0; j < 6; ++j) (*out)[j] = ref.q[j];
+      sched_yield();
+    }
+  };
+  Q end_pose = last, out = last, arm = last;
+  arm[0] += 0.03;
+  hold_arm(arm, 1500 * kMs, &out);
+  CHECK((out - end_pose).cwiseAbs().maxCoeff() == 0, "the output moved to an arm 30 mrad away");
+  arm[0] = end_pose[0] + 0.08;
+  const uint64_t t_away = Now();
+  bool moved = false;
+  while (!moved && Now() < t_away + 5 * kSec) {
+    hold_arm(arm, 10 * kMs, &out);
+    moved = (out - arm).cwiseAbs().maxCoeff() < 1e-12;
+  }
+  printf("late_robot: an arm 80 mrad from the ended program's output got it after %.2f s\n", (Now() - t_away) * 1e-9);
+  CHECK(moved, "the idle output did not move to an arm 80 mrad away");
+  CHECK(Now() - t_away >= 990 * kMs, "the output moved before the arm had been away for 1 s");
+  CHECK(arflex_host_stop(&traj, kCall) == 0, "stop");
+}
+
+
 // ---- force-guard ----------------------------------------------------------------------------
 
 std::vector<struct arflex_param_slot> GuardParams() {
@@ -814,7 +932,7 @@ void CaseBadProgram() {
 
 int main(int argc, char** argv) {
   if (argc != 3) {
-    fprintf(stderr, "usage: %s <trajectory|program_switch|bad_program|force_guard|teach_replay|tools> <bin dir>\n", argv[0]);
+    fprintf(stderr, "usage: %s <trajectory|program_switch|late_robot|bad_program|force_guard|teach_replay|tools> <bin dir>\n", argv[0]);
     return 2;
   }
   bindir = argv[2];
@@ -826,6 +944,7 @@ int main(int argc, char** argv) {
   else if (c == "tools") CaseTools();
   else if (c == "bad_program") CaseBadProgram();
   else if (c == "program_switch") CaseProgramSwitch();
+  else if (c == "late_robot") CaseLateRobot();
   else {
     fprintf(stderr, "unknown case '%s'\n", argv[1]);
     return 2;

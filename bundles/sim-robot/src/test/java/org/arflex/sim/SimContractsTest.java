@@ -75,7 +75,7 @@ class SimContractsTest {
                 "OUT wrench arflex.Wrench STATE"), ports);
         Set<String> rt = rtParams(BUNDLES.resolve("sim-robot/native/sim_robot.cc"),
                 Pattern.compile("\\{\"([a-z_]+)\", [-0-9.]+, '[dib]'\\}"));
-        assertEquals(18, rt.size(), "parameters found in sim_robot.cc: " + rt);
+        assertEquals(19, rt.size(), "parameters found in sim_robot.cc: " + rt);
         assertEquals(rt, props(c), "contract properties == parameters the RT half reads");
     }
 
