@@ -210,10 +210,17 @@ void Cell::Controller() {
   // PD servo: the P term and the gravity feed-forward are applied here; the D term
   // (kd * -dq, reference velocity zero) is part of the joint damping in the model so that
   // MuJoCo integrates it implicitly (stable at 1 kHz with stiff gains).
+  // Reduced power: the corrective term is saturated, the gravity feed-forward is not.
   for (int i = 0; i < kNumJoints; ++i) {
     const double target = q_ref_[i] + correction_[i];
-    data_->ctrl[i] = config_.gains.kp[i] * (target - q[i]) + gravity[i];
+    const double limit = power_scale_ * config_.arm.links[i].max_torque;
+    const double p_term = std::clamp(config_.gains.kp[i] * (target - q[i]), -limit, limit);
+    data_->ctrl[i] = p_term + gravity[i];
   }
+}
+
+void Cell::SetPowerScale(double fraction) {
+  power_scale_ = std::isfinite(fraction) ? std::clamp(fraction, 0.0, 1.0) : 0.0;
 }
 
 void Cell::ApplyDisturbances() {

@@ -50,6 +50,54 @@ TEST(DisturbanceTest, PushDisplacesTheToolAndTheSensorFeelsIt) {
   EXPECT_LT((cell->TrueTcp().translation() - rest).norm(), 5e-6);
 }
 
+// Reduced power (force-guard's protective stop): the servo's corrective torque is saturated at
+// the fraction of each drive's max torque, so a push the full-power arm holds to 1.5 mrad moves
+// the limited arm; gravity compensation is not limited, so the limited arm at rest does not sag.
+TEST(DisturbanceTest, ReducedPowerSaturatesTheServoAndTheArmYields) {
+  CellConfig config = DefaultCellConfig();
+  config.pushes = {{0.5, 0.45, {0.0, 1500.0, 0.0}}};  // 1500 N sideways for 450 ms
+  auto yield = [&](double fraction, double* max_p_term) {
+    std::string error;
+    auto cell = Cell::Create(config, kPose, &error);
+    EXPECT_NE(cell, nullptr) << error;
+    cell->SetPowerScale(fraction);
+    cell->Step(500);
+    const double q0 = cell->ReadJointState().q[0];
+    *max_p_term = 0.0;
+    for (int k = 0; k < 450; ++k) {
+      cell->Step(1);
+      const JointVector g = cell->NominalGravityTorque(cell->ReadJointState().q, 0.0);
+      *max_p_term = std::max(*max_p_term, std::fabs(cell->data()->ctrl[0] - g[0]));
+    }
+    return std::fabs(cell->ReadJointState().q[0] - q0);
+  };
+  double p_full = 0, p_limited = 0;
+  const double full = yield(1.0, &p_full);
+  const double limited = yield(0.1, &p_limited);
+  const double limit = 0.1 * config.arm.links[0].max_torque;  // 1500 N m on joint 1
+  EXPECT_GT(p_full, 1.2 * limit);  // the full-power servo resists with more than the limit
+  EXPECT_LE(p_limited, limit + 1e-6);
+  EXPECT_LT(full, 3e-3);
+  EXPECT_GT(limited, 5.0 * full) << "full power " << full << " rad, limited " << limited << " rad";
+
+  // At rest the limited arm holds (gravity compensation is not limited).
+  std::string error;
+  auto cell = Cell::Create(DefaultCellConfig(), kPose, &error);
+  ASSERT_NE(cell, nullptr) << error;
+  cell->SetPowerScale(0.1);
+  cell->Step(200);
+  const Eigen::Vector3d rest = cell->TrueTcp().translation();
+  cell->Step(2000);
+  EXPECT_LT((cell->TrueTcp().translation() - rest).norm(), 5e-6);
+  // Bad inputs: clamped, a non-finite fraction is no power.
+  cell->SetPowerScale(2.0);
+  EXPECT_EQ(cell->power_scale(), 1.0);
+  cell->SetPowerScale(-1.0);
+  EXPECT_EQ(cell->power_scale(), 0.0);
+  cell->SetPowerScale(std::nan(""));
+  EXPECT_EQ(cell->power_scale(), 0.0);
+}
+
 // Sweeps joint 1 from 0 to 0.5 rad at 0.25 rad/s, the reference updated every 10 ms.
 void Sweep(Cell* cell, int* max_contacts, double* max_force) {
   JointVector ref = kPose;

@@ -7,6 +7,11 @@
 // `wrench` (arflex.Wrench: wrist F/T in the flange frame). Evaluation runs also get the
 // ground truth in `truth` (eval.GroundTruth, not a contract port; see ground_truth.h).
 //
+// Optional input `safety` (arflex.SafetyState, role=safety: the force guard): its power_scale
+// limits the drives (Cell::SetPowerScale: the servo's corrective torque saturates at that
+// fraction of each drive's max torque); unbound, or before a first value, full power. The
+// fraction applied is published on `servo_power` (arflex.Sample) every period.
+//
 // Scripted disturbances come from parameters (see the contract, sim-robot.xml). The safe hook
 // holds the arm where it is (the servo's reference becomes the measured pose).
 //
@@ -19,6 +24,8 @@
 #include <arflex/component.h>
 #include <arflex_types/joint_ref.h>
 #include <arflex_types/joint_state.h>
+#include <arflex_types/safety_state.h>
+#include <arflex_types/sample.h>
 #include <arflex_types/wrench.h>
 
 #include <cerrno>
@@ -56,6 +63,12 @@ const arflex_port_type kJointStateType = {ARFLEX_TYPE_JOINT_STATE_NAME,
                                           ARFLEX_TYPE_JOINT_STATE_SIZE};
 const arflex_port_type kWrenchType = {ARFLEX_TYPE_WRENCH_NAME, ARFLEX_TYPE_WRENCH_VERSION_MAJOR,
                                       ARFLEX_TYPE_WRENCH_VERSION_MINOR, ARFLEX_TYPE_WRENCH_SIZE};
+const arflex_port_type kSafetyType = {ARFLEX_TYPE_SAFETY_STATE_NAME,
+                                      ARFLEX_TYPE_SAFETY_STATE_VERSION_MAJOR,
+                                      ARFLEX_TYPE_SAFETY_STATE_VERSION_MINOR,
+                                      ARFLEX_TYPE_SAFETY_STATE_SIZE};
+const arflex_port_type kSampleType = {ARFLEX_TYPE_SAMPLE_NAME, ARFLEX_TYPE_SAMPLE_VERSION_MAJOR,
+                                      ARFLEX_TYPE_SAMPLE_VERSION_MINOR, ARFLEX_TYPE_SAMPLE_SIZE};
 const arflex_port_type kTruthType = {ARFLEX_SIM_TRUTH_TYPE_NAME, ARFLEX_SIM_TRUTH_VERSION_MAJOR,
                                      ARFLEX_SIM_TRUTH_VERSION_MINOR, ARFLEX_SIM_TRUTH_SIZE};
 
@@ -99,6 +112,8 @@ struct Robot {
   arflex_port* wrench = nullptr;
   arflex_port* truth = nullptr;  // only in evaluation runs
   arflex_input* joint_ref = nullptr;
+  arflex_input* safety = nullptr;
+  arflex_port* servo_power = nullptr;
   int idx[kParamCount];
   // Change detection of the disturbance parameters (applied at the cycle they change).
   double push_sig[5];
@@ -222,6 +237,13 @@ int StepAndPublish(const arflex_component* c, Robot& r, uint64_t release_ns) {
   }
   if (ret == 0) ret = arflex_state_write(r.wrench, &wr, sizeof(wr));
 
+  arflex_sample pw;
+  std::memset(&pw, 0, sizeof(pw));
+  pw.seq = r.seq;
+  pw.t_ns = out.t_ns;
+  pw.value = cell.power_scale();
+  if (ret == 0) ret = arflex_state_write(r.servo_power, &pw, sizeof(pw));
+
   if (r.truth) {
     arflex_sim_ground_truth g;
     std::memset(&g, 0, sizeof(g));
@@ -277,8 +299,15 @@ int Configure(arflex_component* c, void* user) {
     ret = arflex_component_output(c, "wrench", ARFLEX_PORT_STATE, &kWrenchType, &r.wrench);
   }
   if (ret == 0) {
+    ret = arflex_component_output(c, "servo_power", ARFLEX_PORT_STATE, &kSampleType,
+                                  &r.servo_power);
+  }
+  if (ret == 0) {
     ret = arflex_component_input(c, "joint_ref", ARFLEX_PORT_STATE, &kJointRefType,
                                  &r.joint_ref);
+  }
+  if (ret == 0) {
+    ret = arflex_component_input(c, "safety", ARFLEX_PORT_STATE, &kSafetyType, &r.safety);
   }
   if (ret < 0) return ret;
 
@@ -334,6 +363,15 @@ int Update(arflex_component* c, void* user, uint64_t release_ns) {
   Robot& r = *static_cast<Robot*>(user);
   r.safe = false;
   ApplyParams(c, r);
+  // The safety controller's power limit: a new value is applied at once (this period's
+  // physics steps); between values the last one stays; no provider, full power.
+  arflex_safety_state safety;
+  const int sgot = arflex_input_state_read(r.safety, &safety, sizeof(safety), nullptr);
+  if (sgot == 1) {
+    r.cell->SetPowerScale(safety.power_scale);
+  } else if (sgot == -ENOTCONN) {
+    r.cell->SetPowerScale(1.0);
+  }
   arflex_joint_ref ref;
   const int got = arflex_input_state_read(r.joint_ref, &ref, sizeof(ref), nullptr);
   int ret = 0;

@@ -16,6 +16,7 @@
 #include <arflex/host.h>
 #include <arflex_types/image_frame.h>
 #include <arflex_types/joint_state.h>
+#include <arflex_types/sample.h>
 #include <arflex_types/wrench.h>
 
 #include <cstdio>
@@ -135,12 +136,14 @@ bool Run(const Options& opt, bool with_camera, Result* out) {
   const arflex_port_type js_type = {ARFLEX_TYPE_JOINT_STATE_NAME, 1, 0,
                                     ARFLEX_TYPE_JOINT_STATE_SIZE};
   const arflex_port_type wr_type = {ARFLEX_TYPE_WRENCH_NAME, 1, 0, ARFLEX_TYPE_WRENCH_SIZE};
+  const arflex_port_type pw_type = {ARFLEX_TYPE_SAMPLE_NAME, 1, 0, ARFLEX_TYPE_SAMPLE_SIZE};
   const arflex_port_type fr_type = {
       ARFLEX_TYPE_IMAGE_FRAME_NAME, 1, 0,
       ARFLEX_TYPE_IMAGE_FRAME_SIZE + ARFLEX_TYPE_IMAGE_FRAME_MAX_PAYLOAD};
-  struct arflex_host_output robot_outs[2] = {
+  struct arflex_host_output robot_outs[3] = {
       {"joint_state", {ARFLEX_PORT_STATE, js_type, 1, ARFLEX_OVERFLOW_NONE}},
       {"wrench", {ARFLEX_PORT_STATE, wr_type, 1, ARFLEX_OVERFLOW_NONE}},
+      {"servo_power", {ARFLEX_PORT_STATE, pw_type, 1, ARFLEX_OVERFLOW_NONE}},
   };
   arflex_host_opts ro{};
   ro.runtime = rid;
@@ -150,7 +153,7 @@ bool Run(const Options& opt, bool with_camera, Result* out) {
   ro.config.hb_timeout_ns = 0;
   ro.config.cfg_flags = ARFLEX_CFG_MOVES_HARDWARE;
   ro.outputs = robot_outs;
-  ro.noutputs = 2;
+  ro.noutputs = 3;
 
   arflex_param_slot cam_params[3] = {ParamI("camera", 0), ParamI("width", opt.width),
                                      ParamI("height", opt.height)};

@@ -13,6 +13,8 @@
 #include <arflex_types/image_frame.h>
 #include <arflex_types/joint_ref.h>
 #include <arflex_types/joint_state.h>
+#include <arflex_types/safety_state.h>
+#include <arflex_types/sample.h>
 #include <arflex_types/wrench.h>
 #include <gtest/gtest.h>
 
@@ -45,6 +47,9 @@ const arflex_port_type kJointRefType = {ARFLEX_TYPE_JOINT_REF_NAME, 1, 0,
 const arflex_port_type kJointStateType = {ARFLEX_TYPE_JOINT_STATE_NAME, 1, 0,
                                           ARFLEX_TYPE_JOINT_STATE_SIZE};
 const arflex_port_type kWrenchType = {ARFLEX_TYPE_WRENCH_NAME, 1, 0, ARFLEX_TYPE_WRENCH_SIZE};
+const arflex_port_type kSafetyType = {ARFLEX_TYPE_SAFETY_STATE_NAME, 1, 0,
+                                      ARFLEX_TYPE_SAFETY_STATE_SIZE};
+const arflex_port_type kSampleType = {ARFLEX_TYPE_SAMPLE_NAME, 1, 0, ARFLEX_TYPE_SAMPLE_SIZE};
 const arflex_port_type kTruthType = {ARFLEX_SIM_TRUTH_TYPE_NAME, 1, 0, ARFLEX_SIM_TRUTH_SIZE};
 const arflex_port_type kFrameType = {ARFLEX_TYPE_IMAGE_FRAME_NAME, 1, 0, kFrameElem};
 
@@ -173,6 +178,7 @@ class SimComponents : public ::testing::Test {
     std::vector<struct arflex_host_output> outs = {
         {"joint_state", {ARFLEX_PORT_STATE, kJointStateType, 1, ARFLEX_OVERFLOW_NONE}},
         {"wrench", {ARFLEX_PORT_STATE, kWrenchType, 1, ARFLEX_OVERFLOW_NONE}},
+        {"servo_power", {ARFLEX_PORT_STATE, kSampleType, 1, ARFLEX_OVERFLOW_NONE}},
     };
     if (truth) outs.push_back({"truth", {ARFLEX_PORT_STATE, kTruthType, 1, ARFLEX_OVERFLOW_NONE}});
     arflex_host_opts o{};
@@ -423,6 +429,53 @@ TEST_F(SimComponents, RobotAcquiresOnlyAReferenceNearTheArm) {
   EXPECT_EQ(arflex_host_stop(&robot_, kCall), 0);
   arflex_port_close(&js_port);
   Shutdown(&robot_);
+}
+
+// The force guard's power limit reaches the drives: a SafetyState value on the optional safety
+// input sets the fraction the servo may use (published on servo_power); a non-finite one is no
+// power; unbound, full power again. (The physics of the limit: sim.DisturbanceTest.
+// ReducedPowerSaturatesTheServoAndTheArmYields.)
+TEST_F(SimComponents, RobotTakesThePowerLimitOfTheSafetyInput) {
+  CreateRobot(1 * kMs, 1, false);
+  char name[ARFLEX_OBJ_NAME_SIZE];
+  ASSERT_EQ(arflex_ctl_obj_name(name, sizeof(name), rid_, "guard", "out.safety"), 0);
+  arflex_port_spec spec{ARFLEX_PORT_STATE, kSafetyType, 1, ARFLEX_OVERFLOW_NONE};
+  arflex_port feed;
+  ASSERT_EQ(arflex_port_create(&feed, name, &spec), 0);
+  arflex_port pw_port;
+  OpenReader(&robot_, "servo_power", ARFLEX_PORT_STATE, &kSampleType, &pw_port);
+  ASSERT_EQ(arflex_host_start(&robot_, kCall), 0);
+  arflex_sample pw{};
+  bool have = false;
+  auto power_is = [&](double v) {
+    return WaitFor([&] { return Latest(&pw_port, &pw, &have) && pw.value == v; });
+  };
+  uint64_t seq = 0;
+  auto guard = [&](double scale) {
+    arflex_safety_state s{};
+    s.seq = ++seq;
+    s.mode = scale < 1.0 ? ARFLEX_SAFETY_STATE_MODE_PROTECTIVE_STOP : ARFLEX_SAFETY_STATE_MODE_NORMAL;
+    s.power_scale = scale;
+    ASSERT_EQ(arflex_state_write(&feed, &s, sizeof(s)), 0);
+  };
+  EXPECT_TRUE(power_is(1.0)) << "unbound: full power, got " << pw.value;
+  guard(0.25);
+  EXPECT_TRUE(WaitFor([&] { return Latest(&pw_port, &pw, &have) && pw.seq > 50; }));
+  EXPECT_EQ(pw.value, 1.0) << "a value on an unbound input must not count";
+  ASSERT_EQ(arflex_host_bind(&robot_, "safety", name, kCall), 0);
+  EXPECT_TRUE(power_is(0.25)) << "got " << pw.value;
+  guard(std::nan(""));
+  EXPECT_TRUE(power_is(0.0)) << "non-finite: no power, got " << pw.value;
+  guard(1.0);
+  EXPECT_TRUE(power_is(1.0)) << "got " << pw.value;
+  guard(0.1);
+  EXPECT_TRUE(power_is(0.1)) << "got " << pw.value;
+  ASSERT_EQ(arflex_host_unbind(&robot_, "safety", kCall), 0);
+  EXPECT_TRUE(power_is(1.0)) << "unbound again: full power, got " << pw.value;
+  EXPECT_EQ(arflex_host_stop(&robot_, kCall), 0);
+  arflex_port_close(&pw_port);
+  Shutdown(&robot_);
+  EXPECT_EQ(arflex_port_destroy(&feed), 0);
 }
 
 TEST_F(SimComponents, RobotLockStepPeriodsEqualPhysicsSteps) {

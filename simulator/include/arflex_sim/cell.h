@@ -51,6 +51,12 @@ class Cell {
   // correction component acts on the arm). Both in rad, motor side.
   void SetJointReference(const JointVector& q_ref) { q_ref_ = q_ref; }
   void SetCorrection(const JointVector& dq) { correction_ = dq; }
+  // Power limit of the drives (a safety controller's reduced-power mode): the servo's
+  // corrective torque (the P term, gravity compensation excluded, so a limited arm does not
+  // sag) is saturated at `fraction` x the drive's max torque on every joint. 1 = full power
+  // (the default); values outside [0, 1] are clamped, a non-finite one counts as 0.
+  void SetPowerScale(double fraction);
+  double power_scale() const { return power_scale_; }
 
   // Advances exactly `n` physics steps of config.timestep; each runs the servo once. No
   // sleeping: real-time pacing is the caller's business.
@@ -134,6 +140,7 @@ class Cell {
   int ft_torque_adr_ = -1;
   JointVector q_ref_{};
   JointVector correction_{};
+  double power_scale_ = 1.0;
   double payload_mass_ = 0.0;
   std::vector<PushSpec> pushes_;  // capacity fixed at Create()
   size_t push_capacity_ = 0;

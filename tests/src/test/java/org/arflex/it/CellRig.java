@@ -267,6 +267,13 @@ final class CellRig {
         }
     }
 
+    /** arflex.Sample: seq, t_ns, value. */
+    record Sample(long seq, long tNs, double value) {
+        static Sample of(java.nio.ByteBuffer v) {
+            return v == null ? null : new Sample(v.getLong(0), v.getLong(8), v.getDouble(16));
+        }
+    }
+
     static final int REF_SIZE = 64;
     static final int JOINT_STATE_SIZE = 160;
     static final int WRENCH_SIZE = 64;

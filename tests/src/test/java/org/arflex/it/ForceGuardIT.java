@@ -19,7 +19,10 @@ import org.junit.jupiter.api.Test;
  * after the push shows in the wrist sensor (cycle timestamps of the two RT halves, not the
  * test's clock). The trajectory then decelerates along its path and its joint_ref stays
  * bit-identical for more than 1000 of its cycles, through the end of the push, until the
- * operator's {@code arflex:reset force-guard}; then the motion resumes.
+ * operator's {@code arflex:reset force-guard}; then the motion resumes. The robot's drives take
+ * the guard's power limit: sim-robot's {@code servo_power} is 1 while NORMAL, drops to the
+ * guard's {@code safe_power_fraction} in the same or the next robot cycle after the stop, and is
+ * 1 again after the reset.
  */
 class ForceGuardIT {
 
@@ -53,6 +56,7 @@ class ForceGuardIT {
             assertTrue(b.contains("trajectory.safety <- force-guard.safety"), b);
             assertTrue(b.contains("force-guard.wrench <- sim-robot.wrench"), b);
             assertTrue(b.contains("force-guard.joint_state <- sim-robot.joint_state"), b);
+            assertTrue(b.contains("sim-robot.safety <- force-guard.safety"), b);
             long guardPid = rt.pid("force-guard");
             long trajPid = rt.pid("trajectory");
 
@@ -61,6 +65,7 @@ class ForceGuardIT {
             CellRig.Trace<CellRig.Ref> refT = new CellRig.Trace<>();
             CellRig.Trace<CellRig.JointState> jsT = new CellRig.Trace<>();
             CellRig.Trace<CellRig.Ref> armRefT = new CellRig.Trace<>();
+            CellRig.Trace<CellRig.Sample> powerT = new CellRig.Trace<>();
             // what the arm is told to follow (tcp-correction's output when the cell has one)
             String armSource = cell.contains("tcp-correction") ? "tcp-correction" : "trajectory";
             String armPort = cell.contains("tcp-correction") ? "corrected" : "joint_ref";
@@ -69,17 +74,19 @@ class ForceGuardIT {
                     CellRig.Port rp = new CellRig.Port(rt.segment("trajectory", "joint_ref"), CellRig.REF_SIZE);
                     CellRig.Port jp = new CellRig.Port(rt.segment("sim-robot", "joint_state"), CellRig.JOINT_STATE_SIZE);
                     CellRig.Port ap = new CellRig.Port(rt.segment(armSource, armPort), CellRig.REF_SIZE);
+                    CellRig.Port pp = new CellRig.Port(rt.segment("sim-robot", "servo_power"), CellRig.SAMPLE_SIZE);
                     CellRig.Recorder rec = new CellRig.Recorder()) {
                 rec.add(sp, CellRig.Safety::of, CellRig.Safety::seq, safetyT::add);
                 rec.add(wp, CellRig.Wrench::of, CellRig.Wrench::seq, wrenchT::add);
                 rec.add(rp, CellRig.Ref::of, CellRig.Ref::seq, refT::add);
                 rec.add(jp, CellRig.JointState::of, CellRig.JointState::seq, jsT::add);
                 rec.add(ap, CellRig.Ref::of, CellRig.Ref::seq, armRefT::add);
+                rec.add(pp, CellRig.Sample::of, CellRig.Sample::seq, powerT::add);
                 rec.start();
 
                 // Moving, in NORMAL mode, for a while (no false trip from the motion itself).
                 try {
-                    scenario(rt, safetyT, wrenchT, refT, rec, guardPid, trajPid);
+                    scenario(rt, safetyT, wrenchT, refT, powerT, rec, guardPid, trajPid);
                 } catch (AssertionError | RuntimeException e) {
                     for (String n : new String[] {"sim-robot", "tcp-correction", "force-guard", "trajectory"}) {
                         System.out.println("ForceGuardIT: " + rt.cmd("arflex:stats " + n).replace('\n', ' '));
@@ -92,7 +99,8 @@ class ForceGuardIT {
     }
 
     static void scenario(Runtime rt, CellRig.Trace<CellRig.Safety> safetyT, CellRig.Trace<CellRig.Wrench> wrenchT,
-            CellRig.Trace<CellRig.Ref> refT, CellRig.Recorder rec, long guardPid, long trajPid) throws Exception {
+            CellRig.Trace<CellRig.Ref> refT, CellRig.Trace<CellRig.Sample> powerT, CellRig.Recorder rec, long guardPid,
+            long trajPid) throws Exception {
                 rt.waitUntil("1500 guard values and the arm moving", T,
                         () -> safetyT.size() > 1500 && (moved(refT.snapshot())
                                 || safetyT.last().mode() != CellRig.Safety.NORMAL));
@@ -132,12 +140,18 @@ class ForceGuardIT {
                 long[] held = constantRun(refT.snapshot());
                 assertNotNull(held);
                 double[] heldQ = refT.last().q().clone();
+                // The drives limited to the guard's fraction while stopped.
+                double fraction = stillStopped.powerScale();
+                assertTrue(fraction < 1.0, "the stop publishes no reduced power: " + stillStopped);
+                rt.waitUntil("sim-robot's servo_power at the guard's fraction", T,
+                        () -> powerT.size() > 0 && powerT.last().value() == fraction);
                 int refMark = refT.size();
 
                 // Operator reset: NORMAL again, the motion resumes from the held pose.
                 String r = rt.cmd("arflex:reset force-guard");
                 assertTrue(r.startsWith("force-guard: reset"), r);
                 rt.waitUntil("NORMAL after the reset", T, () -> safetyT.last().mode() == CellRig.Safety.NORMAL);
+                rt.waitUntil("full servo power after the reset", T, () -> powerT.last().value() == 1.0);
                 rt.waitUntil("the motion resumes", T,
                         () -> refT.size() > refMark && CellRig.maxDiff(refT.last().q(), heldQ) > 1e-3);
                 assertEquals(guardPid, rt.pid("force-guard"), "the guard was restarted");
@@ -147,6 +161,7 @@ class ForceGuardIT {
                 List<CellRig.Safety> safety = safetyT.snapshot();
                 List<CellRig.Wrench> wrench = wrenchT.snapshot();
                 List<CellRig.Ref> refs = refT.snapshot();
+                List<CellRig.Sample> power = powerT.snapshot();
 
                 // ---- analysis of what was recorded ----
                 // (a) Never a contact force above the limit in NORMAL mode: the trip is in the
@@ -206,6 +221,22 @@ class ForceGuardIT {
                 // tasks up to one period).
                 assertTrue(periods <= 2.0, "first stop " + periods + " periods after the push onset " + onset + " / " + stop
                         + " (onset exact: " + onsetExact + ")");
+                // (d) The power limit reaches the drives in the same or the next robot cycle
+                // after the guard's decision (robot sequence numbers: one per physics period),
+                // and full power before it.
+                CellRig.Sample firstAfter = power.stream().filter(x -> x.tNs() > stop.tNs()).findFirst().orElseThrow();
+                CellRig.Sample firstLimited = power.stream().filter(x -> x.value() < 1.0).findFirst().orElseThrow();
+                for (CellRig.Sample x : power) {
+                    assertTrue(x.value() == 1.0 || x.value() == stop.powerScale(), "servo power neither full nor the"
+                            + " guard's fraction: " + x);
+                    if (x.tNs() <= stop.tNs() - 1_000_000) {
+                        assertEquals(1.0, x.value(), "reduced power before the stop: " + x);
+                    }
+                }
+                System.out.printf("ForceGuardIT: servo power %.2f from robot cycle %d; first robot cycle released after the"
+                        + " stop: %d%n", firstLimited.value(), firstLimited.seq(), firstAfter.seq());
+                assertTrue(firstLimited.seq() <= firstAfter.seq() + 1, "the power limit reached the drives at robot cycle "
+                        + firstLimited.seq() + ", the first released after the stop was " + firstAfter.seq());
     }
 
     /** Writes the recorded traces to the test's directory (diagnosis of a failure). */

@@ -71,8 +71,9 @@ class SimContractsTest {
         for (PortSpec p : c.ports()) {
             ports.add(p.direction() + " " + p.name() + " " + p.type() + " " + p.method());
         }
-        assertEquals(List.of("IN joint_ref arflex.JointRef STATE", "OUT joint_state arflex.JointState STATE",
-                "OUT wrench arflex.Wrench STATE"), ports);
+        assertEquals(List.of("IN joint_ref arflex.JointRef STATE", "IN safety arflex.SafetyState STATE",
+                "OUT joint_state arflex.JointState STATE", "OUT wrench arflex.Wrench STATE",
+                "OUT servo_power arflex.Sample STATE"), ports);
         Set<String> rt = rtParams(BUNDLES.resolve("sim-robot/native/sim_robot.cc"),
                 Pattern.compile("\\{\"([a-z_]+)\", [-0-9.]+, '[dib]'\\}"));
         assertEquals(19, rt.size(), "parameters found in sim_robot.cc: " + rt);
