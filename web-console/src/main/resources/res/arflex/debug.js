@@ -14,12 +14,25 @@
   const STATS = ['last', 'min', 'max', 'mean'];
   let source = null; let shownFor = null; let plot = null;
 
+  // The plan waiting for Confirm; replacing or dropping it cancels it (a staged jar is discarded).
+  let pending = null;
+  function dropPending() {
+    const p = pending;
+    pending = null;
+    if (p && p.onCancel) p.onCancel();
+  }
+
   function showPlan(title, text, onConfirm, onCancel) {
+    dropPending();
+    const mine = {onCancel};
+    pending = mine;
     const confirm = el('button', {type: 'button', id: 'arflex-debug-confirm', onclick: async () => {
       confirm.disabled = true;
+      if (pending === mine) pending = null;
       try { await onConfirm(); } finally { plan.replaceChildren(); refresh(); }
     }}, 'Confirm');
     const cancel = el('button', {type: 'button', id: 'arflex-debug-cancel', onclick: async () => {
+      if (pending === mine) pending = null;
       if (onCancel) await onCancel();
       plan.replaceChildren();
     }}, 'Cancel');
@@ -54,7 +67,12 @@
             message(status, 'debug monitor ' + done.action + ' (bundle ' + done.bundleId + ')', 'ok');
           } catch (e) { message(status, 'Install failed: ' + e.message, 'error'); }
         }, async () => { try { await post('discard', {id: r.id}); } catch (e) { /* gone */ } });
-      } catch (e) { message(status, 'Refused: ' + e.message, 'error'); }
+      } catch (e) {
+        // Refused, or the DRCR could not plan it: no plan (and nothing to confirm) stays.
+        dropPending();
+        plan.replaceChildren();
+        message(status, 'Refused: ' + e.message, 'error');
+      }
     }}, 'Plan install');
     body.replaceChildren(el('p', {id: 'arflex-debug-none'}, 'The debug monitor is not installed.'), el('h2', {}, 'Watch'),
       el('p', {}, 'Choose up to four state ports (arflex.Sample) to watch; the monitor maps them read-only.'),
@@ -102,7 +120,7 @@
             message(status, 'debug monitor uninstalled', 'ok');
           } catch (e) { message(status, 'Uninstall failed: ' + e.message, 'error'); }
         });
-      } catch (e) { message(status, e.message, 'error'); }
+      } catch (e) { dropPending(); plan.replaceChildren(); message(status, 'Cannot plan the uninstall: ' + e.message, 'error'); }
     }}, 'Uninstall the debug monitor');
     const rows = slots.map(k => el('tr', {}, el('td', {}, 'm' + k), el('td', {id: 'arflex-debug-m' + k + '-target'}, wired['m' + k] || 'not bound'),
       STATS.map(s => el('td', {id: 'arflex-debug-m' + k + '-' + s, 'data-index': '-1'}, '–'))));

@@ -1,5 +1,6 @@
 /* Deploy page: install from an uploaded jar or a URL (https or file, SHA-256 pinned), update,
- * uninstall; every change shows the DRCR's plan first and waits for the user to confirm. */
+ * uninstall; every change shows the DRCR's plan first and waits for the user to confirm. When
+ * the DRCR cannot plan, the page shows why and offers nothing to confirm. */
 'use strict';
 (() => {
   const {app, el, get, post, stateBadge, message} = Arflex;
@@ -7,17 +8,47 @@
   const plan = el('div', {id: 'arflex-plan'});
   const installed = el('div', {id: 'arflex-installed'});
 
+  // The plan waiting for Confirm; replacing it (another plan, or an error) cancels it, so a
+  // staged jar is discarded and never left behind a plan that is no longer shown.
+  let pending = null;
+  function dropPending() {
+    const p = pending;
+    pending = null;
+    if (p && p.onCancel) p.onCancel();
+  }
+
   function showPlan(title, text, details, onConfirm, onCancel) {
+    dropPending();
+    const mine = {onCancel};
+    pending = mine;
     const confirm = el('button', {type: 'button', id: 'arflex-confirm', onclick: async () => {
       confirm.disabled = true;
+      if (pending === mine) pending = null;
       try { await onConfirm(); } finally { plan.replaceChildren(); refresh(); }
     }}, 'Confirm');
     const cancel = el('button', {type: 'button', id: 'arflex-cancel', onclick: async () => {
+      if (pending === mine) pending = null;
       if (onCancel) await onCancel();
       plan.replaceChildren();
     }}, 'Cancel');
     plan.replaceChildren(el('h2', {}, title), details || '', el('div', {class: 'arflex-plan', id: 'arflex-plan-text'}, text),
       el('p', {}, confirm, ' ', cancel));
+  }
+
+  /** The DRCR could not plan: the error instead of a plan, and nothing to confirm. */
+  function showPlanError(title, text) {
+    dropPending();
+    const close = el('button', {type: 'button', id: 'arflex-plan-close', onclick: () => plan.replaceChildren()}, 'Close');
+    plan.replaceChildren(el('h2', {}, title),
+      el('div', {class: 'arflex-msg arflex-msg-error', id: 'arflex-plan-error'}, text),
+      el('p', {}, 'Nothing can be confirmed: nothing was changed. ', close));
+  }
+
+  /** A stage (upload or URL) was refused or could not be planned: no plan stays on the page. */
+  function stageRefused(what, e) {
+    dropPending();
+    plan.replaceChildren();
+    message(status, what + ': ' + e.message, 'error');
   }
 
   async function staged(r) {
@@ -39,7 +70,7 @@
     try {
       staged(await post('stage-upload', {file: f.name}, f, 'application/java-archive'));
       message(status, 'Uploaded ' + f.name + '; review the plan below.', 'info');
-    } catch (e) { message(status, 'Upload refused: ' + e.message, 'error'); }
+    } catch (e) { stageRefused('Upload refused', e); }
   }}, 'Upload and plan');
   const url = el('input', {type: 'text', id: 'arflex-url', size: 60, placeholder: 'https://… or file:/…'});
   const sha = el('input', {type: 'text', id: 'arflex-sha256', size: 66, placeholder: 'pinned SHA-256 (64 hex digits)'});
@@ -47,7 +78,7 @@
     try {
       staged(await post('stage-url', {url: url.value, sha256: sha.value}));
       message(status, 'Fetched and checked; review the plan below.', 'info');
-    } catch (e) { message(status, 'Refused: ' + e.message, 'error'); }
+    } catch (e) { stageRefused('Refused', e); }
   }}, 'Fetch and plan');
 
   async function refresh() {
@@ -62,13 +93,27 @@
               try { await post('uninstall', {name: i.name}); message(status, i.name + ' uninstalled', 'ok'); }
               catch (e) { message(status, 'Uninstall failed: ' + e.message, 'error'); }
             });
-          } catch (e) { message(status, 'Cannot plan: ' + e.message, 'error'); }
+          } catch (e) { status.replaceChildren(); showPlanError('Uninstall ' + i.name + ': no plan', e.message); }
         }}, 'Uninstall…');
         const up = el('button', {type: 'button', id: 'arflex-update-' + i.name, onclick: async () => {
-          showPlan('Update ' + i.name, 'Download the jar from the update URL of the contract (https or file), check its pinned SHA-256 and update the bundle; on any failure the old version keeps running.', '',
+          // The DRCR's dry run: it downloads from the contract's update URL, checks the pinned
+          // SHA-256 and the new contracts, and plans the replacement; nothing is installed yet.
+          up.disabled = true;
+          let p;
+          try {
+            p = await post('plan-update', {name: i.name});
+          } catch (e) {
+            status.replaceChildren();
+            showPlanError('Update ' + i.name + ': no plan', e.message);
+            return;
+          } finally { up.disabled = false; }
+          message(status, 'Planned the update of ' + i.name + '; review the plan below.', 'info');
+          showPlan('Plan: update ' + i.name + ' ' + (p.version || ''), p.plan,
+            el('p', {}, 'From ' + p.updateUrl + ', pinned SHA-256 ', el('code', {id: 'arflex-update-sha'}, p.sha256)),
             async () => {
-              try { const r = await post('update', {name: i.name}); message(status, r.report, 'ok'); }
-              catch (e) { message(status, e.message, 'error'); }
+              // The pin the plan was made for: a contract that pins something else by now is refused.
+              try { const r = await post('update', p.sha256 ? {name: i.name, sha256: p.sha256} : {name: i.name}); message(status, r.report, 'ok'); }
+              catch (e) { message(status, 'Update failed: ' + e.message, 'error'); }
             });
         }}, 'Update…');
         return el('tr', {'data-component': i.name}, el('td', {}, i.name), el('td', {}, stateBadge(i.state)),

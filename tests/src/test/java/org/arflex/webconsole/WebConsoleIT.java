@@ -7,6 +7,8 @@ import static org.junit.jupiter.api.Assertions.assertTrue;
 
 import com.sun.net.httpserver.HttpServer;
 import java.io.IOException;
+import java.io.InputStream;
+import java.io.OutputStream;
 import java.net.InetSocketAddress;
 import java.net.URI;
 import java.net.http.HttpRequest;
@@ -19,6 +21,11 @@ import java.time.Duration;
 import java.util.HexFormat;
 import java.util.List;
 import java.util.Map;
+import java.util.function.UnaryOperator;
+import java.util.jar.JarEntry;
+import java.util.jar.JarInputStream;
+import java.util.jar.JarOutputStream;
+import java.util.jar.Manifest;
 import java.util.regex.Matcher;
 import java.util.regex.Pattern;
 import java.util.stream.Stream;
@@ -127,6 +134,25 @@ class WebConsoleIT {
 
     private static void shot(String name) throws IOException {
         Files.write(screenshots.resolve(name + ".png"), browser.getScreenshotAs(OutputType.BYTES));
+    }
+
+    /**
+     * Waits until the element's text contains {@code text}; on timeout fails naming the text it
+     * last showed. Returns the text.
+     */
+    private static String awaitElementText(By by, String text) {
+        String[] seen = {null};
+        try {
+            new WebDriverWait(browser, WAIT).until(d -> {
+                List<WebElement> e = d.findElements(by);
+                seen[0] = e.isEmpty() ? null : e.get(0).getText();
+                return seen[0] != null && seen[0].contains(text);
+            });
+        } catch (org.openqa.selenium.TimeoutException e) {
+            throw new AssertionError("waited " + WAIT.toSeconds() + " s for " + by + " to show \"" + text
+                    + "\"; it shows: " + (seen[0] == null ? "(no such element)" : "\"" + seen[0] + "\""), e);
+        }
+        return seen[0];
     }
 
     private static String cell() {
@@ -406,10 +432,12 @@ class WebConsoleIT {
                 () -> !"ACTIVE".equals(instanceState("sample-scaler")));
         open("arflex-cell");
         By reason = By.cssSelector("tr[data-component='sample-scaler'] .arflex-reason");
-        new WebDriverWait(browser, WAIT).until(d -> !d.findElement(reason).getText().isBlank());
-        String why = browser.findElement(reason).getText();
+        // The resolver's reason for an explicit binding whose provider left the cell: the input,
+        // the consumer and the provider's port, as the DRCR words it.
+        String expected = "input 'x' of 'sample-scaler': explicit provider 'sample-counter.count' is not installed";
+        String why = awaitElementText(reason, expected);
         shot("12-cell-why-not-active");
-        assertTrue(why.contains("sample-counter") || why.contains("x"), "reason names the missing input: " + why);
+        assertEquals(expected, why.strip(), "the cell shows the DRCR's reason for the missing provider");
 
         // Start it again from its page: both Active.
         // A stopped bundle's component stays in the cell as INSTALLED, and its page says so.
@@ -596,13 +624,11 @@ class WebConsoleIT {
         RuntimeUnderTest.awaitCondition("tcp-correction Active", Duration.ofSeconds(60),
                 () -> "ACTIVE".equals(instanceState("tcp-correction")));
         String contract = rt.get("/system/console/arflex-component/api/component?name=tcp-correction", true).body();
+        // The cell's tcp-correction publishes its tool-centre error: without it the preset has
+        // nothing to plot, and that is a broken cell bundle, not a pass.
+        assertTrue(contract.contains("\"name\":\"error\",\"direction\":\"OUT\""),
+                "tcp-correction has no output port 'error' for the preset to plot: " + contract);
         open("arflex-cell");
-        if (!contract.contains("\"name\":\"error\",\"direction\":\"OUT\"")) {
-            // A tcp-correction without the error output: the preset says so.
-            awaitText(By.id("arflex-tcp-error-none"), "has no output port error");
-            shot("18-cell-tcp-preset-no-error-port");
-            return;
-        }
         WebElement toggle = await(By.id("arflex-tcp-toggle"));
         By plot = By.id("arflex-tcp-error-plot");
         String before = paramValue("tcp-correction", "enable");
@@ -618,6 +644,218 @@ class WebConsoleIT {
         browser.findElement(By.id("arflex-tcp-toggle")).click();
         new WebDriverWait(browser, WAIT).until(d -> "on".equals(d.findElement(plot).getAttribute("data-correction")));
         assertEquals("true", paramValue("tcp-correction", "enable"));
+    }
+
+    /** Copies {@code jar} to {@code out} with every OSGI-INF/arflex/*.xml contract passed through {@code edit}. */
+    private static Path withContract(Path jar, Path out, UnaryOperator<String> edit) throws IOException {
+        Files.createDirectories(out.getParent());
+        try (InputStream fin = Files.newInputStream(jar); JarInputStream in = new JarInputStream(fin)) {
+            Manifest m = in.getManifest();
+            try (OutputStream fout = Files.newOutputStream(out); JarOutputStream o = new JarOutputStream(fout, m)) {
+                JarEntry e;
+                while ((e = in.getNextJarEntry()) != null) {
+                    byte[] data = in.readAllBytes();
+                    if (e.getName().startsWith("OSGI-INF/arflex/") && e.getName().endsWith(".xml")) {
+                        String xml = new String(data, StandardCharsets.UTF_8);
+                        String edited = edit.apply(xml);
+                        assertFalse(xml.equals(edited), "the edit changed nothing in " + e.getName());
+                        data = edited.getBytes(StandardCharsets.UTF_8);
+                    }
+                    o.putNextEntry(new JarEntry(e.getName()));
+                    o.write(data);
+                    o.closeEntry();
+                }
+            }
+        }
+        return out;
+    }
+
+    /** Where the tests write their bundle variants (inside the runtime's work directory). */
+    private static Path variant(String file) {
+        return rt.work.resolve("jars").resolve(file);
+    }
+
+    private static final String CRITICALITY_3 = "<criticality>3</criticality>";
+
+    /** The scaler whose contract names an update URL and pin (placed where the schema wants it). */
+    private static Path scalerWithUpdate(String file, Path target, String pin) throws IOException {
+        return withContract(sample("scaler"), variant(file), xml -> xml.replace(CRITICALITY_3,
+                CRITICALITY_3 + "<update url=\"" + target.toUri() + "\" sha256=\"" + pin + "\"/>"));
+    }
+
+    /** Uploads a jar on the Deploy page, checks its plan is shown, confirms and waits for the status. */
+    private static void uploadAndConfirm(Path jar, String statusText) {
+        open("arflex-deploy");
+        await(By.id("arflex-upload-file")).sendKeys(jar.toString());
+        browser.findElement(By.id("arflex-upload")).click();
+        assertFalse(await(By.id("arflex-plan-text")).getText().isBlank(), "a plan is shown before confirming");
+        browser.findElement(By.id("arflex-confirm")).click();
+        awaitElementText(By.id("arflex-deploy-status"), statusText);
+    }
+
+    private static String componentJson(String name) {
+        return rt.get("/system/console/arflex-component/api/component?name=" + name, true).body();
+    }
+
+    private static String contractVersion(String name) {
+        Matcher m = Pattern.compile("\"contract\":\\{\"name\":\"" + Pattern.quote(name) + "\",\"version\":\"([^\"]+)\"")
+                .matcher(componentJson(name));
+        return m.find() ? m.group(1) : null;
+    }
+
+    /** A POST from the console page itself (its origin, its CSRF token): "status body". */
+    private static String pagePost(String api) {
+        return (String) browser.executeAsyncScript(
+                "const done = arguments[arguments.length - 1]; const app = document.getElementById('arflex-app');"
+                + "fetch(app.dataset.root + '/api/' + arguments[0], {method: 'POST', credentials: 'same-origin',"
+                + " headers: {'Accept': 'application/json', 'X-Arflex-Csrf': app.dataset.csrf}})"
+                + ".then(r => r.text().then(t => done(r.status + ' ' + t))).catch(e => done('error ' + e));", api);
+    }
+
+    @Test
+    @Order(15)
+    void anUpdateTheDrcrCannotPlanShowsWhyAndOffersNoConfirm() throws IOException {
+        long scalerPid = pid("sample-scaler");
+        assertTrue(scalerPid > 0, cell());
+        // No update URL in the contract: the DRCR's reason instead of a plan, and no Confirm.
+        open("arflex-deploy");
+        await(By.id("arflex-update-sample-scaler")).click();
+        String error = awaitElementText(By.id("arflex-plan-error"), "cannot plan the update of sample-scaler");
+        assertEquals("cannot plan the update of sample-scaler: its contract has no update URL", error.strip());
+        assertTrue(browser.findElements(By.id("arflex-confirm")).isEmpty(), "no Confirm for a plan the DRCR could not make");
+        assertTrue(browser.findElements(By.id("arflex-plan-text")).isEmpty(), "no plan text either");
+        shot("19-deploy-update-no-url");
+        // The JSON endpoint: CSRF-checked like every POST; from the page, a 409 naming why.
+        HttpResponse<String> forged = rt.send(HttpRequest.newBuilder(URI.create(rt.base()
+                + "/system/console/arflex-deploy/api/plan-update?name=sample-scaler"))
+                .header("Origin", rt.base()).POST(HttpRequest.BodyPublishers.noBody()), true);
+        assertEquals(403, forged.statusCode(), forged.body());
+        String r = pagePost("plan-update?name=sample-scaler");
+        assertEquals("409 {\"error\":\"cannot plan the update of sample-scaler: its contract has no update URL\"}", r);
+        assertTrue(pagePost("plan-update?name=nope").startsWith("404 "), "an unknown component is 404");
+
+        // A contract that pins the wrong hash: the dry run downloads and checks it, names both hashes.
+        Path v2 = withContract(sample("scaler"), variant("scaler-1.1.0.jar"),
+                xml -> xml.replace("version=\"1.0.0\"", "version=\"1.1.0\""));
+        String wrong = "0".repeat(64);
+        uploadAndConfirm(scalerWithUpdate("scaler-wrong-pin.jar", v2, wrong), "updated");
+        RuntimeUnderTest.awaitCondition("the scaler with the wrong pin Active", WAIT,
+                () -> "ACTIVE".equals(instanceState("sample-scaler")) && componentJson("sample-scaler").contains(wrong));
+        long pinnedPid = pid("sample-scaler");
+        open("arflex-deploy");
+        await(By.id("arflex-update-sample-scaler")).click();
+        error = awaitElementText(By.id("arflex-plan-error"), "SHA-256");
+        assertTrue(error.startsWith("cannot plan the update of sample-scaler: update not installed, the old version keeps running:")
+                && error.contains(v2.toUri().toString()) && error.contains(sha256(v2)) && error.contains(wrong), error);
+        assertTrue(browser.findElements(By.id("arflex-confirm")).isEmpty(), "no Confirm after a hash mismatch");
+        shot("20-deploy-update-wrong-pin");
+        assertEquals("1.0.0", contractVersion("sample-scaler"), "nothing installed");
+        assertEquals(pinnedPid, pid("sample-scaler"), "a failed plan restarts nothing");
+        assertEquals("ACTIVE", instanceState("sample-scaler"));
+    }
+
+    @Test
+    @Order(16)
+    void updateAComponentFromTheDeployPageAfterTheDrcrsPlan() throws IOException {
+        Path v2 = withContract(sample("scaler"), variant("scaler-1.1.0.jar"),
+                xml -> xml.replace("version=\"1.0.0\"", "version=\"1.1.0\""));
+        String pin = sha256(v2);
+        uploadAndConfirm(scalerWithUpdate("scaler-1.0.0-updatable.jar", v2, pin), "updated");
+        RuntimeUnderTest.awaitCondition("the updatable scaler Active", WAIT,
+                () -> "ACTIVE".equals(instanceState("sample-scaler")) && componentJson("sample-scaler").contains(pin));
+        assertEquals("1.0.0", contractVersion("sample-scaler"));
+        long scalerPid = pid("sample-scaler");
+        long counterPid = pid("sample-counter");
+
+        open("arflex-deploy");
+        await(By.id("arflex-update-sample-scaler")).click();
+        String plan = await(By.id("arflex-plan-text")).getText();
+        // The DRCR's dry run: from where, hash checked, and the replacement restarts only the scaler.
+        assertTrue(plan.startsWith("update of sample-scaler from " + v2.toUri() + " (sha256 verified)"), plan);
+        assertTrue(plan.lines().anyMatch(l -> l.matches("\\s*RESTART\\s+sample-scaler\\s.*")), plan);
+        assertTrue(plan.lines().noneMatch(l -> l.matches("\\s*(STOP|RESTART)\\s+sample-counter\\s.*")), plan);
+        assertEquals(pin, browser.findElement(By.id("arflex-update-sha")).getText());
+        assertTrue(browser.findElement(By.id("arflex-plan")).getText().contains("Plan: update sample-scaler 1.0.0"));
+        assertEquals("1.0.0", contractVersion("sample-scaler"), "a plan installs nothing");
+        assertEquals(scalerPid, pid("sample-scaler"), "a plan restarts nothing");
+        shot("21-deploy-update-plan");
+
+        browser.findElement(By.id("arflex-confirm")).click();
+        String report = awaitElementText(By.id("arflex-deploy-status"), "updated to 1.1.0");
+        assertEquals("sample-scaler: updated to 1.1.0 from " + v2.toUri() + " (sha256 verified)", report.strip());
+        RuntimeUnderTest.awaitCondition("sample-scaler 1.1.0 Active with a new pid", WAIT,
+                () -> "ACTIVE".equals(instanceState("sample-scaler")) && pid("sample-scaler") > 0
+                        && pid("sample-scaler") != scalerPid && "1.1.0".equals(contractVersion("sample-scaler")));
+        assertEquals(counterPid, pid("sample-counter"), "the provider is not restarted");
+        assertTrue(browser.findElements(By.id("arflex-confirm")).isEmpty(), "the plan is gone once confirmed");
+        open("arflex-deploy");
+        awaitText(By.cssSelector("tr[data-component='sample-scaler']"), "ACTIVE");
+        shot("22-deploy-updated");
+    }
+
+    private static final Pattern CYCLES = Pattern.compile("\"cycles\":(\\d+)");
+
+    private static long cycles(String name) {
+        Matcher m = CYCLES.matcher(componentJson(name));
+        return m.find() ? Long.parseLong(m.group(1)) : -1;
+    }
+
+    private static Boolean awaitingReset(String name) {
+        Matcher m = Pattern.compile("\"awaitingReset\":(true|false)").matcher(componentJson(name));
+        return m.find() ? Boolean.valueOf(m.group(1)) : null;
+    }
+
+    /** The field values (the payload) of the newest value of an output port, as api/port decodes them. */
+    private static String portFields(String name, String port) {
+        String body = rt.get("/system/console/arflex-component/api/port?name=" + name + "&port=" + port, true).body();
+        int at = body.indexOf("\"fields\":");
+        assertTrue(at >= 0, body);
+        return body.substring(at);
+    }
+
+    @Test
+    @Order(17)
+    void theResetButtonReleasesARestartedMovingComponent() throws IOException {
+        // The counter as a component that moves hardware: after a crash the DRCR restarts it held
+        // (no motion) until an operator resets it.
+        Path moving = withContract(sample("counter"), variant("counter-moving.jar"),
+                xml -> xml.replace("movesHardware=\"false\"", "movesHardware=\"true\""));
+        uploadAndConfirm(moving, "updated");
+        RuntimeUnderTest.awaitCondition("the moving counter Active", WAIT, () -> "ACTIVE".equals(instanceState("sample-counter"))
+                && componentJson("sample-counter").contains("\"movesHardware\":true"));
+        assertEquals(Boolean.FALSE, awaitingReset("sample-counter"), "the first start needs no reset");
+        long pid = pid("sample-counter");
+        ProcessHandle.of(pid).ifPresent(ProcessHandle::destroyForcibly);
+        RuntimeUnderTest.awaitCondition("sample-counter restarted", WAIT, () -> {
+            long now = pid("sample-counter");
+            return now > 0 && now != pid && "ACTIVE".equals(instanceState("sample-counter"));
+        });
+        assertEquals(Boolean.TRUE, awaitingReset("sample-counter"), componentJson("sample-counter"));
+        long restartedPid = pid("sample-counter");
+        // Held: the RT half cycles, its output does not move.
+        RuntimeUnderTest.awaitCondition("the new RT half cycling", WAIT, () -> cycles("sample-counter") > 20);
+        String held = portFields("sample-counter", "count");
+        long c0 = cycles("sample-counter");
+        RuntimeUnderTest.awaitCondition("20 more cycles", WAIT, () -> cycles("sample-counter") > c0 + 20);
+        assertEquals(held, portFields("sample-counter", "count"), "a restarted moving component holds its output");
+
+        open("arflex-component?name=sample-counter");
+        awaitElementText(By.id("arflex-summary"), "restarted: waits for an operator reset before motion");
+        // The live stream comes up although the sampler thread stopped while no page watched
+        // (the Deploy page has no stream): its frames go on numbering from before.
+        awaitElementText(By.id("arflex-live-count"), "samples; cycles");
+        shot("23-component-awaiting-reset");
+        await(By.id("arflex-cmd-reset")).click();
+        awaitElementText(By.id("arflex-component-status"), "reset: done");
+        RuntimeUnderTest.awaitCondition("the DRCR to clear awaitingReset", WAIT,
+                () -> Boolean.FALSE.equals(awaitingReset("sample-counter")));
+        new WebDriverWait(browser, WAIT).until(d -> !d.findElement(By.id("arflex-summary")).getText()
+                .contains("waits for an operator reset"));
+        RuntimeUnderTest.awaitCondition("the output moving again after the reset", WAIT,
+                () -> !held.equals(portFields("sample-counter", "count")));
+        shot("24-component-reset");
+        assertEquals(restartedPid, pid("sample-counter"), "the reset does not restart the process");
+        assertEquals("ACTIVE", instanceState("sample-counter"));
     }
 
     private static String sha256(Path p) throws IOException {

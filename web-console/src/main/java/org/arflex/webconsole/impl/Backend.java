@@ -70,7 +70,8 @@ public class Backend {
     private final SecureRandom random = new SecureRandom();
     private final Map<String, Long> knownBundles = new ConcurrentHashMap<>();
     private BundleContext context;
-    private Path dataDir;
+    /** The bundle's private data area (staging/, installed/); set on activation. */
+    Path dataDir;
     private Path contractsDir;
     Sampler sampler;
 
@@ -437,7 +438,10 @@ public class Backend {
             Files.deleteIfExists(s.file());
             throw e;
         } catch (RuntimeException e) {
-            plan = "the DRCR could not plan this install: " + e.getMessage();
+            // No plan, nothing to confirm: the staged jar goes and the error names why.
+            Files.deleteIfExists(s.file());
+            throw new HttpError(409, "the DRCR could not plan the install of " + s.symbolicName() + " " + s.version()
+                    + " (from " + s.origin() + "), nothing staged: " + reason(e));
         }
         byte[] id = new byte[16];
         random.nextBytes(id);
@@ -511,11 +515,52 @@ public class Backend {
         return Map.of("component", name, "bundleId", id, "action", "uninstalled");
     }
 
-    Map<String, Object> update(String name) throws HttpError {
+    /**
+     * The DRCR's dry run of {@code update name}: it downloads from the contract's update URL,
+     * checks the pinned SHA-256 and the new contracts, and plans the replacement without
+     * installing anything. A failure (no update URL, download, hash mismatch, broken bundle) is
+     * an error (404 unknown component, 409 otherwise), never a plan that could be confirmed.
+     */
+    Map<String, Object> planUpdate(String name) throws HttpError {
+        checkName(name);
+        DrcrService d = drcr();
+        ContractDTO c = d.contract(name).orElseThrow(
+                () -> new HttpError(404, "cannot plan the update of " + name + ": no component named '" + name
+                        + "' in the cell"));
+        String plan;
+        try {
+            plan = d.planUpdate(name);
+        } catch (IllegalArgumentException e) {
+            throw new HttpError(404, "cannot plan the update of " + name + ": " + unprefixed(name, reason(e)));
+        } catch (RuntimeException e) {
+            throw new HttpError(409, "cannot plan the update of " + name + ": " + unprefixed(name, reason(e)));
+        }
+        Map<String, Object> m = new LinkedHashMap<>();
+        m.put("component", name);
+        m.put("version", c.version);
+        m.put("updateUrl", c.updateUrl);
+        m.put("sha256", c.updateSha256);
+        m.put("plan", plan);
+        return m;
+    }
+
+    /**
+     * Updates from the contract's update URL. With {@code sha256} (the pin the shown plan was
+     * made for), a contract that pins something else by now is refused: plan again.
+     */
+    Map<String, Object> update(String name, String sha256) throws HttpError {
         checkName(name);
         UpdateService u = updates;
         if (u == null) {
             throw new HttpError(503, "no UpdateService registered (DRCR not running)");
+        }
+        if (sha256 != null && !sha256.isBlank()) {
+            String pinned = drcr().contract(name).map(c -> c.updateSha256).orElse(null);
+            if (pinned == null || !pinned.equalsIgnoreCase(sha256.trim())) {
+                throw new HttpError(409, "update of " + name + " refused: the contract now pins "
+                        + (pinned == null ? "no update" : "SHA-256 " + pinned) + ", the plan shown was for " + sha256.trim()
+                        + "; plan the update again");
+            }
         }
         try {
             return Map.of("component", name, "report", u.update(name));
@@ -566,6 +611,17 @@ public class Backend {
             throw new HttpError(404, "no saved contract named '" + name + "'");
         }
         return Files.readString(p, StandardCharsets.UTF_8);
+    }
+
+    /** An exception's message, or its class when it has none. */
+    private static String reason(RuntimeException e) {
+        String m = e.getMessage();
+        return m == null || m.isBlank() ? e.getClass().getSimpleName() : m;
+    }
+
+    /** The DRCR starts its update messages with "name: "; said once is enough. */
+    private static String unprefixed(String name, String message) {
+        return message.startsWith(name + ": ") ? message.substring(name.length() + 2) : message;
     }
 
     static void checkName(String name) throws HttpError {

@@ -159,7 +159,9 @@ abstract class PluginBase extends AbstractServlet {
             case "install" -> b.installStaged(req.getParameter("id"));
             case "discard" -> b.discard(req.getParameter("id"));
             case "uninstall" -> b.uninstall(name);
-            case "update" -> b.update(name);
+            // A dry run, but it makes the DRCR download the update: CSRF-checked like stage-url.
+            case "plan-update" -> b.planUpdate(name);
+            case "update" -> b.update(name, req.getParameter("sha256"));
             case "validate" -> Map.of("problems", b.validate(body(req), "editor.xml"));
             case "save" -> b.saveContract(name, body(req));
             case "debug-stage" -> b.debugStage(req.getParameter("targets"));
@@ -220,6 +222,10 @@ abstract class PluginBase extends AbstractServlet {
                 String line;
                 if (f == null) {
                     line = ": idle\n\n";
+                } else if (!f.sampled().contains(key)) {
+                    // Read before this stream subscribed: not "gone", just not sampled yet.
+                    seq = f.seq();
+                    continue;
                 } else {
                     seq = f.seq();
                     Object sample = f.byKey().get(key);

@@ -33,14 +33,19 @@ final class Sampler {
         }
     }
 
-    /** One published frame: per subscription, a JSON-ready map. */
-    record Frame(long seq, Map<Key, Map<String, Object>> byKey) {
+    /**
+     * One published frame: per subscription, a JSON-ready map; {@code sampled} are the
+     * subscriptions it was read for (one missing from {@code byKey} is gone, one not sampled
+     * subscribed after the frame was read).
+     */
+    record Frame(long seq, Map<Key, Map<String, Object>> byKey, Set<Key> sampled) {
     }
 
     private final Function<String, Map<String, Object>> reader;
     private final BiFunction<String, String, Object> portReader;
     private final Map<Key, Integer> subscribers = new HashMap<>();
-    private Frame latest = new Frame(0, Map.of());
+    /** The newest frame; its seq keeps growing across restarts of the thread. */
+    private Frame latest = new Frame(0, Map.of(), Set.of());
     private Thread thread;
     private boolean closed;
 
@@ -72,6 +77,11 @@ final class Sampler {
             subscribers.remove(name);
         }
         notifyAll();
+    }
+
+    /** Whether the sampler thread runs (for tests). */
+    synchronized boolean running() {
+        return thread != null;
     }
 
     /** Waits until a frame newer than {@code seq} is out (or the timeout); null on timeout or close. */
@@ -106,7 +116,6 @@ final class Sampler {
     }
 
     private void run() {
-        long seq = 0;
         long next = System.nanoTime();
         while (true) {
             Key[] keys;
@@ -169,7 +178,9 @@ final class Sampler {
                 frame.put(k, sample);
             }
             synchronized (this) {
-                latest = new Frame(++seq, frame);
+                // Numbered after the previous frame, also one of an earlier thread: a stream that
+                // saw that one waits for this one (a restart from 1 left new streams waiting).
+                latest = new Frame(latest.seq() + 1, frame, Set.of(keys));
                 notifyAll();
             }
             next += PERIOD_MS * 1_000_000L;
