@@ -69,6 +69,7 @@ class CellE2EIT {
     final List<String> report = new ArrayList<>();
     final Map<String, Long> pids = new LinkedHashMap<>();
     final Map<String, Long> cycles = new LinkedHashMap<>();
+    final Map<String, Long> updateErrors = new LinkedHashMap<>();
     double errOffMm = Double.NaN;
     double errOnMm = Double.NaN;
 
@@ -149,11 +150,21 @@ class CellE2EIT {
                     .findFirst().orElseThrow();
             pids.put(n, ((Number) i.get("pid")).longValue());
             cycles.put(n, cyclesOf(i));
+            updateErrors.put(n, statOf(i, "updateErrors"));
         }
-        report.add(step + ": pids " + pids + ", cycles " + cycles);
+        report.add(step + ": pids " + pids + ", cycles " + cycles + ", update errors " + updateErrors);
     }
 
-    /** Same pids as at the mark, ACTIVE, not awaiting a reset, cycle counters past the mark. */
+    static long statOf(Map<String, Object> inst, String key) {
+        @SuppressWarnings("unchecked")
+        Map<String, Object> st = (Map<String, Object>) inst.get("stats");
+        return st == null ? -1 : ((Number) st.get(key)).longValue();
+    }
+
+    /**
+     * Same pids as at the mark, ACTIVE, cycle counters past the mark, and no update error since
+     * the mark (a torn or missing input a component needs, or a refused reference, counts one).
+     */
     void assertLoopKeptCycling(String step) {
         for (String n : LOOP) {
             long before = cycles.get(n);
@@ -163,6 +174,9 @@ class CellE2EIT {
                 assertEquals("ACTIVE", i.get("state"), n + " at '" + step + "'");
                 assertEquals(pids.get(n), ((Number) i.get("pid")).longValue(), n + " was restarted at '" + step + "'");
                 now[0] = cyclesOf(i);
+                if (now[0] > before) {
+                    assertEquals(updateErrors.get(n), statOf(i, "updateErrors"), n + " had update errors at '" + step + "'");
+                }
                 return now[0] > before;
             });
             cycles.put(n, now[0]);

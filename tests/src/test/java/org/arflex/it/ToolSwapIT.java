@@ -41,6 +41,7 @@ class ToolSwapIT {
             String[] watched = {"trajectory", "sim-robot"};
             long[] pids = {rt.pid("trajectory"), rt.pid("sim-robot")};
             long[] cycles = {0, 0};
+            long[] errors = {-1, -1};
             List<String> rows = new ArrayList<>();
             try (CellRig.Port ref = new CellRig.Port(rt.segment("trajectory", "joint_ref"), CellRig.REF_SIZE);
                     CellRig.Port toolId = new CellRig.Port(rt.segment("trajectory", "tool_id"), CellRig.SAMPLE_SIZE);
@@ -89,7 +90,7 @@ class ToolSwapIT {
                 });
                 rec.start();
 
-                Step step = new Step(rt, watched, pids, cycles, rows);
+                Step step = new Step(rt, watched, pids, cycles, errors, rows);
                 rt.waitUntil("trajectory plans for the gripper (tool_id 1)", T, () -> toolIdIs(toolId, 1));
                 rt.waitUntil("the arm moves", T, () -> refs.get() > 500);
                 step.check("gripper mounted");
@@ -132,14 +133,18 @@ class ToolSwapIT {
         return v != null && v.getDouble(16) == id;
     }
 
-    /** Same pids, ACTIVE, cycle counters past the previous step's (waits with a deadline). */
-    record Step(Runtime rt, String[] names, long[] pids, long[] cycles, List<String> rows) {
+    /**
+     * Same pids, ACTIVE, cycle counters past the previous step's (waits with a deadline), and no
+     * update error since the first step: a component that read a torn value, lost an input it
+     * needs or had a reference refused counts one (StatsDTO.updateErrors).
+     */
+    record Step(Runtime rt, String[] names, long[] pids, long[] cycles, long[] errors, List<String> rows) {
         void check(String step) {
             for (int i = 0; i < names.length; i++) {
                 String name = names[i];
                 long before = cycles[i];
                 int k = i;
-                long[] now = {0, 0};
+                long[] now = {0, 0, 0};
                 rt.waitUntil(name + " cycles past " + before + " at '" + step + "'", T, () -> {
                     var inst = rt.instance(name);
                     assertEquals("ACTIVE", inst.get("state"), name + " at '" + step + "'");
@@ -151,10 +156,16 @@ class ToolSwapIT {
                     }
                     now[0] = ((Number) st.get("cycles")).longValue();
                     now[1] = ((Number) st.get("overruns")).longValue();
+                    now[2] = ((Number) st.get("updateErrors")).longValue();
                     return now[0] > before;
                 });
                 cycles[i] = now[0];
-                rows.add(String.format("%-22s %-11s cycles %8d  overruns %5d", step, name, now[0], now[1]));
+                rows.add(String.format("%-22s %-11s cycles %8d  overruns %5d  update errors %d", step, name, now[0], now[1],
+                        now[2]));
+                if (errors[i] < 0) {
+                    errors[i] = now[2];
+                }
+                assertEquals(errors[i], now[2], name + " had update errors between the first step and '" + step + "'");
             }
         }
     }

@@ -18,6 +18,13 @@ public class StatsDTO {
     public String rtState;
     /** Age of the RT half's heartbeat when read, milliseconds. */
     public long heartbeatAgeMs;
+    /**
+     * Since 0.5.0: cycles whose update hook returned an error (an input it could not use, a
+     * refused reference, a failed write: each component's README says which).
+     */
+    public long updateErrors;
+    /** Since 0.5.0: cycles run through the safe hook (heartbeat lost, reset required). */
+    public long safeCycles;
 
     // Since 0.2.0: percentiles and the wake-up latency histogram of the control block (all
     // read under the same seqlock as the counters above). Percentiles are upper bin edges

@@ -116,7 +116,7 @@ public final class ControlBlock implements AutoCloseable {
 
     /** A consistent copy of the statistics counters. */
     public record Stats(long cycles, long overruns, long deadlineMisses, long safeCycles, long latencyMaxNs,
-                        long execMaxNs, long execCount, long execSumNs, long execOverWcet) {
+                        long execMaxNs, long execCount, long execSumNs, long execOverWcet, long updateErrors) {
     }
 
     /**
@@ -283,6 +283,7 @@ public final class ControlBlock implements AutoCloseable {
             long overruns = shm.getLong(OFF_STATS_OVERRUNS);
             long dl = shm.getLong(OFF_STATS_DEADLINE_MISSES);
             long safe = shm.getLong(OFF_STATS_SAFE_CYCLES);
+            long errors = shm.getLong(OFF_STATS_UPDATE_ERRORS);
             long latMax = shm.getLong(OFF_STATS_LATENCY + METRIC_MAX);
             long exMax = shm.getLong(OFF_STATS_EXEC + METRIC_MAX);
             long exCount = shm.getLong(OFF_STATS_EXEC + METRIC_COUNT);
@@ -295,7 +296,7 @@ public final class ControlBlock implements AutoCloseable {
             VarHandleFence.acquire();
             long s2 = shm.getLongAcquire(OFF_STATS_SEQ);
             if (s1 == s2) {
-                return new Stats(cycles, overruns, dl, safe, latMax, exMax, exCount, exSum, over);
+                return new Stats(cycles, overruns, dl, safe, latMax, exMax, exCount, exSum, over, errors);
             }
         }
         return null;
@@ -320,6 +321,7 @@ public final class ControlBlock implements AutoCloseable {
             long overruns = shm.getLong(OFF_STATS_OVERRUNS);
             long dl = shm.getLong(OFF_STATS_DEADLINE_MISSES);
             long safe = shm.getLong(OFF_STATS_SAFE_CYCLES);
+            long errors = shm.getLong(OFF_STATS_UPDATE_ERRORS);
             long[] lm = readMetricScalars(OFF_STATS_LATENCY);
             long[] em = readMetricScalars(OFF_STATS_EXEC);
             for (int b = 0; b <= HIST_BINS; b++) {
@@ -333,7 +335,7 @@ public final class ControlBlock implements AutoCloseable {
                 for (int b = firstBin; b <= HIST_BINS; b++) {
                     over += ex[b];
                 }
-                Stats st = new Stats(cycles, overruns, dl, safe, lm[2], em[2], em[0], em[3], over);
+                Stats st = new Stats(cycles, overruns, dl, safe, lm[2], em[2], em[0], em[3], over, errors);
                 return new Detail(st, new Metric(lm[0], lm[1], lm[2], lm[3], lat), new Metric(em[0], em[1], em[2], em[3], ex));
             }
         }

@@ -158,6 +158,8 @@ public final class Snapshots {
             d.cycles = s.cycles();
             d.overruns = s.overruns();
             d.wcetOverruns = s.execOverWcet();
+            d.updateErrors = s.updateErrors();
+            d.safeCycles = s.safeCycles();
             d.maxLatencyNs = s.latencyMaxNs();
             d.maxExecNs = s.execMaxNs();
             d.meanExecNs = s.execCount() > 0 ? s.execSumNs() / s.execCount() : 0;

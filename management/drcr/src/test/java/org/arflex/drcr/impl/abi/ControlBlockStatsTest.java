@@ -52,6 +52,8 @@ class ControlBlockStatsTest {
             s.setLongRelease(ControlBlock.OFF_STATS_SEQ, 1); // writer inside
             s.putLong(ControlBlock.OFF_STATS_CYCLES, 1000);
             s.putLong(ControlBlock.OFF_STATS_OVERRUNS, 2);
+            s.putLong(ControlBlock.OFF_STATS_UPDATE_ERRORS, 7);
+            s.putLong(ControlBlock.OFF_STATS_SAFE_CYCLES, 5);
             metric(s, ControlBlock.OFF_STATS_LATENCY, lat, 310, 250_000, 1_000_000);
             metric(s, ControlBlock.OFF_STATS_EXEC, ex, 2010, 2050, 2_030_000);
             assertNull(cb.detail(0), "an odd seq (writer inside) never yields a copy");
@@ -61,6 +63,8 @@ class ControlBlockStatsTest {
             assertNotNull(d);
             assertEquals(1000, d.stats().cycles());
             assertEquals(2, d.stats().overruns());
+            assertEquals(7, d.stats().updateErrors());
+            assertEquals(5, d.stats().safeCycles());
             assertEquals(250_000, d.stats().latencyMaxNs());
             assertEquals(1000, d.stats().execOverWcet(), "every exec sample is in a bin at or above the 2000 ns WCET");
             assertEquals(d.stats(), cb.stats(2000), "detail() and stats() agree on the counters");

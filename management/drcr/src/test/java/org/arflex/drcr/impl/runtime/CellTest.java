@@ -110,7 +110,7 @@ class CellTest {
 
     /** Execution-time counters as an RT half would report them (declared WCET 50 us). */
     private static ControlBlock.Stats exec(long cycles, long meanNs, long maxNs, long overWcet) {
-        return new ControlBlock.Stats(cycles, 0, 0, 0, 0, maxNs, cycles, cycles * meanNs, overWcet);
+        return new ControlBlock.Stats(cycles, 0, 0, 0, 0, maxNs, cycles, cycles * meanNs, overWcet, 0);
     }
 
     private long sample() {

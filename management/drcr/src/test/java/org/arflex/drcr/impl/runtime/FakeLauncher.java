@@ -35,7 +35,7 @@ final class FakeLauncher implements RtLauncher {
         /** What flags() reports (control block flags); tests set it. */
         int flags;
         /** What stats() reports; tests set it. */
-        ControlBlock.Stats stats = new ControlBlock.Stats(0, 0, 0, 0, 0, 0, 0, 0, 0);
+        ControlBlock.Stats stats = new ControlBlock.Stats(0, 0, 0, 0, 0, 0, 0, 0, 0, 0);
 
         FakeHalf(Spec s) {
             inst = s.instance();
