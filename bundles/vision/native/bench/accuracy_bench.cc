@@ -22,8 +22,13 @@
 // averaged per final update once the loop has converged (4; 1 = off); --diag: per camera / tag
 // corner errors against the simulator's projections, calibration errors, static check;
 // --no-loop: diagnostics only (no correction); --cameras 2,3: the cameras of the --quick run.
+// --programs DIR [--first N] [--speed F]: writes the joint targets (the nominal IK of the same
+// target set, solved as the runs solve it) as trajectory programs DIR/program-<N+i>.arp (one
+// ptp each, at speed fraction F, default 0.1) and exits: the cell benchmark (tests/,
+// CellAccuracyBench) drives the running cell through them.
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -79,6 +84,9 @@ struct Args {
   int average = 4;       // frames averaged per final update once the loop has converged (1: off)
   bool diag = false;   // print per camera / per tag corner errors (board and tool)
   bool no_loop = false;  // diagnostics only: no correction loop (error "on" not measured)
+  std::string programs;  // write the targets as trajectory programs into this directory
+  int first_program = 11;
+  double program_speed = 0.1;
 };
 
 Eigen::Vector3d V(const arflex::sim::Vec3& v) { return Eigen::Vector3d(v[0], v[1], v[2]); }
@@ -142,6 +150,66 @@ bool NominalIk(const Cell& cell, const Eigen::Isometry3d& target, JointVector* q
     for (int i = 0; i < 6; ++i) (*q)[i] += s * dq(i);
   }
   return false;
+}
+
+// The joint targets of Targets(n) on the nominal model, solved in order: seeds are the last
+// solution (from `start`), then elbow-up guesses facing the target. False (and a message) if
+// one does not converge.
+bool JointTargets(const Cell& cell, const std::vector<Eigen::Isometry3d>& targets, JointVector start,
+                  std::vector<JointVector>* out) {
+  JointVector q_cmd = start;
+  out->clear();
+  for (int i = 0; i < static_cast<int>(targets.size()); ++i) {
+    const Eigen::Isometry3d& target = targets[i];
+    const double yaw = std::atan2(target.translation().y(), target.translation().x());
+    const JointVector seeds[] = {q_cmd, {yaw, 0.3, 0.3, 0.0, 0.6, 0.0}, {yaw, 0.0, 0.6, 0.0, 1.0, 0.0},
+                                 {yaw, 0.5, 0.0, 0.0, 0.8, 0.0}, {yaw, -0.2, 0.9, 0.0, 1.2, 0.0}};
+    JointVector seed{};
+    bool solved = false;
+    for (const JointVector& s : seeds) {
+      seed = s;
+      if ((solved = NominalIk(cell, target, &seed))) break;
+    }
+    if (!solved) {
+      std::fprintf(stderr, "accuracy-bench: target %d: nominal IK did not converge\n", i);
+      return false;
+    }
+    q_cmd = seed;
+    out->push_back(seed);
+  }
+  return true;
+}
+
+// --programs: one trajectory program per target (bundles/trajectory/README.md, program files).
+int WritePrograms(const Args& a) {
+  std::string error;
+  const JointVector home = {0.0, 0.3, 0.3, 0.0, 0.6, 0.0};
+  const auto cell = Cell::Create(arflex::sim::DefaultCellConfig(), home, &error);
+  if (!cell) {
+    std::fprintf(stderr, "accuracy-bench: cell: %s\n", error.c_str());
+    return 1;
+  }
+  std::vector<JointVector> q;
+  if (!JointTargets(*cell, Targets(a.poses), home, &q)) return 1;
+  for (int i = 0; i < static_cast<int>(q.size()); ++i) {
+    const std::string path = a.programs + "/program-" + std::to_string(a.first_program + i) + ".arp";
+    FILE* f = std::fopen(path.c_str(), "w");
+    if (f == nullptr) {
+      std::fprintf(stderr, "accuracy-bench: cannot write %s: %s\n", path.c_str(), std::strerror(errno));
+      return 1;
+    }
+    std::fprintf(f, "arflex-program 1\n# accuracy target %d of %d (arflex-accuracy-bench --programs)\nptp", i,
+                 static_cast<int>(q.size()));
+    for (int j = 0; j < 6; ++j) std::fprintf(f, " %.12f", q[i][j]);
+    std::fprintf(f, " speed %.3f\n", a.program_speed);
+    if (std::fclose(f) != 0) {
+      std::fprintf(stderr, "accuracy-bench: cannot write %s: %s\n", path.c_str(), std::strerror(errno));
+      return 1;
+    }
+  }
+  std::printf("%d programs: %s/program-%d.arp .. program-%d.arp\n", static_cast<int>(q.size()), a.programs.c_str(),
+              a.first_program, a.first_program + static_cast<int>(q.size()) - 1);
+  return 0;
 }
 
 struct Stats {
@@ -429,26 +497,14 @@ bool Bench::Run(const std::string& name, double payload, const std::vector<int>&
   const double dt = cell_->timestep();
   const int period_steps = std::max(1, static_cast<int>(std::lround(args_.period_ms * 1e-3 / dt)));
   const std::vector<Eigen::Isometry3d> targets = Targets(args_.poses);
-  JointVector q_cmd = home;  // IK seed
+  std::vector<JointVector> joint_targets;
+  if (!JointTargets(*cell_, targets, home, &joint_targets)) return false;
+  JointVector q_cmd = home;
   JointVector start = args_.calib_home ? home : park;
   for (int i = 0; i < static_cast<int>(targets.size()); ++i) {
     if (args_.only >= 0 && i != args_.only) continue;
     const Eigen::Isometry3d& target = targets[i];
-    // Seeds: the last reference, then elbow-up guesses facing the target.
-    const double yaw = std::atan2(target.translation().y(), target.translation().x());
-    const JointVector seeds[] = {q_cmd, {yaw, 0.3, 0.3, 0.0, 0.6, 0.0}, {yaw, 0.0, 0.6, 0.0, 1.0, 0.0},
-                                 {yaw, 0.5, 0.0, 0.0, 0.8, 0.0}, {yaw, -0.2, 0.9, 0.0, 1.2, 0.0}};
-    JointVector seed{};
-    bool solved = false;
-    for (const JointVector& s : seeds) {
-      seed = s;
-      if ((solved = NominalIk(*cell_, target, &seed))) break;
-    }
-    if (!solved) {
-      std::fprintf(stderr, "accuracy-bench: target %d: nominal IK did not converge\n", i);
-      return false;
-    }
-    q_cmd = seed;
+    q_cmd = joint_targets[i];
     // Move: a smooth joint-space ramp from where the reference was (incl. the last
     // correction) to the new reference, correction off.
     const int ramp = 1500;
@@ -750,6 +806,37 @@ bool ParseArgs(int argc, char** argv, Args* a) {
       a->no_loop = true;
       continue;
     }
+    if (k == "--programs" || k == "--first" || k == "--speed") {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "accuracy-bench: %s needs a value\n", k.c_str());
+        return false;
+      }
+      const std::string v = argv[++i];
+      if (k == "--programs") {
+        a->programs = v;
+        continue;
+      }
+      char* end = nullptr;
+      const double x = std::strtod(v.c_str(), &end);
+      if (end == v.c_str() || *end != '\0' || !std::isfinite(x)) {
+        std::fprintf(stderr, "accuracy-bench: %s: '%s' is not a number\n", k.c_str(), v.c_str());
+        return false;
+      }
+      if (k == "--first") {
+        if (x < 1 || x > 76 || x != std::floor(x)) {
+          std::fprintf(stderr, "accuracy-bench: --first must be a whole number in 1..76 (programs 1..99)\n");
+          return false;
+        }
+        a->first_program = static_cast<int>(x);
+      } else {
+        if (!(x > 0 && x <= 1)) {
+          std::fprintf(stderr, "accuracy-bench: --speed must be in (0, 1]\n");
+          return false;
+        }
+        a->program_speed = x;
+      }
+      continue;
+    }
     if (k == "--json" || k == "--width" || k == "--height" || k == "--poses" || k == "--noise" ||
         k == "--blur" || k == "--period-ms" || k == "--only" || k == "--outlier-px" ||
         k == "--calib-frames" || k == "--average" || k == "--cameras") {
@@ -823,6 +910,7 @@ bool ParseArgs(int argc, char** argv, Args* a) {
 int main(int argc, char** argv) {
   Args args;
   if (!ParseArgs(argc, argv, &args)) return 2;
+  if (!args.programs.empty()) return WritePrograms(args);
   struct Spec {
     const char* name;
     double payload;

@@ -76,26 +76,16 @@ class CellE2EIT {
     @BeforeAll
     void startRuntime() throws Exception {
         // A private copy of the assembly whose configuration makes this an evaluation run.
-        Path assembly = Path.of(System.getProperty("arflex.it.runtime"));
         evalAssembly = Path.of(System.getProperty("arflex.it.work")).resolve("cell-e2e-assembly");
-        Runtime.deleteTree(evalAssembly);
-        Runtime.copyTree(assembly, evalAssembly);
-        Files.writeString(evalAssembly.resolve("conf/config.properties"),
-                "\n# CellE2EIT: an evaluation run (ground truth of simulated robots)\narflex.evaluation=true\n",
-                StandardCharsets.UTF_8, java.nio.file.StandardOpenOption.APPEND);
-        String old = System.getProperty("arflex.it.runtime");
-        System.setProperty("arflex.it.runtime", evalAssembly.toString());
-        try {
-            rt = new Runtime("cell-e2e");
-        } finally {
-            System.setProperty("arflex.it.runtime", old);
-        }
+        rt = CellRig.evaluationRuntime("cell-e2e", evalAssembly);
+        operator = new CellRig.Operator(rt);
         report.add(rt.renice(-10));
     }
 
     @AfterAll
     void stopRuntime() throws Exception {
-        report.add("operator resets (heartbeat losses, guard trips) during the run: " + operatorResets);
+        report.add("operator resets (heartbeat losses, guard trips) during the run: "
+                + (operator == null ? "{}" : operator.resets));
         System.out.println("CellE2EIT report:");
         report.forEach(r -> System.out.println("  " + r));
         try {
@@ -119,27 +109,15 @@ class CellE2EIT {
         return st == null ? -1 : ((Number) st.get("cycles")).longValue();
     }
 
-    final Map<String, Integer> operatorResets = new java.util.TreeMap<>();
-    long lastOperatorCheck;
+    CellRig.Operator operator;
 
     /**
-     * The operator at the cell: at most once a second, resets what waits for a reset. On this
-     * small shared machine the runtime's heartbeat is sometimes late by more than the 1 ms
-     * components' 100 ms timeout; they then hold (safe mode) and, as they move hardware, wait
-     * for an operator's reset (a trip of the force guard too). Every reset is counted and
-     * printed in the report; the structural steps assert same pids and advancing cycle
-     * counters, which a safe-mode episode does not change.
+     * The operator at the cell (CellRig.Operator): resets what waits for a reset, at most once a
+     * second. Every reset is counted and printed in the report; the structural steps assert same
+     * pids and advancing cycle counters, which a safe-mode episode does not change.
      */
     void operator() {
-        long now = System.nanoTime();
-        if (now - lastOperatorCheck < 1_000_000_000L) {
-            return;
-        }
-        lastOperatorCheck = now;
-        for (String n : CellRig.awaitingReset(rt)) {
-            rt.cmd("arflex:reset " + n);
-            operatorResets.merge(n, 1, Integer::sum);
-        }
+        operator.tick();
     }
 
     /** Records pids and cycle counters of the loop's components as the reference point. */
@@ -270,12 +248,8 @@ class CellE2EIT {
     }
 
     /** The TRUE TCP error now (mm): the simulator's true TCP against the program's target. */
-    double trueErrorMm(CellPorts.State truth, CellPorts.State ref) {
-        CellPorts.Truth t = CellPorts.Truth.of(truth.read());
-        CellPorts.Joints r = CellPorts.Joints.of(ref.read(), false);
-        assertNotNull(t, "no ground truth");
-        assertNotNull(r, "no reference");
-        return 1e3 * NominalArm.distance(t.p(), NominalArm.tcp(r.q()));
+    static double trueErrorMm(CellPorts.State truth, CellPorts.State ref) {
+        return CellRig.trueErrorMm(truth, ref);
     }
 
     /**
@@ -359,8 +333,7 @@ class CellE2EIT {
         // The operator's start-up check: a component that lost the runtime's heartbeat while the
         // cell was being installed (this machine is small and shared) waits for a reset.
         report.add("awaiting a reset after start-up: " + CellRig.awaitingReset(rt));
-        lastOperatorCheck = 0;
-        operator();
+        operator.tickNow();
     }
 
     @Test

@@ -106,6 +106,68 @@ final class CellRig {
                         & CellPorts.FLAG_RESET_REQUIRED) != 0);
     }
 
+    /**
+     * A runtime on a private copy of the assembly (under arflex.it.work) whose configuration
+     * makes it an evaluation run: simulated robots publish their ground truth. {@code copy} is
+     * the folder of the copy; delete it after the runtime is closed.
+     */
+    static Runtime evaluationRuntime(String name, Path copy) throws IOException, InterruptedException {
+        Path assembly = Path.of(System.getProperty("arflex.it.runtime"));
+        Runtime.deleteTree(copy);
+        Runtime.copyTree(assembly, copy);
+        Files.writeString(copy.resolve("conf/config.properties"),
+                "\n# " + name + ": an evaluation run (ground truth of simulated robots)\narflex.evaluation=true\n",
+                java.nio.charset.StandardCharsets.UTF_8, java.nio.file.StandardOpenOption.APPEND);
+        String old = System.getProperty("arflex.it.runtime");
+        System.setProperty("arflex.it.runtime", copy.toString());
+        try {
+            return new Runtime(name);
+        } finally {
+            System.setProperty("arflex.it.runtime", old);
+        }
+    }
+
+    /**
+     * The operator at the cell: at most once a second, resets what waits for a reset, and
+     * counts the resets. On this small shared machine the runtime's heartbeat is sometimes late
+     * by more than the 1 ms components' 100 ms timeout; they then hold (safe mode) and, as they
+     * move hardware, wait for an operator's reset (a trip of the force guard too).
+     */
+    static final class Operator {
+        final Map<String, Integer> resets = new java.util.TreeMap<>();
+        private final Runtime rt;
+        private long last;
+
+        Operator(Runtime rt) {
+            this.rt = rt;
+        }
+
+        /** Resets what waits, unless that was checked less than a second ago. */
+        void tick() {
+            if (System.nanoTime() - last >= 1_000_000_000L) {
+                tickNow();
+            }
+        }
+
+        /** Resets what waits for a reset, now. */
+        void tickNow() {
+            last = System.nanoTime();
+            for (String n : awaitingReset(rt)) {
+                rt.cmd("arflex:reset " + n);
+                resets.merge(n, 1, Integer::sum);
+            }
+        }
+    }
+
+    /** The TRUE tool-centre error (mm): the simulator's ground truth against the nominal model at the reference. */
+    static double trueErrorMm(CellPorts.State truth, CellPorts.State ref) {
+        CellPorts.Truth t = CellPorts.Truth.of(truth.read());
+        CellPorts.Joints r = CellPorts.Joints.of(ref.read(), false);
+        org.junit.jupiter.api.Assertions.assertNotNull(t, "no ground truth");
+        org.junit.jupiter.api.Assertions.assertNotNull(r, "no reference");
+        return 1e3 * NominalArm.distance(t.p(), NominalArm.tcp(r.q()));
+    }
+
     /** The input of sim-robot that carries the motion reference, as arflex:bindings prints it. */
     static boolean armFollows(Runtime rt, String motionSource) {
         String b = rt.cmd("arflex:bindings");

@@ -15,13 +15,13 @@ import java.util.jar.JarOutputStream;
 import java.util.jar.Manifest;
 
 /** Makes variants of a component bundle: the same jar with its contract rewritten. */
-final class Jars {
+public final class Jars {
 
     private Jars() {
     }
 
     /** Copies {@code jar} to {@code out}, passing every OSGI-INF/arflex/*.xml through {@code edit}. */
-    static Path withContract(Path jar, Path out, UnaryOperator<String> edit) throws IOException {
+    public static Path withContract(Path jar, Path out, UnaryOperator<String> edit) throws IOException {
         try (InputStream fin = Files.newInputStream(jar); JarInputStream in = new JarInputStream(fin)) {
             Manifest m = in.getManifest();
             try (OutputStream fout = Files.newOutputStream(out); JarOutputStream o = new JarOutputStream(fout, m)) {

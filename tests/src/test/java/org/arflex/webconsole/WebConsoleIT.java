@@ -7,8 +7,6 @@ import static org.junit.jupiter.api.Assertions.assertTrue;
 
 import com.sun.net.httpserver.HttpServer;
 import java.io.IOException;
-import java.io.InputStream;
-import java.io.OutputStream;
 import java.net.InetSocketAddress;
 import java.net.URI;
 import java.net.http.HttpRequest;
@@ -22,10 +20,6 @@ import java.util.HexFormat;
 import java.util.List;
 import java.util.Map;
 import java.util.function.UnaryOperator;
-import java.util.jar.JarEntry;
-import java.util.jar.JarInputStream;
-import java.util.jar.JarOutputStream;
-import java.util.jar.Manifest;
 import java.util.regex.Matcher;
 import java.util.regex.Pattern;
 import java.util.stream.Stream;
@@ -646,28 +640,17 @@ class WebConsoleIT {
         assertEquals("true", paramValue("tcp-correction", "enable"));
     }
 
-    /** Copies {@code jar} to {@code out} with every OSGI-INF/arflex/*.xml contract passed through {@code edit}. */
+    /**
+     * Copies {@code jar} to {@code out} with every OSGI-INF/arflex/*.xml contract passed through
+     * {@code edit}, which must change it (an edit that matches nothing is a broken test).
+     */
     private static Path withContract(Path jar, Path out, UnaryOperator<String> edit) throws IOException {
         Files.createDirectories(out.getParent());
-        try (InputStream fin = Files.newInputStream(jar); JarInputStream in = new JarInputStream(fin)) {
-            Manifest m = in.getManifest();
-            try (OutputStream fout = Files.newOutputStream(out); JarOutputStream o = new JarOutputStream(fout, m)) {
-                JarEntry e;
-                while ((e = in.getNextJarEntry()) != null) {
-                    byte[] data = in.readAllBytes();
-                    if (e.getName().startsWith("OSGI-INF/arflex/") && e.getName().endsWith(".xml")) {
-                        String xml = new String(data, StandardCharsets.UTF_8);
-                        String edited = edit.apply(xml);
-                        assertFalse(xml.equals(edited), "the edit changed nothing in " + e.getName());
-                        data = edited.getBytes(StandardCharsets.UTF_8);
-                    }
-                    o.putNextEntry(new JarEntry(e.getName()));
-                    o.write(data);
-                    o.closeEntry();
-                }
-            }
-        }
-        return out;
+        return org.arflex.it.Jars.withContract(jar, out, xml -> {
+            String edited = edit.apply(xml);
+            assertFalse(xml.equals(edited), "the edit changed nothing in the contract of " + jar.getFileName());
+            return edited;
+        });
     }
 
     /** Where the tests write their bundle variants (inside the runtime's work directory). */

@@ -41,7 +41,12 @@ class ArtifactsTest {
     }
 
     private long staged() throws IOException {
-        Path s = dir.resolve("staging");
+        return stagedFiles(dir);
+    }
+
+    /** Files in {@code dataDir}'s staging folder (0 when there is none). */
+    static long stagedFiles(Path dataDir) throws IOException {
+        Path s = dataDir.resolve("staging");
         if (!Files.isDirectory(s)) {
             return 0;
         }

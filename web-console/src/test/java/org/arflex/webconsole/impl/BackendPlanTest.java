@@ -18,7 +18,6 @@ import java.util.function.Function;
 import java.util.jar.Attributes;
 import java.util.jar.JarOutputStream;
 import java.util.jar.Manifest;
-import java.util.stream.Stream;
 import org.arflex.drcr.DrcrService;
 import org.arflex.drcr.dto.CellDTO;
 import org.arflex.drcr.dto.ContractDTO;
@@ -159,13 +158,7 @@ class BackendPlanTest {
     }
 
     private long staged() throws IOException {
-        Path s = dir.resolve("staging");
-        if (!Files.isDirectory(s)) {
-            return 0;
-        }
-        try (Stream<Path> l = Files.list(s)) {
-            return l.count();
-        }
+        return ArtifactsTest.stagedFiles(dir);
     }
 
     @Test
