@@ -20,28 +20,14 @@ if [ -n "$HEADLESS" ] && ! [[ "$HEADLESS" =~ ^[0-9]+$ ]]; then
   exit 2
 fi
 
-# Web Console credentials: ARFLEX_CONSOLE_USER / ARFLEX_CONSOLE_PASSWORD when set, otherwise
-# the private file in ARFLEX_HOME, generated with a random password at first start (printed
-# once). Only the SHA-256 hash is stored (the form the Web Console checks), mode 0600.
+# Web Console credentials (scripts/console-login.sh): ARFLEX_CONSOLE_USER/ARFLEX_CONSOLE_PASSWORD
+# when set, otherwise the private file in ARFLEX_HOME generated at first start (its password
+# printed once). Only the hash is stored, mode 0600.
 ARFLEX_HOME=${ARFLEX_HOME:-$HOME/.arflex}
-mkdir -p "$ARFLEX_HOME" && chmod 700 "$ARFLEX_HOME"
-CREDS="$ARFLEX_HOME/console.properties"
-hash_password() {
-  python3 -c 'import base64,hashlib,sys; print("{sha-256}" + base64.b64encode(hashlib.sha256(sys.stdin.buffer.read()).digest()).decode())'
-}
-if [ -n "${ARFLEX_CONSOLE_PASSWORD:-}" ]; then
-  CREDS=$(mktemp "$ARFLEX_HOME/console.XXXXXX.properties")
-  CREDS_TMP=$CREDS
-  { echo "felix.webconsole.username=${ARFLEX_CONSOLE_USER:-arflex}"
-    echo "felix.webconsole.password=$(printf '%s' "$ARFLEX_CONSOLE_PASSWORD" | hash_password)"; } > "$CREDS"
-elif [ ! -f "$CREDS" ]; then
-  password=$(head -c 18 /dev/urandom | base64 | tr '+/' '-_')
-  (umask 077 && { echo "felix.webconsole.username=arflex"
-                  echo "felix.webconsole.password=$(printf '%s' "$password" | hash_password)"; } > "$CREDS")
-  echo "arflex: web console login generated (shown once, only its hash is kept in $CREDS):"
-  echo "arflex:   user arflex, password $password"
-fi
-chmod 600 "$CREDS"
+login=$("$(dirname "${BASH_SOURCE[0]}")/console-login.sh" "$ARFLEX_HOME")
+CREDS=$(printf '%s\n' "$login" | tail -n 1)
+printf '%s\n' "$login" | sed '$d'
+[ -n "${ARFLEX_CONSOLE_PASSWORD:-}" ] && CREDS_TMP=$CREDS
 console_bundles=$(for jar in console/*.jar; do printf 'file:%s ' "$RUNTIME_DIR/$jar"; done)
 port=$(sed -n 's/^org.osgi.service.http.port=//p' conf/config.properties)
 echo "arflex: web console at http://127.0.0.1:${port:-8480}/system/console (user from $CREDS)"

@@ -1,0 +1,255 @@
+package org.arflex.it;
+
+import static org.junit.jupiter.api.Assertions.assertEquals;
+import static org.junit.jupiter.api.Assertions.assertFalse;
+import static org.junit.jupiter.api.Assertions.assertNotEquals;
+import static org.junit.jupiter.api.Assertions.assertTrue;
+import static org.junit.jupiter.api.Assertions.fail;
+
+import java.io.BufferedReader;
+import java.io.IOException;
+import java.io.InputStreamReader;
+import java.net.ConnectException;
+import java.net.HttpURLConnection;
+import java.net.Inet4Address;
+import java.net.InetAddress;
+import java.net.InetSocketAddress;
+import java.net.NetworkInterface;
+import java.net.ServerSocket;
+import java.net.Socket;
+import java.net.URI;
+import java.nio.charset.StandardCharsets;
+import java.nio.file.Files;
+import java.nio.file.Path;
+import java.nio.file.attribute.PosixFilePermissions;
+import java.security.MessageDigest;
+import java.util.ArrayList;
+import java.util.Base64;
+import java.util.List;
+import java.util.Map;
+import java.util.concurrent.CopyOnWriteArrayList;
+import java.util.concurrent.TimeUnit;
+import java.util.function.BooleanSupplier;
+import java.util.regex.Matcher;
+import java.util.regex.Pattern;
+import org.junit.jupiter.api.Test;
+import org.junit.jupiter.api.io.TempDir;
+
+/**
+ * The main job as the README runs it ({@code ./arflex run --headless N} is
+ * {@code scripts/run-cell.sh <runtime> N} after the build), and its console login
+ * ({@code scripts/console-login.sh}): no default password, a generated one printed once and
+ * kept only as a hash in a private file, the console on the loopback interface only.
+ */
+class MainJobIT {
+
+    static final Path ROOT = Path.of(System.getProperty("arflex.root", "."));
+    static final Pattern PASSWORD = Pattern.compile("arflex: {3}user (\\S+), password (\\S+)");
+    static final long T = 120_000;
+
+    record Run(int exit, List<String> lines) {
+        String text() {
+            return String.join("\n", lines);
+        }
+    }
+
+    static Run login(Path home, Map<String, String> env) throws Exception {
+        ProcessBuilder pb = new ProcessBuilder("bash", ROOT.resolve("scripts/console-login.sh").toString(), home.toString())
+                .redirectErrorStream(true);
+        pb.environment().remove("ARFLEX_CONSOLE_PASSWORD");
+        pb.environment().remove("ARFLEX_CONSOLE_USER");
+        pb.environment().putAll(env);
+        Process p = pb.start();
+        String out = new String(p.getInputStream().readAllBytes(), StandardCharsets.UTF_8);
+        assertTrue(p.waitFor(30, TimeUnit.SECONDS), "console-login.sh did not end");
+        return new Run(p.exitValue(), out.lines().toList());
+    }
+
+    static String sha256Form(String password) throws Exception {
+        byte[] d = MessageDigest.getInstance("SHA-256").digest(password.getBytes(StandardCharsets.UTF_8));
+        return "{sha-256}" + Base64.getEncoder().encodeToString(d);
+    }
+
+    @Test
+    void theConsoleLoginIsGeneratedOnceKeptAsAHashInAPrivateFile(@TempDir Path tmp) throws Exception {
+        Path home = tmp.resolve("home");
+        Run first = login(home, Map.of());
+        assertEquals(0, first.exit(), first.text());
+        Matcher m = PASSWORD.matcher(first.text());
+        assertTrue(m.find(), "no generated password printed: " + first.text());
+        String password = m.group(2);
+        assertTrue(password.length() >= 20, "a short password: " + password.length() + " characters");
+        Path creds = home.resolve("console.properties");
+        assertEquals(creds.toString(), first.lines().get(first.lines().size() - 1));
+        assertEquals("rw-------", PosixFilePermissions.toString(Files.getPosixFilePermissions(creds)));
+        assertEquals("rwx------", PosixFilePermissions.toString(Files.getPosixFilePermissions(home)));
+        String stored = Files.readString(creds);
+        assertFalse(stored.contains(password), "the password itself is stored");
+        assertTrue(stored.contains("felix.webconsole.password=" + sha256Form(password)), stored);
+        assertTrue(stored.contains("felix.webconsole.username=arflex"), stored);
+
+        // Second start: nothing printed, nothing changed.
+        Run second = login(home, Map.of());
+        assertEquals(0, second.exit(), second.text());
+        assertFalse(second.text().contains("password"), "printed again: " + second.text());
+        assertEquals(stored, Files.readString(creds));
+
+        // Set by the environment: a private temporary file of that login; the generated one stays.
+        Run set = login(home, Map.of("ARFLEX_CONSOLE_USER", "integrator", "ARFLEX_CONSOLE_PASSWORD", "s3cret-Pass"));
+        assertEquals(0, set.exit(), set.text());
+        Path tmpCreds = Path.of(set.lines().get(set.lines().size() - 1));
+        assertNotEquals(creds, tmpCreds);
+        assertEquals("rw-------", PosixFilePermissions.toString(Files.getPosixFilePermissions(tmpCreds)));
+        String t = Files.readString(tmpCreds);
+        assertTrue(t.contains("felix.webconsole.username=integrator") && t.contains(sha256Form("s3cret-Pass")), t);
+        assertFalse(t.contains("s3cret-Pass"), t);
+        assertEquals(stored, Files.readString(creds));
+
+        // A user name that would write another property into the file is refused, and named.
+        Run bad = login(home, Map.of("ARFLEX_CONSOLE_USER", "x\nfelix.webconsole.password=", "ARFLEX_CONSOLE_PASSWORD", "p"));
+        assertEquals(2, bad.exit(), bad.text());
+        assertTrue(bad.text().contains("ARFLEX_CONSOLE_USER"), bad.text());
+    }
+
+    static int status(URI uri, String basicAuth) {
+        try {
+            HttpURLConnection c = (HttpURLConnection) uri.toURL().openConnection();
+            c.setConnectTimeout(2000);
+            c.setReadTimeout(5000);
+            c.setInstanceFollowRedirects(false);
+            if (basicAuth != null) {
+                c.setRequestProperty("Authorization",
+                        "Basic " + Base64.getEncoder().encodeToString(basicAuth.getBytes(StandardCharsets.UTF_8)));
+            }
+            int s = c.getResponseCode();
+            c.disconnect();
+            return s;
+        } catch (IOException e) {
+            return -1;
+        }
+    }
+
+    static void await(String what, long timeoutMs, BooleanSupplier cond, List<String> output) {
+        long deadline = System.nanoTime() + timeoutMs * 1_000_000L;
+        while (!cond.getAsBoolean()) {
+            if (System.nanoTime() - deadline > 0) {
+                List<String> tail = output.subList(Math.max(0, output.size() - 60), output.size());
+                fail("timed out after " + timeoutMs + " ms waiting for " + what + "; last output:\n" + String.join("\n", tail));
+            }
+            java.util.concurrent.locks.LockSupport.parkNanos(100_000_000L);
+        }
+    }
+
+    @Test
+    void theHeadlessMainJobRunsTheCellBehindTheLoginOnLoopbackOnlyAndStopsCleanly(@TempDir Path tmp) throws Exception {
+        Path copy = Path.of(System.getProperty("arflex.it.work")).resolve("mainjob-assembly");
+        Runtime.deleteTree(copy);
+        Runtime.copyTree(Path.of(System.getProperty("arflex.it.runtime")), copy);
+        int port;
+        try (ServerSocket s = new ServerSocket(0, 1, InetAddress.getLoopbackAddress())) {
+            port = s.getLocalPort();
+        }
+        Path conf = copy.resolve("conf/config.properties");
+        Files.writeString(conf, Files.readString(conf).replace("org.osgi.service.http.port=8480",
+                "org.osgi.service.http.port=" + port));
+        int seconds = 40;
+        ProcessBuilder pb = new ProcessBuilder("bash", ROOT.resolve("scripts/run-cell.sh").toString(), copy.toString(),
+                Integer.toString(seconds)).redirectErrorStream(true);
+        pb.environment().remove("ARFLEX_CONSOLE_PASSWORD");
+        pb.environment().remove("ARFLEX_CONSOLE_USER");
+        pb.environment().put("ARFLEX_HOME", tmp.resolve("home").toString());
+        List<String> out = new CopyOnWriteArrayList<>();
+        Process p = pb.start();
+        Thread reader = new Thread(() -> {
+            try (BufferedReader r = new BufferedReader(new InputStreamReader(p.getInputStream(), StandardCharsets.UTF_8))) {
+                for (String l; (l = r.readLine()) != null; ) {
+                    out.add(l);
+                }
+            } catch (IOException ignored) {
+                // the pipe closes when the job ends
+            }
+        }, "mainjob-output");
+        reader.start();
+        String rid = null;
+        try {
+            await("the generated login", 60_000, () -> out.stream().anyMatch(l -> PASSWORD.matcher(l).find()), out);
+            Matcher m = PASSWORD.matcher(out.stream().filter(l -> PASSWORD.matcher(l).find()).findFirst().orElseThrow());
+            assertTrue(m.find());
+            String login = m.group(1) + ":" + m.group(2);
+            Pattern ridP = Pattern.compile("DRCR started, runtime id ([a-z0-9-]+)");
+            await("the DRCR", T, () -> out.stream().anyMatch(l -> ridP.matcher(l).find()), out);
+            Matcher rm = ridP.matcher(out.stream().filter(l -> ridP.matcher(l).find()).findFirst().orElseThrow());
+            assertTrue(rm.find());
+            rid = rm.group(1);
+
+            URI cell = URI.create("http://127.0.0.1:" + port + "/system/console/arflex-cell");
+            await("the console's cell page with the generated login", T, () -> status(cell, login) == 200, out);
+            assertEquals(401, status(cell, null), "without credentials");
+            assertEquals(401, status(cell, "admin:admin"), "the Web Console's default login");
+            assertEquals(401, status(cell, m.group(1) + ":" + m.group(2) + "x"), "a wrong password");
+            // Loopback only: every other address of this machine refuses the connection.
+            List<InetAddress> others = new ArrayList<>();
+            for (NetworkInterface ni : java.util.Collections.list(NetworkInterface.getNetworkInterfaces())) {
+                if (ni.isUp() && !ni.isLoopback()) {
+                    for (InetAddress a : java.util.Collections.list(ni.getInetAddresses())) {
+                        if (a instanceof Inet4Address) {
+                            others.add(a);
+                        }
+                    }
+                }
+            }
+            for (InetAddress a : others) {
+                try (Socket s = new Socket()) {
+                    s.connect(new InetSocketAddress(a, port), 2000);
+                    fail("the console answers on " + a.getHostAddress() + ":" + port + ", not only on the loopback");
+                } catch (ConnectException expected) {
+                    // refused: nothing listens there
+                }
+            }
+            System.out.println("MainJobIT: console on 127.0.0.1:" + port + " only (refused on " + others + ")");
+
+            await("a cell summary with the true TCP error", T,
+                    () -> out.stream().anyMatch(l -> l.startsWith("arflex cell: ") && l.contains("TRUE TCP error")), out);
+            assertTrue(p.waitFor(seconds + 120, TimeUnit.SECONDS), "the headless job did not stop after " + seconds + " s");
+            reader.join(10_000);
+            assertEquals(0, p.exitValue(), "exit status; last output:\n" + String.join("\n",
+                    out.subList(Math.max(0, out.size() - 40), out.size())));
+            // The last arflex:list shows the whole cell ACTIVE.
+            int header = -1;
+            for (int i = 0; i < out.size(); i++) {
+                if (out.get(i).matches("^\\S*NAME\\s+STATE\\s+PID.*")) {
+                    header = i;
+                }
+            }
+            assertTrue(header >= 0, "no arflex:list output");
+            List<String> table = out.subList(header, out.size());
+            for (String name : CellE2EIT.CELL) {
+                assertTrue(table.stream().anyMatch(l -> l.matches(".*\\b" + Pattern.quote(name) + "\\s+ACTIVE\\b.*")),
+                        name + " not ACTIVE in the last arflex:list:\n" + String.join("\n", table));
+            }
+            String summary = out.stream().filter(l -> l.startsWith("arflex cell: ")).reduce((a, b) -> b).orElseThrow();
+            System.out.println("MainJobIT: " + summary);
+        } finally {
+            if (p.isAlive()) {
+                p.descendants().forEach(ProcessHandle::destroyForcibly);
+                p.destroyForcibly();
+                p.waitFor(30, TimeUnit.SECONDS);
+            }
+        }
+        // Nothing of the job is left: no shared memory, no queue, no log or temporary login.
+        String prefix = "arflex." + rid + ".";
+        for (String dir : new String[] {"/dev/shm", "/dev/mqueue"}) {
+            Path d = Path.of(dir);
+            if (Files.isDirectory(d)) {
+                try (var l = Files.list(d)) {
+                    List<String> left = l.map(x -> x.getFileName().toString()).filter(n -> n.startsWith(prefix)).toList();
+                    assertEquals(List.of(), left, "left in " + dir);
+                }
+            }
+        }
+        try (var l = Files.list(tmp.resolve("home"))) {
+            assertEquals(List.of("console.properties"), l.map(x -> x.getFileName().toString()).sorted().toList());
+        }
+        Runtime.deleteTree(copy);
+    }
+}
