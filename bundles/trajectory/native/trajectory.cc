@@ -83,13 +83,13 @@ struct State {
 // start over from the measured pose. Below sim-robot's ref_acquire_tol (0.05 rad), so that a
 // robot which refuses the output as too far always gets a trajectory that comes to it.
 constexpr double kResyncTol = 0.005;  // rad, any joint
-// Idle (program ended, or held between motions) with the arm measured further than this from
-// the output for kAwayNs: the arm is not following (its robot has no reference input yet, or
-// refuses this one; sim-robot's ref_acquire_tol is the same 0.05 rad) and the output moves to
-// the arm, so that the next motion starts there. A following arm settles well inside it, and
-// tcp-correction's correction (arm = output + correction) is clamped at 0.02 rad.
+// The arm measured at rest further than this from the output for kAwayNs is not following
+// (its robot has no reference input yet, or refuses this one; sim-robot's ref_acquire_tol is
+// the same 0.05 rad) and the trajectory comes to it (Step). A following arm settles well
+// inside it, and tcp-correction's correction (arm = output + correction) is clamped at 0.02 rad.
 constexpr double kAwayTol = 0.05;        // rad, any joint
 constexpr uint64_t kAwayNs = 1000000000;  // 1 s
+constexpr double kRestSpeed = 1e-3;       // rad/s, every joint: the arm is at rest
 
 int Param(struct arflex_component* c, const char* name, int* idx) {
   *idx = arflex_component_param(c, name);
@@ -237,19 +237,6 @@ int Step(struct arflex_component* c, uint64_t release_ns, bool force_stop) {
     if (arflex_input_bound(g.in_state)) return 0;  // wait for the first measurement
     g.player.Init(g.player.program()->has_start ? g.player.program()->start : Q::Zero());
   }
-  // An idle output the arm has stayed away from (kAwayTol, kAwayNs) moves to the arm.
-  if (!arflex_input_bound(g.in_state) || !g.player.idle()) {
-    g.away_since = 0;
-  } else if (arm) {
-    if ((qm - g.player.q_out()).cwiseAbs().maxCoeff() <= kAwayTol) {
-      g.away_since = 0;
-    } else if (g.away_since == 0) {
-      g.away_since = release_ns;
-    } else if (release_ns - g.away_since >= kAwayNs) {
-      g.player.Init(qm);
-      g.away_since = 0;
-    }
-  }
   struct arflex_safety_state s;
   if (arflex_input_bound(g.in_safety)) {
     if (arflex_input_state_read(g.in_safety, &s, sizeof(s), nullptr) == 1) {
@@ -258,6 +245,32 @@ int Step(struct arflex_component* c, uint64_t release_ns, bool force_stop) {
     }
   } else {
     g.safety_seen = false;
+  }
+  const bool stopped_on_purpose =
+      force_stop || (arflex_input_bound(g.in_safety) &&
+                     (!g.safety_seen || g.safety.mode == ARFLEX_SAFETY_STATE_MODE_PROTECTIVE_STOP));
+  // The arm does not follow: measured at rest further than kAwayTol from the output for
+  // kAwayNs (its robot has no reference input yet, or holds, or refuses this reference as too
+  // far from it). The trajectory comes to the arm: idle, the output moves there and the next
+  // motion starts there; in a motion, the program starts over from its first motion at the arm
+  // (as for a robot that appears). Not while a protective stop or safe mode holds on purpose:
+  // those resume where they stopped.
+  bool at_rest = arm;
+  for (int j = 0; at_rest && j < 6; ++j) at_rest = std::fabs(js.qd[j]) < kRestSpeed;
+  if (!arflex_input_bound(g.in_state) || stopped_on_purpose) {
+    g.away_since = 0;
+  } else if (arm) {
+    if ((qm - g.player.q_out()).cwiseAbs().maxCoeff() <= kAwayTol || !at_rest) {
+      g.away_since = 0;
+    } else if (g.away_since == 0) {
+      g.away_since = release_ns;
+    } else if (release_ns - g.away_since >= kAwayNs) {
+      if (!g.player.idle()) {
+        g.player.Begin(&g.model, &g.programs[g.playing], arflex_component_ctl(c)->config.period_ns * 1e-9);
+      }
+      g.player.Init(qm);
+      g.away_since = 0;
+    }
   }
   // Target time rate: 0 = hold. A bound safety input that has not spoken yet holds too.
   double rate = arflex_param_bool(c, g.p_run) ? 1.0 : 0.0;

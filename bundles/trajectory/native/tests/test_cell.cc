@@ -378,7 +378,9 @@ void CaseLateRobot() {
   CHECK(!dir.empty(), "mkdtemp");
   bool ok = WriteText(arflex::cellkin::ProgramPath(dir, 1),
                       "arflex-program 1\nstart 0 0 0 0 0 0\nptp 0.5 0 0 0 0 0 speed 0.3\n"
-                      "ptp 0.5 0.3 0 0 0 0 speed 0.3\n");
+                      "ptp 0.5 0.3 0 0 0 0 speed 0.3\n") &&
+            WriteText(arflex::cellkin::ProgramPath(dir, 2),
+                      "arflex-program 1\nptp 0.5 0 0 0 0 0 speed 0.3\nptp 0.5 0.3 0 0 0 0 speed 0.3\n");
   std::string env = "ARFLEX_DATA_DIR=" + dir;
   char* envp[] = {const_cast<char*>(env.c_str()), nullptr};
   int r = ok ? Make(&script, "script", kMs, {{"joint_state", kJsT}}, {}, nullptr) : -EIO;
@@ -481,6 +483,36 @@ void CaseLateRobot() {
   printf("late_robot: an arm 80 mrad from the ended program's output got it after %.2f s\n", (Now() - t_away) * 1e-9);
   CHECK(moved, "the idle output did not move to an arm 80 mrad away");
   CHECK(Now() - t_away >= 990 * kMs, "the output moved before the arm had been away for 1 s");
+  // Program 2 playing in a loop while the arm stays where it is, at rest (its robot refuses the
+  // reference):
+  // once the output has been more than 50 mrad away for 1 s, the program starts over from its
+  // first motion at the arm; then it plays on from there.
+  const Q held = arm;
+  CHECK(SetI(&traj, "loop", 1) == 0 && SetI(&traj, "program", 2) == 0, "program 2 in a loop");
+  uint64_t t_left = 0, t_back = 0;
+  bool played_on = false;
+  const uint64_t t_end = Now() + 10 * kSec;
+  while (!played_on && Now() < t_end) {
+    write_js(held);
+    struct arflex_joint_ref ref;
+    if (rd.Read(&ref, &seq) != 1) {
+      sched_yield();
+      continue;
+    }
+    for (int j = 0; j < 6; ++j) out[j] = ref.q[j];
+    const double d = (out - held).cwiseAbs().maxCoeff();
+    if (t_left == 0 && d > 0.05) t_left = Now();
+    // Back at the arm: within 1 mrad (the restarted program's first cycle already moves it a
+    // little); the program's own path stays 80 mrad from the held arm on joint 1.
+    if (t_left != 0 && t_back == 0 && d < 1e-3) t_back = Now();
+    if (t_back != 0 && d > 0.01) played_on = true;
+  }
+  printf("late_robot: a looping program whose arm stays put left it and started over at the arm %.2f s later\n",
+         t_back ? (t_back - t_left) * 1e-9 : -1.0);
+  CHECK(t_left != 0, "the looping program never moved away from the arm");
+  CHECK(t_back != 0, "the playing program did not start over at an arm that stays away");
+  CHECK(t_back - t_left >= 990 * kMs, "started over before the arm had been away for 1 s");
+  CHECK(played_on, "the program did not play on from the arm");
   CHECK(arflex_host_stop(&traj, kCall) == 0, "stop");
 }
 
