@@ -96,6 +96,11 @@ class CellAccuracyBench {
                 String[] w = s.split("\\s+");
                 assertTrue(rt.cmd(s).startsWith(w[1] + "." + w[2] + " = "), s);
             }
+            // The moves between poses at 1 rad/s^2 (default 3): at 3 the inertial force at the
+            // stretched-out tool reaches the force guard's 150 N (it compensates gravity only).
+            String accel = System.getProperty("arflex.bench.accel", "1.0");
+            assertEquals("trajectory.accel = " + accel, rt.cmd("arflex:set trajectory accel " + accel));
+            notes.add("trajectory accel = " + accel + " rad/s^2 between poses");
             for (String p : new String[] {"gain", "max_step", "max_rate", "max_correction", "max_sigma"}) {
                 notes.add("tcp-correction " + p + " = " + rt.cmd("arflex:get tcp-correction " + p).strip());
             }
