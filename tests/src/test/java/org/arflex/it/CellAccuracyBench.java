@@ -48,10 +48,6 @@ class CellAccuracyBench {
         operator.tick();
     }
 
-    static double trueErrorMm(CellPorts.State truth, CellPorts.State ref) {
-        return CellRig.trueErrorMm(truth, ref);
-    }
-
     /** The joint target of a program file written by arflex-accuracy-bench --programs. */
     static double[] target(Path program) throws IOException {
         for (String line : Files.readAllLines(program, StandardCharsets.UTF_8)) {
@@ -116,11 +112,8 @@ class CellAccuracyBench {
         Map<Integer, Integer> views = new TreeMap<>();
         long[] posesSeen = {0, 0}; // valid, invalid
         AtomicBoolean sampling = new AtomicBoolean(true);
-        try (CellPorts.State truth = new CellPorts.State(rt.segment("sim-robot", "truth"), CellPorts.TRUTH);
-                CellPorts.State ref = new CellPorts.State(rt.segment("trajectory", "joint_ref"), CellPorts.JOINT_REF);
+        try (CellRig.AccuracyPorts p = CellRig.AccuracyPorts.open(rt);
                 CellPorts.State corrected = new CellPorts.State(rt.segment("tcp-correction", "corrected"), CellPorts.JOINT_REF);
-                CellPorts.State js = new CellPorts.State(rt.segment("sim-robot", "joint_state"), CellPorts.JOINT_STATE);
-                CellPorts.State err = new CellPorts.State(rt.segment("tcp-correction", "error"), CellPorts.SAMPLE);
                 CellPorts.State pose = new CellPorts.State(rt.segment("vision", "tcp_pose"), POSE_SIZE)) {
             // The vision sampler: every new pose, its age when first seen (CLOCK_MONOTONIC, as
             // System.nanoTime on Linux) and how many views it used. It samples every 1 ms; it
@@ -149,10 +142,10 @@ class CellAccuracyBench {
             Map<String, Long> cycles0 = cycles();
             try {
                 for (int i = 0; i < poses; i++) {
-                    rows.add(pose(i, truth, ref, corrected, js, err));
-                    PoseRow p = rows.get(rows.size() - 1);
+                    rows.add(pose(i, p, corrected));
+                    PoseRow row = rows.get(rows.size() - 1);
                     System.out.printf(Locale.ROOT, "CellAccuracyBench: pose %2d  off %.4f mm  on %.4f mm  settle %.2f s%n",
-                            p.index(), p.offMm(), p.onMm(), p.settleS());
+                            row.index(), row.offMm(), row.onMm(), row.settleS());
                 }
             } finally {
                 sampling.set(false);
@@ -173,32 +166,31 @@ class CellAccuracyBench {
         return m;
     }
 
-    PoseRow pose(int i, CellPorts.State truth, CellPorts.State ref, CellPorts.State corrected, CellPorts.State js,
-            CellPorts.State err) throws Exception {
+    PoseRow pose(int i, CellRig.AccuracyPorts p, CellPorts.State corrected) throws Exception {
         int program = FIRST_PROGRAM + i;
         double[] q = target(rt.dir.resolve("data/program-" + program + ".arp"));
         // Off: ramped out to exactly the program's reference.
         assertEquals("tcp-correction.enable = false", rt.cmd("arflex:set tcp-correction enable false"));
         rt.waitUntil("pose " + i + ": the correction ramped out", T, () -> {
             operator();
-            CellPorts.Joints r = CellPorts.Joints.of(ref.read(), false);
+            CellPorts.Joints r = CellPorts.Joints.of(p.ref().read(), false);
             CellPorts.Joints c = CellPorts.Joints.of(corrected.read(), false);
             return r != null && c != null && c.maxAbsDiff(r) == 0.0;
         });
         assertEquals("trajectory.program = " + program, rt.cmd("arflex:set trajectory program " + program));
         rt.waitUntil("pose " + i + ": the reference at the target and the arm at rest", T, () -> {
             operator();
-            CellPorts.Joints r = CellPorts.Joints.of(ref.read(), false);
-            CellPorts.Joints s = CellPorts.Joints.of(js.read(), true);
+            CellPorts.Joints r = CellPorts.Joints.of(p.ref().read(), false);
+            CellPorts.Joints s = CellPorts.Joints.of(p.js().read(), true);
             return r != null && s != null && CellRig.maxDiff(r.q(), q) < 1e-9 && s.maxAbsVelocity() < 1e-3;
         });
-        List<double[]> off = settle(truth, ref, js, err, 3, 0.002, Long.MAX_VALUE);
-        double offMm = mean(off, 3);
+        List<double[]> off = CellRig.settle(rt, operator, p, 3, 0.002, System.nanoTime(), T);
+        double offMm = CellRig.meanOfLast(off, 3);
         // On: from the switch on, every measurement's true error until settled.
         long onAt = System.nanoTime();
         assertEquals("tcp-correction.enable = true", rt.cmd("arflex:set tcp-correction enable true"));
-        List<double[]> on = settle(truth, ref, js, err, 4, 0.005, onAt);
-        double onMm = mean(on, 4);
+        List<double[]> on = CellRig.settle(rt, operator, p, 4, 0.005, onAt, T);
+        double onMm = CellRig.meanOfLast(on, 4);
         double band = onMm + 0.1 * Math.max(0, offMm - onMm);
         double settleS = 0;
         for (int k = on.size() - 1; k >= 0; k--) {
@@ -208,39 +200,6 @@ class CellAccuracyBench {
             }
         }
         return new PoseRow(i, offMm, onMm, settleS, on.size());
-    }
-
-    static double mean(List<double[]> run, int last) {
-        return run.subList(run.size() - last, run.size()).stream().mapToDouble(x -> x[1]).average().orElseThrow();
-    }
-
-    /**
-     * After each new vision measurement (tcp-correction's error output), the true error; until
-     * {@code n} in a row lie within {@code bandMm} of the one before with the arm at rest.
-     * Returns every (seconds since {@code sinceNs}, error mm) seen, the settled run last.
-     */
-    List<double[]> settle(CellPorts.State truth, CellPorts.State ref, CellPorts.State js, CellPorts.State err, int n,
-            double bandMm, long sinceNs) {
-        List<double[]> all = new ArrayList<>();
-        int[] run = {0};
-        long[] lastSeq = {-1};
-        double[] prev = {Double.NaN};
-        rt.waitUntil(n + " vision measurements in a row within " + bandMm + " mm", T, () -> {
-            operator();
-            CellPorts.Sample e = CellPorts.Sample.of(err.read());
-            long seq = e == null ? 0 : e.seq();
-            if (seq == lastSeq[0]) {
-                return false;
-            }
-            lastSeq[0] = seq;
-            CellPorts.Joints s = CellPorts.Joints.of(js.read(), true);
-            double now = trueErrorMm(truth, ref);
-            all.add(new double[] {sinceNs == Long.MAX_VALUE ? 0 : (System.nanoTime() - sinceNs) / 1e9, now});
-            run[0] = s == null || s.maxAbsVelocity() > 1e-3 || !(Math.abs(now - prev[0]) <= bandMm) ? 1 : run[0] + 1;
-            prev[0] = now;
-            return run[0] >= n;
-        });
-        return all;
     }
 
     void report(List<PoseRow> rows, double seconds, Map<String, Long> c0, Map<String, Long> c1, List<Double> ages,

@@ -258,36 +258,16 @@ class CellE2EIT {
      * {@code bandMm} of the one before. Returns the mean of those true errors (mm).
      */
     double settledTrueError(String what, int n, double bandMm, long timeoutMs) throws IOException {
-        try (CellPorts.State truth = new CellPorts.State(seg("sim-robot", "truth"), CellPorts.TRUTH);
-                CellPorts.State ref = new CellPorts.State(seg("trajectory", "joint_ref"), CellPorts.JOINT_REF);
-                CellPorts.State js = new CellPorts.State(seg("sim-robot", "joint_state"), CellPorts.JOINT_STATE);
-                CellPorts.State err = new CellPorts.State(seg("tcp-correction", "error"), CellPorts.SAMPLE)) {
-            List<Double> run = new ArrayList<>();
-            long[] lastSeq = {-1};
-            double[] prev = {Double.NaN};
+        try (CellRig.AccuracyPorts p = CellRig.AccuracyPorts.open(rt)) {
+            List<double[]> all = CellRig.settle(rt, operator, p, n, bandMm, System.nanoTime(), timeoutMs);
             StringBuilder trace = new StringBuilder();
-            rt.waitUntil(what + " (" + n + " vision measurements in a row within " + bandMm + " mm)", timeoutMs, () -> {
-                operator();
-                CellPorts.Sample e = CellPorts.Sample.of(err.read());
-                long seq = e == null ? 0 : e.seq();
-                if (seq == lastSeq[0]) {
-                    return false;
-                }
-                lastSeq[0] = seq;
-                CellPorts.Joints s = CellPorts.Joints.of(js.read(), true);
-                double now = trueErrorMm(truth, ref);
+            for (double[] x : all) {
                 if (trace.length() < 2000) {
-                    trace.append(String.format(" %.4f", now));
+                    trace.append(String.format(" %.4f", x[1]));
                 }
-                if (s == null || s.maxAbsVelocity() > 1e-3 || !(Math.abs(now - prev[0]) <= bandMm)) {
-                    run.clear();
-                }
-                prev[0] = now;
-                run.add(now);
-                return run.size() >= n;
-            });
+            }
             report.add(what + ": true error after each measurement (mm):" + trace);
-            return run.stream().mapToDouble(Double::doubleValue).average().orElseThrow();
+            return CellRig.meanOfLast(all, n);
         }
     }
 

@@ -168,6 +168,59 @@ final class CellRig {
         return 1e3 * NominalArm.distance(t.p(), NominalArm.tcp(r.q()));
     }
 
+    /** The cell's ports the accuracy measurements read (mapped read-only). */
+    record AccuracyPorts(CellPorts.State truth, CellPorts.State ref, CellPorts.State js, CellPorts.State err)
+            implements AutoCloseable {
+        static AccuracyPorts open(Runtime rt) throws IOException {
+            return new AccuracyPorts(new CellPorts.State(rt.segment("sim-robot", "truth"), CellPorts.TRUTH),
+                    new CellPorts.State(rt.segment("trajectory", "joint_ref"), CellPorts.JOINT_REF),
+                    new CellPorts.State(rt.segment("sim-robot", "joint_state"), CellPorts.JOINT_STATE),
+                    new CellPorts.State(rt.segment("tcp-correction", "error"), CellPorts.SAMPLE));
+        }
+
+        @Override
+        public void close() throws IOException {
+            for (CellPorts.State p : new CellPorts.State[] {truth, ref, js, err}) {
+                p.close();
+            }
+        }
+    }
+
+    /**
+     * Waits (up to {@code timeoutMs}) until the true error has settled: after each new vision
+     * measurement (tcp-correction's error output) the TRUE error, until {@code n} in a row lie
+     * within {@code bandMm} of the one before with the arm at rest. The operator ticks while it
+     * waits. Returns every (seconds since {@code sinceNs}, error mm) seen, the settled run last.
+     */
+    static List<double[]> settle(Runtime rt, Operator operator, AccuracyPorts p, int n, double bandMm, long sinceNs,
+            long timeoutMs) {
+        List<double[]> all = new ArrayList<>();
+        int[] run = {0};
+        long[] lastSeq = {-1};
+        double[] prev = {Double.NaN};
+        rt.waitUntil(n + " vision measurements in a row within " + bandMm + " mm of each other", timeoutMs, () -> {
+            operator.tick();
+            CellPorts.Sample e = CellPorts.Sample.of(p.err().read());
+            long seq = e == null ? 0 : e.seq();
+            if (seq == lastSeq[0]) {
+                return false;
+            }
+            lastSeq[0] = seq;
+            CellPorts.Joints s = CellPorts.Joints.of(p.js().read(), true);
+            double now = trueErrorMm(p.truth(), p.ref());
+            all.add(new double[] {(System.nanoTime() - sinceNs) / 1e9, now});
+            run[0] = s == null || s.maxAbsVelocity() > 1e-3 || !(Math.abs(now - prev[0]) <= bandMm) ? 1 : run[0] + 1;
+            prev[0] = now;
+            return run[0] >= n;
+        });
+        return all;
+    }
+
+    /** The mean error of the last {@code n} entries of {@link #settle}'s result. */
+    static double meanOfLast(List<double[]> settled, int n) {
+        return settled.subList(settled.size() - n, settled.size()).stream().mapToDouble(x -> x[1]).average().orElseThrow();
+    }
+
     /** The input of sim-robot that carries the motion reference, as arflex:bindings prints it. */
     static boolean armFollows(Runtime rt, String motionSource) {
         String b = rt.cmd("arflex:bindings");
