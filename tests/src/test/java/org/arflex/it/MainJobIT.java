@@ -209,7 +209,7 @@ class MainJobIT {
             System.out.println("MainJobIT: console on 127.0.0.1:" + port + " only (refused on " + others + ")");
 
             await("a cell summary with the true TCP error", T,
-                    () -> out.stream().anyMatch(l -> l.startsWith("arflex cell: ") && l.contains("TRUE TCP error")), out);
+                    () -> out.stream().anyMatch(l -> l.contains("arflex cell: ") && l.contains("TRUE TCP error")), out);
             assertTrue(p.waitFor(seconds + 120, TimeUnit.SECONDS), "the headless job did not stop after " + seconds + " s");
             reader.join(10_000);
             assertEquals(0, p.exitValue(), "exit status; last output:\n" + String.join("\n",
@@ -217,7 +217,7 @@ class MainJobIT {
             // The last arflex:list shows the whole cell ACTIVE.
             int header = -1;
             for (int i = 0; i < out.size(); i++) {
-                if (out.get(i).matches("^\\S*NAME\\s+STATE\\s+PID.*")) {
+                if (out.get(i).matches(".*\\bNAME\\s+STATE\\s+PID.*")) {
                     header = i;
                 }
             }
@@ -227,7 +227,8 @@ class MainJobIT {
                 assertTrue(table.stream().anyMatch(l -> l.matches(".*\\b" + Pattern.quote(name) + "\\s+ACTIVE\\b.*")),
                         name + " not ACTIVE in the last arflex:list:\n" + String.join("\n", table));
             }
-            String summary = out.stream().filter(l -> l.startsWith("arflex cell: ")).reduce((a, b) -> b).orElseThrow();
+            // (the summary is printed beside the shell's output: a line may begin with its prompt)
+            String summary = out.stream().filter(l -> l.contains("arflex cell: ")).reduce((a, b) -> b).orElseThrow();
             System.out.println("MainJobIT: " + summary);
         } finally {
             if (p.isAlive()) {
