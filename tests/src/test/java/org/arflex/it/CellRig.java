@@ -135,6 +135,8 @@ final class CellRig {
      */
     static final class Operator {
         final Map<String, Integer> resets = new java.util.TreeMap<>();
+        /** Resets so far, all components together. */
+        int total;
         private final Runtime rt;
         private long last;
 
@@ -155,6 +157,7 @@ final class CellRig {
             for (String n : awaitingReset(rt)) {
                 rt.cmd("arflex:reset " + n);
                 resets.merge(n, 1, Integer::sum);
+                total++;
             }
         }
     }
