@@ -149,6 +149,48 @@ static void state_port_no_torn_no_lost(void **state)
 	th_assert_clean(rid);
 }
 
+/* A consumer judges freshness by the producer's write stamp: a producer that stops writing
+ * ages, and a header damaged while mapped is reported, not read. */
+static void port_age_and_header_recheck(void **state)
+{
+	struct arflex_port_spec spec = { .method = ARFLEX_PORT_STATE, .type = sample_type };
+	struct arflex_port mgr, w, r;
+	struct sample v;
+	char name[ARFLEX_OBJ_NAME_SIZE];
+	uint64_t age = 1, now;
+
+	(void)state;
+	th_rid(rid, sizeof(rid), "age");
+	name_of(name, "x");
+	assert_int_equal(arflex_port_create(&mgr, name, &spec), 0);
+	assert_int_equal(arflex_port_open(&w, name, true, true, ARFLEX_PORT_STATE, &sample_type), 0);
+	assert_int_equal(arflex_port_open(&r, name, false, false, ARFLEX_PORT_STATE, &sample_type), 0);
+	assert_int_equal(arflex_port_age(&r, arflex_sys_now_ns(), &age), -ENODATA);
+	fill(&v, 1);
+	assert_int_equal(arflex_state_write(&w, &v, sizeof(v)), 0);
+	now = arflex_sys_now_ns();
+	assert_int_equal(arflex_port_age(&r, now, &age), 0);
+	assert_true(age < 1000000000u);
+	/* the same value, judged 250 ms later: 250 ms older */
+	assert_int_equal(arflex_port_age(&r, now + 250000000u, &age), 0);
+	assert_true(age >= 250000000u && age < 1250000000u);
+	/* a stamp in the future (clock read before the write) is age 0, never negative */
+	assert_int_equal(arflex_port_age(&r, 0, &age), 0);
+	assert_int_equal(age, 0);
+	/* damage: magic, then geometry */
+	mgr.hdr->magic ^= 1;
+	assert_int_equal(arflex_port_age(&r, now, &age), -EPROTO);
+	mgr.hdr->magic ^= 1;
+	assert_int_equal(arflex_port_age(&r, now, &age), 0);
+	mgr.hdr->slot_stride += 64;
+	assert_int_equal(arflex_port_age(&r, now, &age), -EPROTO);
+	mgr.hdr->slot_stride -= 64;
+	arflex_port_close(&r);
+	arflex_port_close(&w);
+	assert_int_equal(arflex_port_destroy(&mgr), 0);
+	th_assert_clean(rid);
+}
+
 static void port_open_checks_type(void **state)
 {
 	struct arflex_port_spec spec = { .method = ARFLEX_PORT_STATE, .type = sample_type };
@@ -418,6 +460,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(state_port_no_torn_no_lost),
 		cmocka_unit_test(port_open_checks_type),
+		cmocka_unit_test(port_age_and_header_recheck),
 		cmocka_unit_test(stream_single_process_semantics),
 		cmocka_unit_test(stream_drop_newest_exact_counts),
 		cmocka_unit_test(stream_drop_oldest_exact_counts),

@@ -7,10 +7,14 @@
 // `wrench` (arflex.Wrench: wrist F/T in the flange frame). Evaluation runs also get the
 // ground truth in `truth` (eval.GroundTruth, not a contract port; see ground_truth.h).
 //
-// Optional input `safety` (arflex.SafetyState, role=safety: the force guard): its power_scale
-// limits the drives (Cell::SetPowerScale: the servo's corrective torque saturates at that
-// fraction of each drive's max torque); unbound, or before a first value, full power. The
-// fraction applied is published on `servo_power` (arflex.Sample) every period.
+// Safety input `safety` (arflex.SafetyState, role=safety: the force guard) permits motion
+// (SPEC §5.3 safety inputs, docs/safety.md): the servo follows joint_ref only while the
+// guard is bound, has spoken since it was bound, is fresh (safety_max_age_ms) and valid and
+// not in a protective stop (arflex/safety_gate.h). Otherwise the arm holds its measured pose
+// (a protective stop); losing a guard that had permitted motion also latches an operator
+// reset. Its power_scale limits the drives (Cell::SetPowerScale: the servo's corrective
+// torque saturates at that fraction of each drive's max torque). The fraction applied is
+// published on `servo_power` (arflex.Sample) every period.
 //
 // Scripted disturbances come from parameters (see the contract, sim-robot.xml). The safe hook
 // holds the arm where it is (the servo's reference becomes the measured pose).
@@ -22,6 +26,7 @@
 #include <unistd.h>
 
 #include <arflex/component.h>
+#include <arflex/safety_gate.h>
 #include <arflex_types/joint_ref.h>
 #include <arflex_types/joint_state.h>
 #include <arflex_types/safety_state.h>
@@ -79,7 +84,7 @@ enum Param {
   kPushForce, kPushDirX, kPushDirY, kPushDirZ, kPushDurationMs,
   kObstacleEnable, kObstacleX, kObstacleY, kObstacleZ,
   kGuideForce, kGuideDx, kGuideDy, kGuideDz, kGuideDurationMs,
-  kRefAcquireTol,
+  kRefAcquireTol, kSafetyMaxAgeMs,
   kParamCount
 };
 struct ParamInfo {
@@ -99,6 +104,7 @@ const ParamInfo kParams[kParamCount] = {
     {"guide_dy", 0.2, 'd'},       {"guide_dz", 0.0, 'd'},
     {"guide_duration_ms", 2000, 'd'},
     {"ref_acquire_tol", 0.05, 'd'},
+    {"safety_max_age_ms", 20, 'd'},
 };
 
 // A step of up to ref_acquire_tol (0.05 rad) taken by the servo at once puts hundreds of
@@ -114,6 +120,10 @@ struct Robot {
   arflex_input* joint_ref = nullptr;
   arflex_input* safety = nullptr;
   arflex_port* servo_power = nullptr;
+  arflex_safety_gate gate{};
+  bool guard_hold = false;       // holding because the safety input does not permit motion
+  bool guard_permitted = false;  // the safety input permitted motion since start
+  bool loss_latched = false;     // the reset for this loss of the guard is latched
   int idx[kParamCount];
   // Change detection of the disturbance parameters (applied at the cycle they change).
   double push_sig[5];
@@ -272,6 +282,39 @@ int StepAndPublish(const arflex_component* c, Robot& r, uint64_t release_ns) {
   return ret;
 }
 
+// Judges the safety input (every cycle, in update and in safe mode), applies its power limit
+// and says why the arm holds (ctl hold word; rt-core refuses a RESET while it names a safety
+// input). A guard that had permitted motion and is gone (not merely stopping: no provider,
+// silent, stale, invalid, damaged) latches an operator reset: nothing tells this arm any more
+// that moving is safe.
+arflex_safety_verdict JudgeSafety(arflex_component* c, Robot& r) {
+  r.gate.max_age_ns = static_cast<uint64_t>(P(c, r, kSafetyMaxAgeMs) * 1e6);
+  const arflex_safety_verdict v = arflex_safety_gate_check(&r.gate, arflex_sys_now_ns());
+  if (arflex_safety_permits(v)) {
+    r.cell->SetPowerScale(arflex_safety_gate_scale(&r.gate));
+    r.guard_permitted = true;
+    r.loss_latched = false;
+    arflex_component_hold(c, ARFLEX_HOLD_NONE, 0, 0);
+    return v;
+  }
+  if (v == ARFLEX_SAFETY_STOP) r.cell->SetPowerScale(r.gate.state.power_scale);
+  if (r.guard_permitted && v != ARFLEX_SAFETY_STOP && !r.loss_latched) {
+    arflex_component_require_reset(c);
+    r.loss_latched = true;
+  }
+  arflex_component_hold(c, ARFLEX_HOLD_SAFETY_INPUT, v, arflex_input_index(c, r.safety));
+  return v;
+}
+
+// The servo holds where the arm is: its reference becomes the measured pose, no blend.
+void HoldMeasured(Robot& r) {
+  const arflex::sim::JointState js = r.cell->ReadJointState();
+  r.q_ref = js.q;
+  r.blend_t = kBlendSeconds;  // holding: no blend in progress
+  r.cell->SetJointReference(r.q_ref);
+  r.cell->SetCorrection(JointVector{});
+}
+
 bool ReferenceValid(const Cell& cell, const double* q) {
   for (int i = 0; i < kNumJoints; ++i) {
     const auto& link = cell.config().arm.links[i];
@@ -310,6 +353,8 @@ int Configure(arflex_component* c, void* user) {
     ret = arflex_component_input(c, "safety", ARFLEX_PORT_STATE, &kSafetyType, &r.safety);
   }
   if (ret < 0) return ret;
+  arflex_safety_gate_init(&r.gate, r.safety,
+                          static_cast<uint64_t>(P(c, r, kSafetyMaxAgeMs) * 1e6));
 
   // The ground-truth segment exists only when the manager created it (evaluation run).
   char name[ARFLEX_OBJ_NAME_SIZE];
@@ -355,6 +400,11 @@ int Start(arflex_component* c, void* user) {
   Robot& r = *static_cast<Robot*>(user);
   r.acquired = false;  // after STOP/START the reference must meet the arm again
   r.refusing = false;
+  r.guard_hold = false;
+  r.guard_permitted = false;
+  r.loss_latched = false;
+  arflex_safety_gate_init(&r.gate, r.safety,
+                          static_cast<uint64_t>(P(c, r, kSafetyMaxAgeMs) * 1e6));
   ApplyParams(c, r);
   return 0;
 }
@@ -363,14 +413,21 @@ int Update(arflex_component* c, void* user, uint64_t release_ns) {
   Robot& r = *static_cast<Robot*>(user);
   r.safe = false;
   ApplyParams(c, r);
-  // The safety controller's power limit: a new value is applied at once (this period's
-  // physics steps); between values the last one stays; no provider, full power.
-  arflex_safety_state safety;
-  const int sgot = arflex_input_state_read(r.safety, &safety, sizeof(safety), nullptr);
-  if (sgot == 1) {
-    r.cell->SetPowerScale(safety.power_scale);
-  } else if (sgot == -ENOTCONN) {
-    r.cell->SetPowerScale(1.0);
+  // The safety input permits motion, or the arm holds (fail closed). Its power limit is
+  // applied at once (this period's physics steps); a protective stop applies the reduced
+  // power the guard publishes, so the held arm yields to a push.
+  const arflex_safety_verdict verdict = JudgeSafety(c, r);
+  if (!arflex_safety_permits(verdict)) {
+    if (!r.guard_hold) {
+      HoldMeasured(r);
+      r.guard_hold = true;
+    }
+    return StepAndPublish(c, r, release_ns);
+  }
+  if (r.guard_hold) {  // the reference must meet the arm again (D9)
+    r.guard_hold = false;
+    r.acquired = false;
+    r.refusing = false;
   }
   arflex_joint_ref ref;
   const int got = arflex_input_state_read(r.joint_ref, &ref, sizeof(ref), nullptr);
@@ -421,12 +478,11 @@ int Update(arflex_component* c, void* user, uint64_t release_ns) {
 int Safe(arflex_component* c, void* user, arflex_safe_mode /*mode*/, bool first) {
   Robot& r = *static_cast<Robot*>(user);
   if (first) {
-    const arflex::sim::JointState js = r.cell->ReadJointState();
-    r.q_ref = js.q;
-    r.blend_t = kBlendSeconds;  // holding: no blend in progress
-    r.cell->SetJointReference(r.q_ref);
-    r.cell->SetCorrection(JointVector{});
+    HoldMeasured(r);
+    r.acquired = false;  // after the reset the reference must meet the arm again (D9)
+    r.refusing = false;
   }
+  JudgeSafety(c, r);
   r.safe = true;
   return StepAndPublish(c, r, arflex_sys_now_ns());
 }

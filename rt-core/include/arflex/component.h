@@ -27,7 +27,8 @@
  * older than that, the RT thread sets ARFLEX_FLAG_SAFE_ACTIVE and calls safe instead of
  * update every cycle. When the heartbeat is fresh again: without ARFLEX_CFG_MOVES_HARDWARE
  * safe mode ends by itself; with it, ARFLEX_FLAG_RESET_REQUIRED is set and safe mode lasts
- * until the operator's RESET command (which fails with -EAGAIN while the heartbeat is stale).
+ * until the operator's RESET command (which fails with -EAGAIN while the heartbeat is stale,
+ * and with -EBUSY while the component's hold word names a safety input: the cause persists).
  *
  * Threads: configure and cleanup run on the main thread; start, update, safe and stop on the
  * RT thread; commands on the mailbox thread. Hooks never run concurrently with each other.
@@ -135,6 +136,12 @@ ARFLEX_API bool arflex_input_bound(const struct arflex_input *in);
  *  must not carry state across providers (a motion source following the measured arm, a
  *  robot accepting a reference) compares it with the one it last saw. */
 ARFLEX_API uint32_t arflex_input_binding(const struct arflex_input *in);
+/** The bound provider's mapping (read-only use), NULL while unbound. Valid until the next
+ *  cycle boundary (a REBIND is taken there). RT safe. */
+ARFLEX_API struct arflex_port *arflex_input_port(struct arflex_input *in);
+/** arflex_port_age on the bound provider (age of its newest value at @now_ns, header
+ *  re-checked); -ENOTCONN when unbound. RT safe. */
+ARFLEX_API int arflex_input_age(const struct arflex_input *in, uint64_t now_ns, uint64_t *age_ns);
 /** arflex_state_read on the bound provider; -ENOTCONN when unbound. */
 ARFLEX_API int arflex_input_state_read(struct arflex_input *in, void *out, size_t len,
 				       uint64_t *seq);
@@ -156,6 +163,15 @@ ARFLEX_API bool arflex_component_safe_active(const struct arflex_component *c);
  *  the flag; the flag survives a restart of the RT process. Idempotent. RT safe: one atomic
  *  OR, callable from any hook or thread of the component. */
 ARFLEX_API void arflex_component_require_reset(struct arflex_component *c);
+
+/** Says why the component holds the arm by itself (ctl->hold, shown by the runtime with the
+ *  state): @cause an enum arflex_hold_cause (ARFLEX_HOLD_NONE clears), @detail and @input as
+ *  documented there. Written only when it changes. RT safe: one atomic store. */
+ARFLEX_API void arflex_component_hold(struct arflex_component *c, uint32_t cause, uint32_t detail,
+				      uint32_t input);
+/** Index of @in among the component's inputs (declaration order), for arflex_component_hold. */
+ARFLEX_API uint32_t arflex_input_index(const struct arflex_component *c,
+				       const struct arflex_input *in);
 
 #ifdef __cplusplus
 }

@@ -115,6 +115,18 @@ enum arflex_warn_kind {
 	ARFLEX_WARN_SAFE = 10,       /**< safe mode entered (heartbeat lost or reset required) */
 };
 
+/** Causes of ctl->hold (bits 0..7). Detail (bits 8..15): for SAFETY_INPUT the enum
+ *  arflex_safety_verdict (arflex/safety_gate.h); input (bits 16..23): index of the input in
+ *  the order the component declared them. */
+enum arflex_hold_cause {
+	ARFLEX_HOLD_NONE = 0,
+	ARFLEX_HOLD_SAFETY_INPUT = 1,  /**< a safety input does not permit motion */
+	ARFLEX_HOLD_AWAIT_COMMAND = 2, /**< stopped; after the reset, waits for a fresh command */
+	ARFLEX_HOLD_REFERENCE = 3,     /**< the reference input does not meet the arm */
+};
+#define ARFLEX_HOLD_WORD(cause, detail, input) \
+	((uint32_t)(cause) | ((uint32_t)(detail) & 0xffu) << 8 | ((uint32_t)(input) & 0xffu) << 16)
+
 /* ---- statistics (seqlock) ----------------------------------------------------------- */
 
 /** One measured quantity (wake-up latency or execution time), in ns. 16128 bytes. */
@@ -220,7 +232,9 @@ struct arflex_ctl {
 	int32_t exit_status;     /**< last error of the RT half (0 or -errno), for diagnosis */
 	uint64_t runtime_hb_ns;  /**< manager heartbeat, CLOCK_MONOTONIC ns */
 	uint64_t rt_hb_ns;       /**< RT thread heartbeat, CLOCK_MONOTONIC ns, every cycle */
-	uint64_t reserved_hdr;
+	uint32_t hold;           /**< why the component holds the arm by itself (RT process):
+				      ARFLEX_HOLD_WORD(cause, detail, input); 0 = not holding */
+	uint32_t reserved_hdr;
 	/* config, 64 bytes at 64 */
 	struct arflex_ctl_config config;
 	/* warnings, 128 bytes at 128: count of each enum arflex_warn_kind (RT process) */
@@ -242,6 +256,7 @@ ARFLEX_STATIC_ASSERT(sizeof(struct arflex_ctl_config) == 64, "config size");
 ARFLEX_STATIC_ASSERT(offsetof(struct arflex_ctl, state) == 24, "ctl.state");
 ARFLEX_STATIC_ASSERT(offsetof(struct arflex_ctl, runtime_hb_ns) == 40, "ctl.runtime_hb");
 ARFLEX_STATIC_ASSERT(offsetof(struct arflex_ctl, rt_hb_ns) == 48, "ctl.rt_hb");
+ARFLEX_STATIC_ASSERT(offsetof(struct arflex_ctl, hold) == 56, "ctl.hold");
 ARFLEX_STATIC_ASSERT(offsetof(struct arflex_ctl, config) == 64, "ctl.config");
 ARFLEX_STATIC_ASSERT(offsetof(struct arflex_ctl, warnings) == 128, "ctl.warnings");
 ARFLEX_STATIC_ASSERT(offsetof(struct arflex_ctl, stats) == 256, "ctl.stats");
@@ -317,6 +332,7 @@ ARFLEX_API uint64_t arflex_metric_percentile(const struct arflex_metric *m, doub
 /** Atomic accessors for the shared words (acquire loads, release stores). */
 ARFLEX_API uint32_t arflex_ctl_state(const struct arflex_ctl *ctl);
 ARFLEX_API uint32_t arflex_ctl_flags(const struct arflex_ctl *ctl);
+ARFLEX_API uint32_t arflex_ctl_hold(const struct arflex_ctl *ctl);
 ARFLEX_API void arflex_ctl_set_runtime_hb(struct arflex_ctl *ctl, uint64_t now_ns);
 
 #ifdef __cplusplus

@@ -184,6 +184,16 @@ ARFLEX_API int arflex_port_open(struct arflex_port *p, const char *shm_name, boo
 /** Unmaps a port opened with arflex_port_open (does not unlink). */
 ARFLEX_API void arflex_port_close(struct arflex_port *p);
 
+/**
+ * Freshness of a port as a consumer judges it: *@age_ns = @now_ns minus the producer's write
+ * stamp of its newest element (0 if the stamp is in the future). A dead, stopped or hung
+ * producer's last value keeps ageing, so a consumer that must not act on old data (a safety
+ * input) compares the age with its limit every cycle. Also re-checks the segment header
+ * (magic, method, geometry) against the mapping: a header overwritten while mapped reports
+ * -EPROTO. Returns 0, -ENODATA (nothing written yet), -EPROTO, -EINVAL. RT safe.
+ */
+ARFLEX_API int arflex_port_age(const struct arflex_port *p, uint64_t now_ns, uint64_t *age_ns);
+
 /* ---- state ----------------------------------------------------------------------- */
 
 /** Writes @len (<= elem_size) bytes as the new value. Returns 0 or -EINVAL. RT safe. */

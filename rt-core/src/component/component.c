@@ -126,6 +126,20 @@ void arflex_component_require_reset(struct arflex_component *c)
 	__atomic_or_fetch(&c->ctl->flags, ARFLEX_FLAG_RESET_REQUIRED, __ATOMIC_RELEASE);
 }
 
+void arflex_component_hold(struct arflex_component *c, uint32_t cause, uint32_t detail,
+			   uint32_t input)
+{
+	uint32_t w = cause == ARFLEX_HOLD_NONE ? 0 : ARFLEX_HOLD_WORD(cause, detail, input);
+
+	if (__atomic_load_n(&c->ctl->hold, __ATOMIC_RELAXED) != w)
+		STORE(&c->ctl->hold, w);
+}
+
+uint32_t arflex_input_index(const struct arflex_component *c, const struct arflex_input *in)
+{
+	return (uint32_t)(in - c->inputs);
+}
+
 bool arflex_input_bound(const struct arflex_input *in)
 {
 	return in->cur != NULL;
@@ -134,6 +148,16 @@ bool arflex_input_bound(const struct arflex_input *in)
 uint32_t arflex_input_binding(const struct arflex_input *in)
 {
 	return in->cur ? in->binding : 0;
+}
+
+struct arflex_port *arflex_input_port(struct arflex_input *in)
+{
+	return in->cur;
+}
+
+int arflex_input_age(const struct arflex_input *in, uint64_t now_ns, uint64_t *age_ns)
+{
+	return in->cur ? arflex_port_age(in->cur, now_ns, age_ns) : -ENOTCONN;
 }
 
 int arflex_input_state_read(struct arflex_input *in, void *out, size_t len, uint64_t *seq)
@@ -599,6 +623,8 @@ static bool serve(struct arflex_component *c, struct arflex_msg *m)
 
 		if (t && now > hb && now - hb > t) {
 			st = -EAGAIN;
+		} else if ((LOAD(&c->ctl->hold) & 0xffu) == ARFLEX_HOLD_SAFETY_INPUT) {
+			st = -EBUSY; /* the cause persists: a safety input does not permit motion */
 		} else {
 			__atomic_and_fetch(&c->ctl->flags, ~(uint32_t)ARFLEX_FLAG_RESET_REQUIRED,
 					   __ATOMIC_RELEASE);
@@ -808,6 +834,7 @@ int arflex_component_main(int argc, char **argv, const struct arflex_component_o
 	}
 	STORE(&c->ctl->pid, (int32_t)getpid());
 	STORE(&c->ctl->exit_status, 0);
+	STORE(&c->ctl->hold, 0);
 	/* a restart reuses the block: keep only the manager's reset-required bit */
 	__atomic_and_fetch(&c->ctl->flags, (uint32_t)ARFLEX_FLAG_RESET_REQUIRED, __ATOMIC_ACQ_REL);
 	for (unsigned k = 0; k < ARFLEX_WARN_KINDS; k++)

@@ -285,6 +285,11 @@ uint32_t arflex_ctl_flags(const struct arflex_ctl *ctl)
 	return LOAD(&ctl->flags);
 }
 
+uint32_t arflex_ctl_hold(const struct arflex_ctl *ctl)
+{
+	return __atomic_load_n(&ctl->hold, __ATOMIC_ACQUIRE);
+}
+
 void arflex_ctl_set_runtime_hb(struct arflex_ctl *ctl, uint64_t now_ns)
 {
 	STORE(&ctl->runtime_hb_ns, now_ns);

@@ -253,6 +253,26 @@ int arflex_state_write(struct arflex_port *p, const void *val, size_t len)
 	return 0;
 }
 
+int arflex_port_age(const struct arflex_port *p, uint64_t now_ns, uint64_t *age_ns)
+{
+	const struct arflex_slot_hdr *s;
+	uint64_t head, stamp;
+
+	if (!p->hdr || !age_ns)
+		return -EINVAL;
+	/* the identification cannot change while mapped: anything else is damage */
+	if (LOADR(&p->hdr->magic) != ARFLEX_PORT_MAGIC || LOADR(&p->hdr->method) != p->method ||
+	    LOADR(&p->hdr->slot_stride) != p->stride || LOADR(&p->hdr->depth) != p->depth)
+		return -EPROTO;
+	head = LOAD(&p->hdr->head);
+	if (head == 0)
+		return -ENODATA;
+	s = slot(p, head - 1);
+	stamp = LOAD(&s->stamp_ns);
+	*age_ns = now_ns > stamp ? now_ns - stamp : 0;
+	return 0;
+}
+
 int arflex_state_read(struct arflex_port *p, void *out, size_t len, uint64_t *seq)
 {
 	struct arflex_slot_hdr *s;

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <arflex/host.h>
+#include <arflex/safety_gate.h>
 #include <arflex_types/image_frame.h>
 #include <arflex_types/joint_ref.h>
 #include <arflex_types/joint_state.h>
@@ -21,11 +22,13 @@
 #include <cmath>
 #include <cstring>
 #include <array>
+#include <atomic>
 #include <functional>
 #include <map>
 #include <memory>
 #include <set>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "arflex_sim/cell.h"
@@ -135,8 +138,60 @@ std::vector<arflex_param_slot> RobotParams(int64_t steps_per_period) {
       ParamF("guide_dz", 0, -1, 1, true),
       ParamF("guide_duration_ms", 2000, 1, 60000, true),
       ParamF("ref_acquire_tol", 0.05, 0.001, 0.5, true),
+      ParamF("safety_max_age_ms", 20, 2, 1000, true),
   };
 }
+
+// A force guard owned by the test: its thread publishes a fresh arflex.SafetyState every
+// millisecond (sim-robot holds without a fresh safety input), with the mode and power scale the
+// test sets; Silence() stops the writes as a dead guard would.
+class TestGuard {
+ public:
+  void Create(const char* rid) {
+    ASSERT_EQ(arflex_ctl_obj_name(name_, sizeof(name_), rid, "guard", "out.safety"), 0);
+    arflex_port_spec spec{ARFLEX_PORT_STATE, kSafetyType, 1, ARFLEX_OVERFLOW_NONE};
+    ASSERT_EQ(arflex_port_create(&port_, name_, &spec), 0);
+    created_ = true;
+    running_ = true;
+    writer_ = std::thread([this] {
+      uint64_t seq = 0;
+      while (running_) {
+        if (writing_) {
+          arflex_safety_state st{};
+          st.t_ns = static_cast<int64_t>(Now());
+          st.seq = ++seq;
+          st.mode = mode_;
+          st.power_scale = scale_;
+          st.force_limit = 150;
+          arflex_state_write(&port_, &st, sizeof(st));
+        }
+        Pause();
+      }
+    });
+  }
+  void Set(uint32_t mode, double scale) {
+    scale_ = scale;
+    mode_ = mode;
+  }
+  void Silence(bool silent) { writing_ = !silent; }
+  const char* name() const { return name_; }
+  void Destroy() {
+    if (!created_) return;
+    running_ = false;
+    writer_.join();
+    EXPECT_EQ(arflex_port_destroy(&port_), 0);
+    created_ = false;
+  }
+
+ private:
+  char name_[ARFLEX_OBJ_NAME_SIZE] = {0};
+  arflex_port port_{};
+  bool created_ = false;
+  std::thread writer_;
+  std::atomic<bool> running_{false}, writing_{true};
+  std::atomic<uint32_t> mode_{ARFLEX_SAFETY_STATE_MODE_NORMAL};
+  std::atomic<double> scale_{1.0};
+};
 
 class SimComponents : public ::testing::Test {
  protected:
@@ -150,6 +205,7 @@ class SimComponents : public ::testing::Test {
   void TearDown() override {
     if (camera_used_) arflex_host_destroy(&camera_);
     if (robot_used_) arflex_host_destroy(&robot_);
+    guard_.Destroy();
     if (ref_used_) arflex_port_destroy(&ref_);
     EXPECT_EQ(Leftovers(), "") << "objects or children left behind";
   }
@@ -172,8 +228,9 @@ class SimComponents : public ::testing::Test {
     return left;
   }
 
+  // The robot, with its safety input bound to a fresh NORMAL guard unless @guarded is false.
   void CreateRobot(uint64_t period_ns, int64_t steps_per_period, bool truth,
-                   uint64_t hb_timeout_ns = 0) {
+                   uint64_t hb_timeout_ns = 0, bool guarded = true) {
     std::vector<arflex_param_slot> params = RobotParams(steps_per_period);
     std::vector<struct arflex_host_output> outs = {
         {"joint_state", {ARFLEX_PORT_STATE, kJointStateType, 1, ARFLEX_OVERFLOW_NONE}},
@@ -194,7 +251,15 @@ class SimComponents : public ::testing::Test {
     ASSERT_EQ(arflex_host_create(&robot_, &o), 0);
     ASSERT_EQ(arflex_host_spawn(&robot_, SIM_ROBOT_EXE, nullptr, nullptr), 0);
     ASSERT_EQ(arflex_host_wait_state(&robot_, ARFLEX_STATE_READY, 60 * kSec), 0);
+    if (guarded) {
+      guard_.Create(rid_);
+      ASSERT_EQ(arflex_host_bind(&robot_, "safety", guard_.name(), kCall), 0);
+    }
   }
+
+  // The robot's hold word (ctl->hold): cause and detail.
+  uint32_t HoldCause() { return arflex_ctl_hold(robot_.ctl) & 0xffu; }
+  uint32_t HoldDetail() { return (arflex_ctl_hold(robot_.ctl) >> 8) & 0xffu; }
 
   void CreateCamera(uint64_t period_ns, int64_t camera, int64_t w, int64_t h, double noise) {
     std::vector<arflex_param_slot> params = {
@@ -271,6 +336,7 @@ class SimComponents : public ::testing::Test {
   }
 
   char rid_[ARFLEX_ID_MAX + 1];
+  TestGuard guard_;
   arflex_host robot_, camera_;
   arflex_port ref_;
   std::string ref_name_;
@@ -431,51 +497,102 @@ TEST_F(SimComponents, RobotAcquiresOnlyAReferenceNearTheArm) {
   Shutdown(&robot_);
 }
 
-// The force guard's power limit reaches the drives: a SafetyState value on the optional safety
-// input sets the fraction the servo may use (published on servo_power); a non-finite one is no
-// power; unbound, full power again. (The physics of the limit: sim.DisturbanceTest.
-// ReducedPowerSaturatesTheServoAndTheArmYields.)
+// The force guard's power limit reaches the drives, and the guard permits motion (fail
+// closed, SAFETY.md 1): without a fresh valid value the arm holds where it is, says why in its
+// hold word, and a guard that had permitted motion and went silent latches an operator reset
+// that is refused while the guard stays silent. (The physics of the limit:
+// sim.DisturbanceTest.ReducedPowerSaturatesTheServoAndTheArmYields.)
 TEST_F(SimComponents, RobotTakesThePowerLimitOfTheSafetyInput) {
-  CreateRobot(1 * kMs, 1, false);
-  char name[ARFLEX_OBJ_NAME_SIZE];
-  ASSERT_EQ(arflex_ctl_obj_name(name, sizeof(name), rid_, "guard", "out.safety"), 0);
-  arflex_port_spec spec{ARFLEX_PORT_STATE, kSafetyType, 1, ARFLEX_OVERFLOW_NONE};
-  arflex_port feed;
-  ASSERT_EQ(arflex_port_create(&feed, name, &spec), 0);
-  arflex_port pw_port;
+  CreateRobot(1 * kMs, 1, false, 0, false);
+  CreateReference();
+  guard_.Create(rid_);
+  arflex_port pw_port, js_port;
   OpenReader(&robot_, "servo_power", ARFLEX_PORT_STATE, &kSampleType, &pw_port);
+  OpenReader(&robot_, "joint_state", ARFLEX_PORT_STATE, &kJointStateType, &js_port);
+  ASSERT_EQ(arflex_host_bind(&robot_, "joint_ref", ref_name_.c_str(), kCall), 0);
   ASSERT_EQ(arflex_host_start(&robot_, kCall), 0);
   arflex_sample pw{};
-  bool have = false;
+  arflex_joint_state js{};
+  bool have = false, hj = false;
   auto power_is = [&](double v) {
     return WaitFor([&] { return Latest(&pw_port, &pw, &have) && pw.value == v; });
   };
-  uint64_t seq = 0;
-  auto guard = [&](double scale) {
-    arflex_safety_state s{};
-    s.seq = ++seq;
-    s.mode = scale < 1.0 ? ARFLEX_SAFETY_STATE_MODE_PROTECTIVE_STOP : ARFLEX_SAFETY_STATE_MODE_NORMAL;
-    s.power_scale = scale;
-    ASSERT_EQ(arflex_state_write(&feed, &s, sizeof(s)), 0);
-  };
-  EXPECT_TRUE(power_is(1.0)) << "unbound: full power, got " << pw.value;
-  guard(0.25);
-  EXPECT_TRUE(WaitFor([&] { return Latest(&pw_port, &pw, &have) && pw.seq > 50; }));
-  EXPECT_EQ(pw.value, 1.0) << "a value on an unbound input must not count";
-  ASSERT_EQ(arflex_host_bind(&robot_, "safety", name, kCall), 0);
-  EXPECT_TRUE(power_is(0.25)) << "got " << pw.value;
-  guard(std::nan(""));
-  EXPECT_TRUE(power_is(0.0)) << "non-finite: no power, got " << pw.value;
-  guard(1.0);
+  // No guard: the arm does not take a reference (the unguarded robot holds).
+  ASSERT_TRUE(WaitFor([&] { return HoldCause() == ARFLEX_HOLD_SAFETY_INPUT; }));
+  EXPECT_EQ(HoldDetail(), static_cast<uint32_t>(ARFLEX_SAFETY_NO_PROVIDER));
+  const double target[6] = {0.15, 0.5, 0.3, 0.0, 0.8, 0.0};
+  AcquireAtHome(&js_port);
+  WriteReference(target);
+  ASSERT_TRUE(WaitFor([&] { return Latest(&js_port, &js, &hj) && js.seq > 300; }));
+  EXPECT_NEAR(js.q[0], 0.0, 1e-3) << "an unguarded arm moved";
+  EXPECT_EQ(arflex_ctl_flags(robot_.ctl) & ARFLEX_FLAG_RESET_REQUIRED, 0u)
+      << "never permitted: nothing to reset";
+  // A fresh NORMAL guard permits: the reference is acquired and followed, full power.
+  ASSERT_EQ(arflex_host_bind(&robot_, "safety", guard_.name(), kCall), 0);
+  ASSERT_TRUE(WaitFor([&] { return HoldCause() == ARFLEX_HOLD_NONE; }));
+  AcquireAtHome(&js_port);
   EXPECT_TRUE(power_is(1.0)) << "got " << pw.value;
-  guard(0.1);
+  guard_.Set(ARFLEX_SAFETY_STATE_MODE_LIMITED, 0.25);
+  EXPECT_TRUE(power_is(0.25)) << "got " << pw.value;
+  guard_.Set(ARFLEX_SAFETY_STATE_MODE_NORMAL, std::nan(""));
+  ASSERT_TRUE(WaitFor([&] { return HoldDetail() == ARFLEX_SAFETY_INVALID; }))
+      << "a non-finite power scale is rejected";
+  // a guard that says nonsense is as good as none: reset latched, refused while it persists
+  ASSERT_TRUE(WaitFor([&] {
+    return (arflex_ctl_flags(robot_.ctl) & ARFLEX_FLAG_RESET_REQUIRED) != 0;
+  }));
+  EXPECT_EQ(arflex_host_reset(&robot_, kCall), -EBUSY);
+  guard_.Set(ARFLEX_SAFETY_STATE_MODE_NORMAL, 1.0);
+  ASSERT_TRUE(WaitFor([&] { return HoldCause() == ARFLEX_HOLD_NONE; }));
+  EXPECT_EQ(arflex_host_reset(&robot_, kCall), 0);
+  ASSERT_TRUE(WaitFor([&] {
+    return (arflex_ctl_flags(robot_.ctl) & ARFLEX_FLAG_SAFE_ACTIVE) == 0;
+  }));
+  // a protective stop of the guard holds with the guard's reduced power, without a latch
+  guard_.Set(ARFLEX_SAFETY_STATE_MODE_PROTECTIVE_STOP, 0.1);
   EXPECT_TRUE(power_is(0.1)) << "got " << pw.value;
-  ASSERT_EQ(arflex_host_unbind(&robot_, "safety", kCall), 0);
-  EXPECT_TRUE(power_is(1.0)) << "unbound again: full power, got " << pw.value;
+  EXPECT_EQ(HoldDetail(), static_cast<uint32_t>(ARFLEX_SAFETY_STOP));
+  guard_.Set(ARFLEX_SAFETY_STATE_MODE_NORMAL, 1.0);
+  EXPECT_TRUE(power_is(1.0)) << "got " << pw.value;
+  ASSERT_TRUE(WaitFor([&] { return HoldCause() == ARFLEX_HOLD_NONE; }));
+  // Moving, the guard dies (stops writing; its segment still reads NORMAL, power 1): stale
+  // within 1.5 x 20 ms, the arm stops where it is and a reset is latched.
+  const double far[6] = {0.6, 0.5, 0.3, 0.0, 0.8, 0.0};
+  AcquireAtHome(&js_port);  // after a hold the reference must meet the arm again (D9)
+  WriteReference(far);
+  ASSERT_TRUE(WaitFor([&] { return Latest(&js_port, &js, &hj) && js.q[0] > 0.03; }));
+  guard_.Silence(true);
+  const uint64_t dead = Now();
+  ASSERT_TRUE(WaitFor([&] { return HoldDetail() == ARFLEX_SAFETY_STALE; }));
+  EXPECT_LT(Now() - dead, 200 * kMs) << "stale detected late";
+  ASSERT_TRUE(WaitFor([&] {
+    return (arflex_ctl_flags(robot_.ctl) & ARFLEX_FLAG_RESET_REQUIRED) != 0;
+  }));
+  ASSERT_TRUE(WaitFor([&] {
+    if (!Latest(&js_port, &js, &hj)) return false;
+    for (int i = 0; i < 6; ++i)
+      if (std::fabs(js.qd[i]) > 1e-3) return false;
+    return true;
+  })) << "the arm did not stop";
+  const double q_hold = js.q[0];
+  EXPECT_LT(q_hold, 0.5) << "went on to the target unguarded";
+  EXPECT_EQ(arflex_host_reset(&robot_, kCall), -EBUSY) << "reset while the guard is silent";
+  // The guard is back: the cause is gone, the reset is accepted, and the arm waits for a
+  // reference that meets it (D9) instead of resuming the old one on its own.
+  guard_.Silence(false);
+  ASSERT_TRUE(WaitFor([&] { return HoldCause() == ARFLEX_HOLD_NONE; }));
+  EXPECT_NE(arflex_ctl_flags(robot_.ctl) & ARFLEX_FLAG_RESET_REQUIRED, 0u) << "left without reset";
+  EXPECT_EQ(arflex_host_reset(&robot_, kCall), 0);
+  ASSERT_TRUE(WaitFor([&] {
+    return (arflex_ctl_flags(robot_.ctl) & ARFLEX_FLAG_SAFE_ACTIVE) == 0;
+  }));
+  const uint64_t s0 = js.seq;
+  ASSERT_TRUE(WaitFor([&] { return Latest(&js_port, &js, &hj) && js.seq > s0 + 300; }));
+  EXPECT_NEAR(js.q[0], q_hold, 2e-3) << "resumed the old reference after the reset";
   EXPECT_EQ(arflex_host_stop(&robot_, kCall), 0);
   arflex_port_close(&pw_port);
+  arflex_port_close(&js_port);
   Shutdown(&robot_);
-  EXPECT_EQ(arflex_port_destroy(&feed), 0);
 }
 
 TEST_F(SimComponents, RobotLockStepPeriodsEqualPhysicsSteps) {
