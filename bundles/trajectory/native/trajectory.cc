@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "arflex/component.h"
+#include "arflex/safety_gate.h"
 #include "arflex_types/joint_ref.h"
 #include "arflex_types/joint_state.h"
 #include "arflex_types/safety_state.h"
@@ -68,10 +69,17 @@ struct State {
   struct arflex_tool_state tool{};
   bool tool_seen = false;
   int p_program = -1, p_run, p_loop, p_profile, p_speed, p_accel, p_accel_max, p_lin_speed,
-      p_lin_accel, p_stop_time;
+      p_lin_accel, p_stop_time, p_safety_max_age = -1;
   traj::Player player;
-  struct arflex_safety_state safety{};
-  bool safety_seen = false;
+  struct arflex_safety_gate gate{};
+  bool permitted = false;    // the safety input permitted motion since start
+  // Reset permits, it does not start (SAFETY.md 2): after a stop (a protective stop or loss
+  // of the guard that had permitted motion, rt-core safe mode, a restart that needs a reset)
+  // the output holds until a fresh command: a write of `run` (true) or `program` taken after
+  // the stop's causes are gone. cmd_seq is the command slots' applied_seq sum as last seen
+  // while the stop held, so commands sent before the reset are discarded.
+  bool await_command = false;
+  uint64_t cmd_seq = 0;
   uint64_t seq = 0;
   uint64_t tool_seq = 0;
   int64_t playing = 0;  // the program the player plays
@@ -90,6 +98,8 @@ constexpr double kResyncTol = 0.005;  // rad, any joint
 constexpr double kAwayTol = 0.05;        // rad, any joint
 constexpr uint64_t kAwayNs = 1000000000;  // 1 s
 constexpr double kRestSpeed = 1e-3;       // rad/s, every joint: the arm is at rest
+// A safety value older than this (in the trajectory's own cycles for half as long) is stale.
+constexpr uint64_t kSafetyMaxAgeNs = 20000000;  // 20 ms
 
 int Param(struct arflex_component* c, const char* name, int* idx) {
   *idx = arflex_component_param(c, name);
@@ -127,6 +137,7 @@ int Configure(struct arflex_component* c, void*) {
       Param(c, "accel_max", &g.p_accel_max) < 0 || Param(c, "lin_speed", &g.p_lin_speed) < 0 ||
       Param(c, "lin_accel", &g.p_lin_accel) < 0 || Param(c, "stop_time", &g.p_stop_time) < 0)
     return -ENOENT;
+  g.p_safety_max_age = arflex_component_param(c, "safety_max_age_ms");  // optional
 
   g.programs.resize(kMaxPrograms);
   std::string err;
@@ -168,14 +179,33 @@ traj::Limits CurrentLimits(struct arflex_component* c) {
   return l;
 }
 
+// The safety input's freshness limit: the safety_max_age_ms parameter, 20 ms without it.
+uint64_t SafetyMaxAgeNs(struct arflex_component* c) {
+  return g.p_safety_max_age >= 0
+             ? static_cast<uint64_t>(arflex_param_f64(c, g.p_safety_max_age) * 1e6)
+             : kSafetyMaxAgeNs;
+}
+
+// Sum of the applied_seq of the command parameters (run, program): changes with every write.
+uint64_t CommandSeq(struct arflex_component* c) {
+  const struct arflex_ctl* ctl = arflex_component_ctl(c);
+  return __atomic_load_n(&ctl->params[g.p_run].applied_seq, __ATOMIC_ACQUIRE) +
+         __atomic_load_n(&ctl->params[g.p_program].applied_seq, __ATOMIC_ACQUIRE);
+}
+
 int Start(struct arflex_component* c, void*) {
   const int64_t n = arflex_param_i64(c, g.p_program);
   if (n < 0 || n >= kMaxPrograms || g.programs[n].motions.empty()) return -ENOENT;
   const struct arflex_ctl* ctl = arflex_component_ctl(c);
   g.player.Begin(&g.model, &g.programs[n], ctl->config.period_ns * 1e-9);
   g.playing = n;
-  g.safety_seen = false;
   g.tool_seen = false;
+  g.permitted = false;
+  arflex_safety_gate_init(&g.gate, g.in_safety, SafetyMaxAgeNs(c));
+  // A restart of a component that moves hardware comes with a reset to take (the runtime
+  // sets RESET_REQUIRED before the spawn): after it, wait for a fresh command too.
+  g.await_command = (arflex_ctl_flags(ctl) & ARFLEX_FLAG_RESET_REQUIRED) != 0;
+  g.cmd_seq = CommandSeq(c);
   return 0;
 }
 
@@ -237,18 +267,34 @@ int Step(struct arflex_component* c, uint64_t release_ns, bool force_stop) {
     if (arflex_input_bound(g.in_state)) return 0;  // wait for the first measurement
     g.player.Init(g.player.program()->has_start ? g.player.program()->start : Q::Zero());
   }
-  struct arflex_safety_state s;
-  if (arflex_input_bound(g.in_safety)) {
-    if (arflex_input_state_read(g.in_safety, &s, sizeof(s), nullptr) == 1) {
-      g.safety = s;
-      g.safety_seen = true;
+  // The safety input: bound, it must permit (fresh, valid, not stopped). Unbound from the
+  // start the trajectory plays (the robot, which moves the hardware, holds without a guard);
+  // a guard that had permitted motion and is gone stops it like a protective stop.
+  g.gate.max_age_ns = SafetyMaxAgeNs(c);
+  const arflex_safety_verdict verdict = arflex_safety_gate_check(&g.gate, arflex_sys_now_ns());
+  // Before the guard first permitted, a bound one that has not spoken holds (no stop: nothing
+  // moved yet); a stop once it had permitted, or rt-core safe mode, needs the fresh command.
+  const bool permits = arflex_safety_permits(verdict) ||
+                       (verdict == ARFLEX_SAFETY_NO_PROVIDER && !g.permitted);
+  const bool stop_cause = force_stop || !permits;
+  if (force_stop || (g.permitted && !permits)) g.await_command = true;
+  if (arflex_safety_permits(verdict)) g.permitted = true;
+  if (g.await_command) {
+    const uint64_t cmd = CommandSeq(c);
+    if (stop_cause) {
+      g.cmd_seq = cmd;  // commands while the cause holds are discarded
+    } else if (cmd != g.cmd_seq && arflex_param_bool(c, g.p_run)) {
+      g.await_command = false;  // the fresh command after the reset
     }
-  } else {
-    g.safety_seen = false;
   }
-  const bool stopped_on_purpose =
-      force_stop || (arflex_input_bound(g.in_safety) &&
-                     (!g.safety_seen || g.safety.mode == ARFLEX_SAFETY_STATE_MODE_PROTECTIVE_STOP));
+  if (!permits) {
+    arflex_component_hold(c, ARFLEX_HOLD_SAFETY_INPUT, verdict, arflex_input_index(c, g.in_safety));
+  } else if (g.await_command && !force_stop) {
+    arflex_component_hold(c, ARFLEX_HOLD_AWAIT_COMMAND, 0, 0);
+  } else {
+    arflex_component_hold(c, ARFLEX_HOLD_NONE, 0, 0);
+  }
+  const bool stopped_on_purpose = stop_cause || g.await_command;
   // The arm does not follow: measured at rest further than kAwayTol from the output for
   // kAwayNs (its robot has no reference input yet, or holds, or refuses this reference as too
   // far from it). The trajectory comes to the arm: idle, the output moves there and the next
@@ -272,15 +318,10 @@ int Step(struct arflex_component* c, uint64_t release_ns, bool force_stop) {
       g.away_since = 0;
     }
   }
-  // Target time rate: 0 = hold. A bound safety input that has not spoken yet holds too.
+  // Target time rate: 0 = hold (stopped, or waiting for the fresh command).
   double rate = arflex_param_bool(c, g.p_run) ? 1.0 : 0.0;
-  if (force_stop) rate = 0;
-  if (arflex_input_bound(g.in_safety)) {
-    if (!g.safety_seen || g.safety.mode == ARFLEX_SAFETY_STATE_MODE_PROTECTIVE_STOP)
-      rate = 0;
-    else if (g.safety.mode == ARFLEX_SAFETY_STATE_MODE_LIMITED)
-      rate = std::min(rate, std::max(0.0, std::min(1.0, g.safety.power_scale)));
-  }
+  if (stopped_on_purpose) rate = 0;
+  if (verdict == ARFLEX_SAFETY_LIMITED) rate = std::min(rate, arflex_safety_gate_scale(&g.gate));
   // Another program selected while running: taken at the next standstill (between motions,
   // at the end, or paused), from where the arm is. One that was not loaded when the RT half
   // started is refused (-ENOENT, counted by rt-core as an update error) and the current one

@@ -191,7 +191,8 @@ std::vector<struct arflex_param_slot> TrajectoryParams() {
           PB("loop", false, true),             PI("profile", 0, 0, 1, true),
           PD("speed", 1, 0.01, 1, true),       PD("accel", 3, 0.1, 50, true),
           PD("accel_max", 20, 0.1, 200, true), PD("lin_speed", 0.25, 0.001, 2, true),
-          PD("lin_accel", 1, 0.01, 10, true),  PD("stop_time", 0.3, 0.001, 5, true)};
+          PD("lin_accel", 1, 0.01, 10, true),  PD("stop_time", 0.3, 0.001, 5, true),
+          PD("safety_max_age_ms", 20, 2, 1000, true)};
 }
 
 std::string MakeDataDir() {
@@ -600,6 +601,9 @@ void CaseForceGuard() {
   r = Make(&traj, "trajectory", kMs, {{"joint_ref", kRefT}, {"tool_id", kSampleT}}, TrajectoryParams(), "trajectory");
   CHECK(r == 0, "trajectory: %d", r);
   CHECK(SetI(&traj, "loop", 1) == 0, "loop");
+  // the guard writes every 20 ms here: fresh means younger than 100 ms
+  CHECK(arflex_host_set_param(&traj, "safety_max_age_ms", arflex_f64_bits(100), nullptr, kCall) == 0,
+        "safety_max_age_ms");
   Q q;
   q << 0.1, 0.2, 0.5, 0.1, 0.6, 0.2;
   WriteRobot(&script, m, q, Q::Zero(), Eigen::Vector3d::Zero(), &wseq);
@@ -686,6 +690,34 @@ void CaseForceGuard() {
   }
   CHECK(normal, "reset parameter edge did not leave safe mode");
   CHECK(arflex_host_set_param(&guard, "reset", 0, nullptr, kCall) == 0, "reset=0");
+  // 4b. The reset permits, it does not start (SAFETY.md 2): the trajectory waits for a fresh
+  //     command, with its hold word saying so; a `run` written after the reset resumes it.
+  {
+    struct arflex_joint_ref a, b;
+    bool have = false;
+    uint64_t since = 0;
+    const uint64_t d3 = Now() + kWait;
+    while (Now() < d3) {
+      if (tr.Read(&b, &tseq) != 1) continue;
+      if (!have) {
+        a = b;
+        have = true;
+        since = tseq;
+      }
+      CHECK(memcmp(a.q, b.q, sizeof(a.q)) == 0, "the trajectory moved after the reset without a command");
+      if (tseq - since >= 500) break;
+    }
+    CHECK(have && tseq - since >= 500, "no trajectory output after the reset");
+    CHECK(((arflex_ctl_hold(traj.ctl) & 0xffu) == ARFLEX_HOLD_AWAIT_COMMAND), "hold word 0x%x",
+          arflex_ctl_hold(traj.ctl));
+    CHECK(arflex_host_set_param(&traj, "run", 1, nullptr, kCall) == 0, "run=1 (the fresh command)");
+    bool resumed = false;
+    const uint64_t d4 = Now() + kWait;
+    while (!resumed && Now() < d4)
+      if (tr.Read(&b, &tseq) == 1) resumed = memcmp(a.q, b.q, sizeof(a.q)) != 0;
+    CHECK(resumed, "the fresh command did not resume the motion");
+    CHECK(arflex_ctl_hold(traj.ctl) == 0, "hold word 0x%x after the command", arflex_ctl_hold(traj.ctl));
+  }
   // 5. An external joint torque (4 kN m on joint 2) trips it too; the RESET command clears it.
   cycles = PushAndCount(&script, &rd, m, q, (Q() << 0, 4000, 0, 0, 0, 0).finished(),
                         Eigen::Vector3d::Zero(), &wseq);
