@@ -2,6 +2,7 @@ package org.arflex.contract;
 
 import static org.junit.jupiter.api.Assertions.assertEquals;
 import static org.junit.jupiter.api.Assertions.assertFalse;
+import static org.junit.jupiter.api.Assertions.assertThrows;
 import static org.junit.jupiter.api.Assertions.assertTrue;
 import static org.junit.jupiter.api.Assertions.fail;
 
@@ -11,8 +12,11 @@ import java.nio.file.Files;
 import java.nio.file.Path;
 import java.util.ArrayList;
 import java.util.List;
+import java.util.Map;
 import java.util.stream.Stream;
+import org.junit.jupiter.api.io.TempDir;
 import org.junit.jupiter.params.ParameterizedTest;
+import org.junit.jupiter.params.provider.Arguments;
 import org.junit.jupiter.params.provider.MethodSource;
 import org.junit.jupiter.api.Test;
 
@@ -46,12 +50,69 @@ class CorpusTest {
         Path xml = RESOURCES.resolve("bad").resolve(file);
         Path exp = RESOURCES.resolve("bad").resolve(file.replace(".xml", ".expected"));
         assertTrue(Files.exists(exp), "missing " + exp);
+        assertRefusedWith(xml, Files.readAllLines(exp, StandardCharsets.UTF_8));
+    }
+
+    /**
+     * Hostile documents too large to keep in bad/ (a text node over 100,000 characters in a
+     * document under 1 MiB), made at test time: each must be refused with a located §2.1
+     * problem, never with an exception escaping the parser (issue 16, finding 7: Woodstox's
+     * unchecked WstxLazyException escaped).
+     */
+    @ParameterizedTest(name = "generated/{0}")
+    @MethodSource("hugeText")
+    void hugeTextIsRefusedWithALocatedProblem(String name, String xml, @TempDir Path dir) throws IOException {
+        assertTrue(xml.getBytes(StandardCharsets.UTF_8).length < ContractParser.MAX_BYTES, "must pass the size cap");
+        Path file = dir.resolve(name + ".xml");
+        Files.writeString(file, xml, StandardCharsets.UTF_8);
+        List<Problem> problems = assertRefusedWith(file, List.of("2.1|(document)|parser limit"));
+        assertTrue(problems.stream().allMatch(p -> p.column() > 0), "problem without a column: " + problems);
+
+        ContractException e = assertThrows(ContractException.class, () -> PARSER.parse(xml, name));
+        assertEquals("2.1", e.problems().get(0).section());
+        List<Problem> validated = PARSER.validate(xml, name);
+        assertFalse(validated.isEmpty());
+        assertTrue(validated.get(0).line() > 0, validated.toString());
+        List<ContractParser.Result> all = PARSER.parseAll(Map.of(name, xml));
+        assertFalse(all.get(0).ok());
+    }
+
+    static Stream<Arguments> hugeText() {
+        String big = "x".repeat(100_000);
+        String spaces = " ".repeat(100_000);
+        return Stream.of(
+                Arguments.of("huge-description", contractWith("<description>" + big + "</description>", "")),
+                Arguments.of("huge-cdata", contractWith("<description><![CDATA[" + big + "]]></description>", "")),
+                Arguments.of("huge-split-text",
+                        contractWith("<description>" + big + "<![CDATA[" + big + "]]>" + big + "</description>", "")),
+                Arguments.of("huge-whitespace", contractWith(spaces, "")),
+                Arguments.of("huge-property-text", contractWith("",
+                        "<properties><property name=\"gain\" type=\"double\" default=\"1\">" + big
+                                + "</property></properties>")));
+    }
+
+    private static String contractWith(String head, String tail) {
+        return "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+                + "<component xmlns=\"urn:arflex:contract:1\" name=\"huge\" version=\"1.0.0\">\n  " + head + "\n"
+                + "  <implementation executable=\"huge\" task=\"periodic\"/>\n"
+                + "  <ports/>\n  " + tail + "\n"
+                + "  <timing period=\"1ms\" deadline=\"1ms\" wcet=\"50us\" priority=\"80\"/>\n"
+                + "  <resources memory=\"8MiB\"/>\n"
+                + "  <criticality>5</criticality>\n"
+                + "  <fault restart=\"permanent\" intensity=\"3\" window=\"10s\" backoff=\"100ms\" safe=\"hold\""
+                + " heartbeatTimeout=\"100ms\"/>\n"
+                + "</component>\n";
+    }
+
+    /** Parses {@code xml} as a file and checks the corpus rules; returns the problems. */
+    private static List<Problem> assertRefusedWith(Path xml, List<String> expected) {
+        String file = xml.getFileName().toString();
         List<ContractParser.Result> r = PARSER.parseFiles(List.of(xml));
         assertFalse(r.get(0).ok(), file + " was accepted");
         List<Problem> problems = r.get(0).problems();
         assertFalse(problems.isEmpty());
         List<String> missing = new ArrayList<>();
-        for (String line : Files.readAllLines(exp, StandardCharsets.UTF_8)) {
+        for (String line : expected) {
             if (line.isBlank()) {
                 continue;
             }
@@ -76,6 +137,7 @@ class CorpusTest {
             }
             assertFalse(p.section().equals("14"), "the Java validator, not the XSD, must catch this: " + p);
         }
+        return problems;
     }
 
     @ParameterizedTest(name = "good/{0}")

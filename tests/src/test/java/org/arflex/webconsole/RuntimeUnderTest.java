@@ -83,6 +83,11 @@ final class RuntimeUnderTest implements AutoCloseable {
         Path conf = runtimeDir.resolve("conf/config.properties");
         String props = Files.readString(conf).replaceAll("(?m)^org\\.osgi\\.service\\.http\\.port=.*$",
                 "org.osgi.service.http.port=" + port);
+        // stage-url reads file: URLs only from configured folders: those of the sample bundles
+        String stageDirs = String.join(",", Stream.of("counter", "scaler")
+                .map(w -> System.getProperty("arflex.sample." + w)).filter(v -> v != null && !v.isBlank())
+                .map(v -> Path.of(v).toAbsolutePath().normalize().getParent().toString()).distinct().toList());
+        props += "\narflex.console.stage.dirs=" + stageDirs + "\n";
         Files.writeString(conf, props);
         byte[] pw = new byte[18];
         new SecureRandom().nextBytes(pw);

@@ -88,12 +88,19 @@ public final class Binder {
             return mapper.readerFor(type).withAttribute(PROBLEMS, problems).withAttribute(SOURCE, source)
                     .readValue(data);
         } catch (JsonMappingException e) {
+            if (XmlFailure.fromParser(e)) {
+                // data binding wrapped a parser failure: report it as the parser's (§2.1)
+                problems.add(XmlFailure.problem(e, source, null));
+                return null;
+            }
             JsonLocation loc = e.getLocation();
             problems.add(new Problem(source, loc == null ? 0 : loc.getLineNr(), loc == null ? 0 : loc.getColumnNr(),
                     "2.4", path(e), "cannot bind: " + e.getOriginalMessage()));
             return null;
-        } catch (IOException e) {
-            problems.add(new Problem(source, 0, 0, "2.1", "(document)", SecureXml.describe(e)));
+        } catch (IOException | RuntimeException e) {
+            // RuntimeException: Woodstox's unchecked WstxLazyException (an error found while
+            // text is read lazily) and limits' IllegalArgumentException (issue 16)
+            problems.add(XmlFailure.problem(e, source, null));
             return null;
         }
     }
@@ -175,6 +182,14 @@ public final class Binder {
                 p.skipChildren();
             } else {
                 String s = p.getValueAsString();
+                if (s != null && s.length() > SecureXml.MAX_TEXT_LENGTH) {
+                    // Woodstox enforces its text limit only when it grows a buffer, so a text
+                    // read into a large recycled buffer passes it: check here too (§2.1)
+                    problems(ctxt).add(new Problem((String) ctxt.getAttribute(SOURCE), loc.getLineNr(),
+                            loc.getColumnNr(), "2.1", "(document)", "document exceeds a parser limit: a text node"
+                                    + " is longer than " + SecureXml.MAX_TEXT_LENGTH + " characters"));
+                    s = "";
+                }
                 t.value = s == null ? "" : s;
             }
             return t;

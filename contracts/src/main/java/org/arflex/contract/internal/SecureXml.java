@@ -159,12 +159,11 @@ public final class SecureXml {
             if (!seenRoot) {
                 problems.add(new Problem(source, 1, 1, "2.3", "(root)", "document has no root element"));
             }
-        } catch (XMLStreamException e) {
-            Location loc = e.getLocation();
-            if (loc == null && r != null) {
-                loc = r.getLocation();
-            }
-            add(problems, source, loc, "2.1", "(document)", describe(e));
+        } catch (XMLStreamException | RuntimeException e) {
+            // RuntimeException: Woodstox reports an error found while reading text lazily (a
+            // text node past the limit) as an unchecked WstxLazyException, and a limit may throw
+            // IllegalArgumentException; all of them are problems of this document (issue 16).
+            problems.add(XmlFailure.problem(e, source, r == null ? null : locationOf(r)));
         } finally {
             if (r != null) {
                 try {
@@ -179,8 +178,12 @@ public final class SecureXml {
 
     /** The parser's message without Woodstox's location prefix (the Problem carries it). */
     public static String describe(Exception e) {
-        String m = e.getMessage() == null ? e.getClass().getSimpleName() : e.getMessage();
-        m = m.replaceFirst("(?s)^ParseError at \\[row,col\\]:\\[\\d+,\\d+\\]\\s*Message:\\s*", "");
+        return describe(e.getMessage() == null ? e.getClass().getSimpleName() : e.getMessage());
+    }
+
+    /** A parser's message {@code m} without Woodstox's location prefix. */
+    static String describe(String message) {
+        String m = message.replaceFirst("(?s)^ParseError at \\[row,col\\]:\\[\\d+,\\d+\\]\\s*Message:\\s*", "");
         int at = m.indexOf("\n at [");
         if (at > 0) {
             m = m.substring(0, at);
@@ -189,6 +192,14 @@ public final class SecureXml {
             m = "document exceeds a parser limit: " + m;
         }
         return "malformed XML: " + m.replace('\n', ' ').trim();
+    }
+
+    private static Location locationOf(XMLStreamReader r) {
+        try {
+            return r.getLocation();
+        } catch (RuntimeException e) {
+            return null;
+        }
     }
 
     private static void add(List<Problem> problems, String source, Location loc, String section, String field,

@@ -22,8 +22,9 @@ import java.util.regex.Pattern;
 
 /**
  * Bringing a component bundle in: from a URL under the DRCR's update rules (https or file only,
- * SHA-256 pinned and checked before anything is installed) or from an upload, into a private
- * staging directory. Every refusal names what is wrong.
+ * SHA-256 pinned and checked before anything is installed; file only inside the configured
+ * {@link StagingSources} folders; no redirect) or from an upload, into a private staging
+ * directory. Every refusal names what is wrong.
  */
 final class Artifacts {
     /** Largest bundle accepted. */
@@ -71,13 +72,24 @@ final class Artifacts {
         return s;
     }
 
-    /** Downloads the URL into staging and checks the pinned hash; the file is removed on any failure. */
-    static Staged fetch(URI u, String pinned, Path stagingDir) throws HttpError, IOException {
+    /**
+     * Downloads the URL into staging and checks the pinned hash; the file is removed on any
+     * failure. A {@code file:} URL must name a file in one of {@code sources}' folders.
+     */
+    static Staged fetch(URI u, String pinned, Path stagingDir, StagingSources sources) throws HttpError, IOException {
         String expected = checkSha(pinned);
-        Path tmp = Files.createTempFile(Files.createDirectories(stagingDir), "fetch-", ".jar");
+        // opened before the staging file is made: a refused source leaves nothing behind
+        InputStream source = open(u, sources);
+        Path tmp;
+        try {
+            tmp = Files.createTempFile(Files.createDirectories(stagingDir), "fetch-", ".jar");
+        } catch (IOException e) {
+            source.close();
+            throw e;
+        }
         boolean ok = false;
         try {
-            try (InputStream in = open(u)) {
+            try (InputStream in = source) {
                 String actual = copyBounded(in, tmp);
                 if (!actual.equals(expected)) {
                     throw new HttpError(400, "sha256: the jar at " + u + " has SHA-256 " + actual
@@ -116,37 +128,37 @@ final class Artifacts {
         return Files.move(s.file(), target, StandardCopyOption.REPLACE_EXISTING);
     }
 
-    private static InputStream open(URI u) throws HttpError, IOException {
-        if (u.getScheme().equalsIgnoreCase("file")) {
-            Path p;
-            try {
-                p = Path.of(u);
-            } catch (IllegalArgumentException e) {
-                throw new HttpError(400, "url: " + e.getMessage());
-            }
-            if (!Files.isRegularFile(p)) {
-                throw new HttpError(400, "url: no such file " + p);
-            }
-            return Files.newInputStream(p);
+    private static InputStream open(URI u, StagingSources sources) throws HttpError, IOException {
+        if ("file".equalsIgnoreCase(u.getScheme())) {
+            return Files.newInputStream(sources.file(u));
         }
-        HttpClient client = HttpClient.newBuilder().connectTimeout(Duration.ofSeconds(10))
-                .followRedirects(HttpClient.Redirect.NORMAL).build();
         try {
-            HttpResponse<InputStream> r = client.send(HttpRequest.newBuilder(u).timeout(Duration.ofSeconds(60)).GET()
-                    .build(), HttpResponse.BodyHandlers.ofInputStream());
+            HttpResponse<InputStream> r = client().send(HttpRequest.newBuilder(u).timeout(Duration.ofSeconds(60))
+                    .GET().build(), HttpResponse.BodyHandlers.ofInputStream());
+            if (r.statusCode() / 100 == 3) {
+                r.body().close();
+                throw new HttpError(400, "url: redirect refused: " + u + " answered HTTP " + r.statusCode()
+                        + " to " + r.headers().firstValue("Location").orElse("(no Location)")
+                        + "; give the final https URL");
+            }
             if (r.statusCode() != 200) {
                 r.body().close();
                 throw new HttpError(502, "url: " + u + " answered HTTP " + r.statusCode());
-            }
-            if (!r.uri().getScheme().equalsIgnoreCase("https")) {
-                r.body().close();
-                throw new HttpError(400, "url: redirected to a non-https URL " + r.uri());
             }
             return r.body();
         } catch (InterruptedException e) {
             Thread.currentThread().interrupt();
             throw new IOException("interrupted while downloading " + u, e);
         }
+    }
+
+    /**
+     * The download client. Redirects are never followed: the pinned URL is the one fetched, and
+     * a redirect is refused by name rather than reported as a hash mismatch of its body.
+     */
+    static HttpClient client() {
+        return HttpClient.newBuilder().connectTimeout(Duration.ofSeconds(10)).followRedirects(HttpClient.Redirect.NEVER)
+                .build();
     }
 
     private static String copyBounded(InputStream in, Path to) throws IOException, HttpError {

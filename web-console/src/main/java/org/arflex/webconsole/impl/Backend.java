@@ -73,6 +73,7 @@ public class Backend {
     /** The bundle's private data area (staging/, installed/); set on activation. */
     Path dataDir;
     private Path contractsDir;
+    private StagingSources stageSources = StagingSources.parse(null);
     Sampler sampler;
 
     @Activate
@@ -83,6 +84,7 @@ public class Backend {
         String home = System.getenv("ARFLEX_HOME");
         this.contractsDir = configured != null ? Path.of(configured)
                 : home != null ? Path.of(home, "contracts") : dataDir.resolve("contracts");
+        this.stageSources = StagingSources.parse(bc.getProperty(StagingSources.PROPERTY));
         this.sampler = new Sampler(this::sample, this::portSample);
         cleanStaging();
     }
@@ -418,7 +420,7 @@ public class Backend {
     /** Stages a bundle from a URL with a pinned hash and returns its plan. */
     Map<String, Object> stageUrl(String url, String sha256) throws HttpError, IOException {
         var u = Artifacts.checkUrl(url, sha256);
-        return planStaged(Artifacts.fetch(u, sha256, dataDir.resolve("staging")));
+        return planStaged(Artifacts.fetch(u, sha256, dataDir.resolve("staging"), stageSources));
     }
 
     /** Stages an uploaded bundle and returns its plan. */

@@ -79,7 +79,7 @@ class ArtifactsTest {
     void aFileUrlWithTheRightPinIsStaged() throws Exception {
         Path jar = bundle("org.example.good");
         Artifacts.Staged s = Artifacts.fetch(Artifacts.checkUrl(jar.toUri().toString(), sha(jar)), sha(jar),
-                dir.resolve("staging"));
+                dir.resolve("staging"), StagingSources.parse(dir.toString()));
         assertEquals("org.example.good", s.symbolicName());
         assertEquals("1.2.3", s.version());
         assertEquals(sha(jar), s.sha256());
@@ -91,7 +91,8 @@ class ArtifactsTest {
         Path jar = bundle("org.example.pinned");
         String wrong = "0".repeat(64);
         HttpError e = assertThrows(HttpError.class, () -> Artifacts.fetch(
-                Artifacts.checkUrl(jar.toUri().toString(), wrong), wrong, dir.resolve("staging")));
+                Artifacts.checkUrl(jar.toUri().toString(), wrong), wrong, dir.resolve("staging"),
+                StagingSources.parse(dir.toString())));
         assertTrue(e.getMessage().contains(sha(jar)) && e.getMessage().contains(wrong), e.getMessage());
         assertEquals(0, staged());
     }
