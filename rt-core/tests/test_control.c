@@ -23,6 +23,7 @@ static void layout_matches_abi_md(void **state)
 	assert_int_equal(offsetof(struct arflex_ctl, pid), 32);
 	assert_int_equal(offsetof(struct arflex_ctl, config.priority), 96);
 	assert_int_equal(offsetof(struct arflex_ctl, config.param_count), 112);
+	assert_int_equal(offsetof(struct arflex_ctl, config.orphan_hold_ns), 120);
 	assert_int_equal(offsetof(struct arflex_ctl, stats.latency), 256 + 64);
 	assert_int_equal(offsetof(struct arflex_ctl, stats.exec), 256 + 16192);
 	assert_int_equal(offsetof(struct arflex_metric, hist), 64);
@@ -216,6 +217,67 @@ static void task_counts_cycles_and_overruns(void **state)
 	assert_int_equal(th_threads(), 1);
 }
 
+#define MS 1000000ull
+
+/* The windowed runtime-heartbeat judgement (issue 15, finding 6), with synthetic times:
+ * period 1 ms, timeout 100 ms. */
+static void heartbeat_judged_over_own_cycles(void **state)
+{
+	struct arflex_hb_window w;
+	uint64_t t = 1000 * MS, hb = t, first_stale = 0;
+
+	(void)state;
+	/* 150 ms of steady cycles without a runtime heartbeat: trips, after the timeout */
+	memset(&w, 0, sizeof(w));
+	for (uint64_t k = 0; k <= 150; k++) {
+		bool stale = arflex_hb_judge(&w, hb, t + k * MS, MS, 100 * MS);
+
+		if (stale && !first_stale)
+			first_stale = k;
+		assert_true(stale == (k > 100));
+	}
+	assert_int_equal(first_stale, 101); /* within timeout + one cycle */
+
+	/* a 150 ms gap of the RT thread itself (the whole machine stalled, the runtime too):
+	 * the same heartbeat before and after the gap does not trip */
+	memset(&w, 0, sizeof(w));
+	t = 2000 * MS;
+	for (uint64_t k = 0; k < 50; k++) {
+		if (k % 25 == 0)
+			hb = t + k * MS; /* the runtime writes every 25 ms */
+		assert_false(arflex_hb_judge(&w, hb, t + k * MS, MS, 100 * MS));
+	}
+	t += 49 * MS;
+	assert_false(arflex_hb_judge(&w, hb, t + 150 * MS, MS, 100 * MS));
+	t += 150 * MS;
+	/* the runtime comes back within its interval: never stale */
+	for (uint64_t k = 1; k <= 20; k++)
+		assert_false(arflex_hb_judge(&w, hb, t + k * MS, MS, 100 * MS));
+	hb = t + 20 * MS;
+	assert_false(arflex_hb_judge(&w, hb, t + 21 * MS, MS, 100 * MS));
+	assert_int_equal(w.silence_ns, 0);
+
+	/* the runtime never comes back after the stall: caught after ~timeout of cycles */
+	memset(&w, 0, sizeof(w));
+	t = 3000 * MS;
+	hb = t;
+	assert_false(arflex_hb_judge(&w, hb, t, MS, 100 * MS));
+	assert_false(arflex_hb_judge(&w, hb, t + 150 * MS, MS, 100 * MS)); /* +2 ms only */
+	t += 150 * MS;
+	first_stale = 0;
+	for (uint64_t k = 1; k <= 120 && !first_stale; k++)
+		if (arflex_hb_judge(&w, hb, t + k * MS, MS, 100 * MS))
+			first_stale = k;
+	assert_int_equal(first_stale, 99);
+
+	/* the first judgement counts the heartbeat's age; timeout 0 never trips */
+	memset(&w, 0, sizeof(w));
+	assert_true(arflex_hb_judge(&w, 5000 * MS, 5200 * MS, MS, 100 * MS));
+	memset(&w, 0, sizeof(w));
+	assert_false(arflex_hb_judge(&w, 5000 * MS, 5200 * MS, MS, 0));
+	th_assert_clean("none");
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -224,6 +286,7 @@ int main(void)
 		cmocka_unit_test(params_protocol),
 		cmocka_unit_test(metric_and_percentiles),
 		cmocka_unit_test(task_counts_cycles_and_overruns),
+		cmocka_unit_test(heartbeat_judged_over_own_cycles),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);

@@ -29,6 +29,17 @@
  * safe mode ends by itself; with it, ARFLEX_FLAG_RESET_REQUIRED is set and safe mode lasts
  * until the operator's RESET command (which fails with -EAGAIN while the heartbeat is stale,
  * and with -EBUSY while the component's hold word names a safety input: the cause persists).
+ * "Older than that" is judged over the RT thread's own cycling time (arflex_hb_judge): each
+ * cycle adds at most two periods to the runtime's silence, so a stall of the whole machine
+ * that delays the RT thread too is not taken for a silent runtime (ABI.md 6).
+ *
+ * Supervisor death (ABI.md 6.2): SIGPIPE is ignored and stdout/stderr pipes are made
+ * non-blocking, so a dead supervisor can neither kill nor block the process. With
+ * ARFLEX_CFG_SUPERVISOR_PIPE a watcher thread reads fd 0; EOF sets
+ * ARFLEX_FLAG_SUPERVISOR_LOST, and the RT thread enters safe mode in that cycle (latching
+ * ARFLEX_FLAG_RESET_REQUIRED for ARFLEX_CFG_MOVES_HARDWARE). After config.orphan_hold_ns the
+ * mailbox thread leaves as on SHUTDOWN (stop, cleanup, EXITED, exit 0) and unlinks the
+ * instance's ctl, queues and output segments: no manager is left to do it.
  *
  * Threads: configure and cleanup run on the main thread; start, update, safe and stop on the
  * RT thread; commands on the mailbox thread. Hooks never run concurrently with each other.

@@ -33,8 +33,9 @@ extern "C" {
 
 /** ABI major: a reader refuses an object whose major differs. */
 #define ARFLEX_ABI_MAJOR 1u
-/** ABI minor: additions only; a reader accepts any minor >= the one it needs. */
-#define ARFLEX_ABI_MINOR 0u
+/** ABI minor: additions only; a reader accepts any minor >= the one it needs.
+ *  1.1: config.orphan_hold_ns, ARFLEX_CFG_SUPERVISOR_PIPE, ARFLEX_FLAG_SUPERVISOR_LOST. */
+#define ARFLEX_ABI_MINOR 1u
 
 /** Magic of the control block: bytes "ARFLXCTL" read as little-endian uint64. */
 #define ARFLEX_CTL_MAGIC UINT64_C(0x4C5443584C465241)
@@ -77,6 +78,7 @@ enum arflex_ctl_flag {
 	ARFLEX_FLAG_RESET_REQUIRED = 1u << 3, /**< motion needs an operator RESET */
 	ARFLEX_FLAG_AFFINITY = 1u << 4,       /**< CPU affinity applied */
 	ARFLEX_FLAG_DMA_LATENCY = 1u << 5,    /**< /dev/cpu_dma_latency held at 0 */
+	ARFLEX_FLAG_SUPERVISOR_LOST = 1u << 6, /**< supervisor pipe (fd 0) reached EOF: orphaned */
 };
 
 /** Bits of config.cfg_flags (manager, before spawn). */
@@ -84,6 +86,9 @@ enum arflex_cfg_flag {
 	ARFLEX_CFG_MOVES_HARDWARE = 1u << 0, /**< leaving safe mode needs an operator RESET */
 	ARFLEX_CFG_NO_MLOCK = 1u << 1,       /**< do not call mlockall (tests, many instances) */
 	ARFLEX_CFG_NO_DMA_LATENCY = 1u << 2, /**< do not hold /dev/cpu_dma_latency */
+	/** fd 0 of the RT process is a pipe whose write end the supervisor holds for the life of
+	 *  the process: EOF on it means the supervisor is gone (ABI.md 6.2). */
+	ARFLEX_CFG_SUPERVISOR_PIPE = 1u << 3,
 };
 
 /** Safe-output mode, config.safe_mode; passed to the component's safe hook. */
@@ -213,7 +218,8 @@ struct arflex_ctl_config {
 	uint32_t cfg_flags;       /**< enum arflex_cfg_flag */
 	uint32_t param_count;     /**< slots in use (the first param_count slots) */
 	uint32_t reserved0;
-	uint64_t reserved[1];
+	uint64_t orphan_hold_ns;  /**< after the supervisor is lost: hold safe outputs this long,
+				   *   then exit and unlink (ABI.md 6.2); 0 = after one safe cycle */
 };
 
 /* ---- the control block -------------------------------------------------------------- */
@@ -253,6 +259,7 @@ ARFLEX_STATIC_ASSERT(sizeof(struct arflex_metric) == 16128, "metric size");
 ARFLEX_STATIC_ASSERT(sizeof(struct arflex_stats) == 32320, "stats size");
 ARFLEX_STATIC_ASSERT(sizeof(struct arflex_param_slot) == 128, "param slot size");
 ARFLEX_STATIC_ASSERT(sizeof(struct arflex_ctl_config) == 64, "config size");
+ARFLEX_STATIC_ASSERT(offsetof(struct arflex_ctl_config, orphan_hold_ns) == 56, "orphan_hold");
 ARFLEX_STATIC_ASSERT(offsetof(struct arflex_ctl, state) == 24, "ctl.state");
 ARFLEX_STATIC_ASSERT(offsetof(struct arflex_ctl, runtime_hb_ns) == 40, "ctl.runtime_hb");
 ARFLEX_STATIC_ASSERT(offsetof(struct arflex_ctl, rt_hb_ns) == 48, "ctl.rt_hb");
@@ -328,6 +335,28 @@ ARFLEX_API int arflex_ctl_stats_read(const struct arflex_ctl *ctl, struct arflex
 /** Percentile @p (0 < p < 100, e.g. 99.9) of a metric from its histogram, in ns (upper edge of
  *  the bin; the max for the overflow bin). Returns 0 when empty. */
 ARFLEX_API uint64_t arflex_metric_percentile(const struct arflex_metric *m, double p);
+
+/**
+ * Windowed judgement of the runtime heartbeat (ABI.md 6.1), the state of one RT thread.
+ * Zero it before the first cycle of a run.
+ */
+struct arflex_hb_window {
+	uint64_t last_hb;    /**< runtime_hb_ns seen at the previous judgement */
+	uint64_t last_now;   /**< time of the previous judgement; 0 = none yet */
+	uint64_t silence_ns; /**< cycling time of the RT thread since runtime_hb_ns last changed */
+};
+
+/**
+ * One judgement per cycle of the RT thread at time @now, the runtime heartbeat reading @hb:
+ * returns true when the runtime is silent beyond @timeout_ns (0: never). Silence is counted
+ * only over time the RT thread itself was cycling: each step adds at most 2 * @period_ns, so a
+ * stall of the whole machine (the RT thread late too) does not count as the runtime's
+ * silence, while a runtime that stops writing is caught after @timeout_ns of cycles (plus a
+ * period). A changed @hb resets the silence. The first judgement counts the age of @hb
+ * (now - hb) as silence. Pure: no shared memory, no clock; RT safe.
+ */
+ARFLEX_API bool arflex_hb_judge(struct arflex_hb_window *w, uint64_t hb, uint64_t now,
+				uint64_t period_ns, uint64_t timeout_ns);
 
 /** Atomic accessors for the shared words (acquire loads, release stores). */
 ARFLEX_API uint32_t arflex_ctl_state(const struct arflex_ctl *ctl);

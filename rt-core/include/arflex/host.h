@@ -56,6 +56,20 @@ struct arflex_host {
 	int exit_status;    /**< wait status once reaped */
 	bool reaped;
 	uint32_t seq;
+	int sup_fd;         /**< write end of the child's stdin (supervisor pipe) */
+	bool sup_open;
+	int out_fd;         /**< read end of the child's stdout/stderr (output pipe) */
+	bool out_open;
+};
+
+/** Flags of arflex_host_spawn_ex(). */
+enum arflex_host_spawn_flag {
+	/** The child's stdin is a pipe whose write end the host holds until the child was
+	 *  reaped (or arflex_host_drop_supervisor); ARFLEX_CFG_SUPERVISOR_PIPE is set in the
+	 *  control block, so the RT half takes EOF as the death of its supervisor. */
+	ARFLEX_HOST_SUPERVISOR_PIPE = 1u << 0,
+	/** The child's stdout and stderr go to a pipe the host reads (arflex_host_output_fd). */
+	ARFLEX_HOST_OUTPUT_PIPE = 1u << 1,
 };
 
 /** Creates every object of the instance. Returns 0 or -errno (-EINVAL: bad ids, config or
@@ -71,6 +85,19 @@ ARFLEX_API void arflex_host_destroy(struct arflex_host *h);
  *  environment). Writes a fresh runtime heartbeat first. Returns 0 or -errno. */
 ARFLEX_API int arflex_host_spawn(struct arflex_host *h, const char *exe,
 				 char *const extra[], char *const envp[]);
+
+/** As arflex_host_spawn(), with enum arflex_host_spawn_flag @flags. Returns 0 or -errno. */
+ARFLEX_API int arflex_host_spawn_ex(struct arflex_host *h, const char *exe, char *const extra[],
+				    char *const envp[], unsigned flags);
+
+/** Closes the host's end of the supervisor pipe: to the RT half, as if its supervisor died. */
+ARFLEX_API void arflex_host_drop_supervisor(struct arflex_host *h);
+
+/** Read end of the child's output pipe (ARFLEX_HOST_OUTPUT_PIPE), or -1. */
+ARFLEX_API int arflex_host_output_fd(const struct arflex_host *h);
+
+/** Closes the read end of the child's output pipe (the child's writes then fail: EPIPE). */
+ARFLEX_API void arflex_host_close_output(struct arflex_host *h);
 
 /** Waits until the RT half's state word equals @state or the child exits or @timeout_ns
  *  passes. Returns 0, -ECHILD (child exited; see arflex_host_exit_status), -ETIMEDOUT. */

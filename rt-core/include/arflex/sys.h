@@ -93,6 +93,13 @@ ARFLEX_API int arflex_sys_ftruncate(int fd, off_t len);
 ARFLEX_API int arflex_sys_fstat(int fd, struct stat *st);
 /** write() of the whole buffer (loops on short writes). Returns 0 or -errno. */
 ARFLEX_API int arflex_sys_write_all(int fd, const void *buf, size_t len);
+/** read(); retries EINTR. Returns the byte count (0 at EOF) or -errno. */
+ARFLEX_API long arflex_sys_read(int fd, void *buf, size_t len);
+/** pipe2(O_CLOEXEC): @fds[0] the read end, @fds[1] the write end. Returns 0 or -errno. */
+ARFLEX_API int arflex_sys_pipe(int fds[2]);
+/** Sets O_NONBLOCK on @fd when it is a pipe or FIFO (never on a TTY or a file). Returns 1 if
+ *  set, 0 if @fd is not a pipe, or -errno (never faulted). */
+ARFLEX_API int arflex_sys_nonblock_pipe(int fd);
 /** mmap(). Stores the mapping in *@out. Returns 0 or -errno. */
 ARFLEX_API int arflex_sys_mmap(void **out, size_t len, int prot, int flags, int fd, off_t off);
 /** munmap(). Returns 0 or -errno (never faulted). */
@@ -139,6 +146,10 @@ ARFLEX_API int arflex_sys_set_affinity(uint64_t mask);
  *  the pid in *@pid, or -errno. */
 ARFLEX_API int arflex_sys_spawn(pid_t *pid, const char *path, char *const argv[],
 				char *const envp[]);
+/** As arflex_sys_spawn(), with the child's fd i (0 stdin, 1 stdout, 2 stderr) duplicated from
+ *  @fds[i] when @fds[i] >= 0 (inherited otherwise). */
+ARFLEX_API int arflex_sys_spawn_io(pid_t *pid, const char *path, char *const argv[],
+				   char *const envp[], const int fds[3]);
 /** kill(). Returns 0 or -errno (never faulted). */
 ARFLEX_API int arflex_sys_kill(pid_t pid, int sig);
 /** waitpid(); retries EINTR. Returns the pid, 0 (WNOHANG, still running) or -errno (never

@@ -18,6 +18,9 @@
 #define XCHG(p, v) __atomic_exchange_n((p), (v), __ATOMIC_ACQ_REL)
 
 #define POLL_NS 100000000u          /* mailbox thread wakes at least every 100 ms */
+#define ORPHAN_POLL_NS 10000000u    /* ... every 10 ms once the supervisor is lost */
+#define ORPHAN_SAFE_WAIT_NS 1000000000u /* after the hold: wait this long at most for the
+					 * RT thread's first safe cycle of the orphan */
 #define APPLY_WAIT_NS 1000000000u   /* SET_PARAM/BIND wait for the cycle boundary */
 
 struct arflex_input {
@@ -47,6 +50,15 @@ struct arflex_component {
 	bool configuring;
 	bool safe;                    /* RT thread */
 	bool safe_first;
+	bool lost_seen;               /* RT thread: this cycle saw SUPERVISOR_LOST */
+	bool orphan_safe;             /* RT -> mailbox: a safe cycle ran after the loss */
+	bool hb_stale;                /* RT -> mailbox: the windowed heartbeat judgement */
+	struct arflex_hb_window hbw;  /* RT thread */
+	uint64_t lost_ns;             /* watcher -> mailbox: when the supervisor was lost */
+	bool lost_noticed;            /* mailbox thread */
+	bool orphaned;                /* mailbox thread: left the loop as an orphan */
+	pthread_t watcher;
+	bool watching;                /* main thread: the watcher runs */
 	struct arflex_port outputs[ARFLEX_MAX_OUTPUTS];
 	char output_names[ARFLEX_MAX_OUTPUTS][ARFLEX_NAME_SIZE];
 	unsigned noutputs;
@@ -67,16 +79,26 @@ static void logf_(const struct arflex_component *c, const char *fmt, ...)
 	__attribute__((format(printf, 2, 3)));
 
 #include <stdarg.h>
+/* One line, one write: stderr may be a non-blocking pipe (a line is dropped, never split or
+ * waited for) or a pipe nobody reads any more (EPIPE, SIGPIPE is ignored). */
 static void logf_(const struct arflex_component *c, const char *fmt, ...)
 {
+	char line[512];
 	va_list ap;
+	int n;
 
-	fprintf(stderr, "arflex: %s[%s.%s]: ", c->name, c->rid[0] ? c->rid : "?",
-		c->inst[0] ? c->inst : "?");
+	n = snprintf(line, sizeof(line), "arflex: %s[%s.%s]: ", c->name, c->rid[0] ? c->rid : "?",
+		     c->inst[0] ? c->inst : "?");
+	if (n < 0 || (size_t)n >= sizeof(line) - 1)
+		n = 0;
 	va_start(ap, fmt);
-	vfprintf(stderr, fmt, ap);
+	vsnprintf(line + n, sizeof(line) - 1 - (size_t)n, fmt, ap);
 	va_end(ap);
-	fputc('\n', stderr);
+	n = (int)strlen(line);
+	line[n++] = '\n';
+	fwrite(line, 1, (size_t)n, stderr);
+	fflush(stderr);
+	clearerr(stderr);
 }
 
 /* ---- accessors ------------------------------------------------------------------------ */
@@ -291,16 +313,18 @@ static void take_bindings(struct arflex_component *c)
 	}
 }
 
+/* Safe mode when the runtime heartbeat is stale (judged over the RT thread's own cycling time,
+ * arflex_hb_judge) or the supervisor is lost (the watcher saw EOF on fd 0): within one cycle. */
 static void check_heartbeat(struct arflex_component *c, uint64_t now)
 {
 	struct arflex_ctl *ctl = c->ctl;
-	uint64_t timeout = ctl->config.hb_timeout_ns, hb;
-	bool stale = false, want;
+	bool stale, want;
 
-	if (timeout) {
-		hb = LOAD(&ctl->runtime_hb_ns);
-		stale = now > hb && now - hb > timeout;
-	}
+	stale = arflex_hb_judge(&c->hbw, LOAD(&ctl->runtime_hb_ns), now, ctl->config.period_ns,
+				ctl->config.hb_timeout_ns);
+	STORE(&c->hb_stale, stale);
+	c->lost_seen = (LOAD(&ctl->flags) & ARFLEX_FLAG_SUPERVISOR_LOST) != 0;
+	stale = stale || c->lost_seen;
 	if (stale && (ctl->config.cfg_flags & ARFLEX_CFG_MOVES_HARDWARE) &&
 	    !(LOAD(&ctl->flags) & ARFLEX_FLAG_RESET_REQUIRED))
 		__atomic_or_fetch(&ctl->flags, ARFLEX_FLAG_RESET_REQUIRED, __ATOMIC_RELEASE);
@@ -342,6 +366,8 @@ static int rt_cycle(void *arg, uint64_t release_ns)
 						c->safe_first)
 				 : 0;
 		c->safe_first = false;
+		if (c->lost_seen)
+			STORE(&c->orphan_safe, true);
 		STORE(&ctl->stats.seq, seq + 1);
 		__atomic_thread_fence(__ATOMIC_RELEASE);
 		ctl->stats.safe_cycles++;
@@ -357,6 +383,7 @@ static int rt_start(void *arg)
 	struct arflex_component *c = arg;
 
 	c->safe = false;
+	memset(&c->hbw, 0, sizeof(c->hbw));
 	take_bindings(c);
 	check_heartbeat(c, arflex_sys_now_ns());
 	return c->ops->start ? c->ops->start(c, c->ops->user) : 0;
@@ -620,8 +647,14 @@ static bool serve(struct arflex_component *c, struct arflex_msg *m)
 	case ARFLEX_CMD_RESET: {
 		uint64_t t = c->ctl->config.hb_timeout_ns, hb = LOAD(&c->ctl->runtime_hb_ns);
 		uint64_t now = arflex_sys_now_ns();
+		bool stale = t && now > hb && now - hb > t;
 
-		if (t && now > hb && now - hb > t) {
+		/* While running, the heartbeat is judged as the RT thread does (over its own
+		 * cycling time): an old heartbeat after a stall of the whole machine does not
+		 * refuse a reset; a heartbeat fresh right now always allows it. */
+		if (stale && c->running)
+			stale = LOAD(&c->hb_stale);
+		if (stale || (arflex_ctl_flags(c->ctl) & ARFLEX_FLAG_SUPERVISOR_LOST)) {
 			st = -EAGAIN;
 		} else if ((LOAD(&c->ctl->hold) & 0xffu) == ARFLEX_HOLD_SAFETY_INPUT) {
 			st = -EBUSY; /* the cause persists: a safety input does not permit motion */
@@ -660,6 +693,36 @@ static bool serve(struct arflex_component *c, struct arflex_msg *m)
 	return quit;
 }
 
+/* The orphan policy (ABI.md 6.2): once the watcher saw the supervisor go, safe mode holds
+ * (the RT thread enters it within a cycle; when not running the flags say so too) for
+ * config.orphan_hold_ns from the loss, and at least one safe cycle has run if running; then
+ * true: the half leaves as on SHUTDOWN and removes its own objects. */
+static bool orphan_done(struct arflex_component *c)
+{
+	struct arflex_ctl *ctl = c->ctl;
+	uint64_t lost = LOAD(&c->lost_ns), hold = ctl->config.orphan_hold_ns, now;
+
+	if (!lost)
+		return false;
+	if (!c->lost_noticed) {
+		c->lost_noticed = true;
+		logf_(c, "supervisor lost (EOF on its pipe): safe mode, holding %llu ms, then "
+		      "exiting and removing my objects", (unsigned long long)(hold / 1000000u));
+	}
+	if (!c->running) {
+		if (ctl->config.cfg_flags & ARFLEX_CFG_MOVES_HARDWARE)
+			__atomic_or_fetch(&ctl->flags, ARFLEX_FLAG_RESET_REQUIRED,
+					  __ATOMIC_RELEASE);
+		__atomic_or_fetch(&ctl->flags, ARFLEX_FLAG_SAFE_ACTIVE, __ATOMIC_RELEASE);
+	}
+	now = arflex_sys_now_ns();
+	if (now - lost < hold)
+		return false;
+	if (c->running && !LOAD(&c->orphan_safe) && now - lost < hold + ORPHAN_SAFE_WAIT_NS)
+		return false;
+	return true;
+}
+
 static void serve_loop(struct arflex_component *c)
 {
 	struct arflex_msg m;
@@ -667,10 +730,14 @@ static void serve_loop(struct arflex_component *c)
 	while (!got_signal) {
 		int r;
 
+		if (orphan_done(c)) {
+			c->orphaned = true;
+			break;
+		}
 		arflex_task_report(&c->task, stderr);
 		if (!c->running)
 			arflex_ctl_param_apply_all(c->ctl, false);
-		r = arflex_mailbox_recv(&c->mb, &m, POLL_NS);
+		r = arflex_mailbox_recv(&c->mb, &m, LOAD(&c->lost_ns) ? ORPHAN_POLL_NS : POLL_NS);
 		if (r == -ETIMEDOUT)
 			continue;
 		if (r == -EPROTO) {
@@ -752,6 +819,65 @@ static int parse_args(struct arflex_component *c, int argc, char **argv)
 	return 0;
 }
 
+/* The supervisor-pipe watcher (ARFLEX_CFG_SUPERVISOR_PIPE): blocks in read() on fd 0; EOF or
+ * an error means the supervisor is gone. Not the RT thread; it only sets two words. */
+static void *watch_supervisor(void *arg)
+{
+	struct arflex_component *c = arg;
+	char buf[64];
+	long n;
+
+	do {
+		n = arflex_sys_read(0, buf, sizeof(buf)); /* data is ignored */
+	} while (n > 0);
+	STORE(&c->lost_ns, arflex_sys_now_ns());
+	__atomic_or_fetch(&c->ctl->flags, ARFLEX_FLAG_SUPERVISOR_LOST, __ATOMIC_RELEASE);
+	return NULL;
+}
+
+static int start_watcher(struct arflex_component *c)
+{
+	sigset_t all, old;
+	int r;
+
+	sigemptyset(&all);
+	sigaddset(&all, SIGTERM);
+	sigaddset(&all, SIGINT);
+	pthread_sigmask(SIG_BLOCK, &all, &old);
+	r = arflex_sys_thread_create(&c->watcher, NULL, watch_supervisor, c);
+	pthread_sigmask(SIG_SETMASK, &old, NULL);
+	c->watching = !r;
+	return r;
+}
+
+/* Before the control block is unmapped: the watcher must not write to it any more. It is
+ * blocked in read() (a cancellation point) or about to return. */
+static void stop_watcher(struct arflex_component *c)
+{
+	if (!c->watching)
+		return;
+	pthread_cancel(c->watcher);
+	arflex_sys_thread_join(c->watcher, NULL);
+	c->watching = false;
+}
+
+/* No manager is left to remove the objects of an orphan (ABI.md 2, DECISIONS.md D10). */
+static void unlink_own(struct arflex_component *c, unsigned noutputs)
+{
+	char name[ARFLEX_OBJ_NAME_SIZE], chan[ARFLEX_NAME_SIZE + 8];
+
+	for (unsigned i = 0; i < noutputs; i++) {
+		snprintf(chan, sizeof(chan), "out.%s", c->output_names[i]);
+		if (!arflex_ctl_obj_name(name, sizeof(name), c->rid, c->inst, chan))
+			arflex_sys_shm_unlink(name);
+	}
+	if (!arflex_ctl_obj_name(name, sizeof(name), c->rid, c->inst, "cmd"))
+		arflex_sys_mq_unlink(name);
+	if (!arflex_ctl_obj_name(name, sizeof(name), c->rid, c->inst, "rsp"))
+		arflex_sys_mq_unlink(name);
+	arflex_sys_shm_unlink(c->ctl_name);
+}
+
 static int attach_ctl(struct arflex_component *c)
 {
 	struct stat st;
@@ -807,6 +933,7 @@ int arflex_component_main(int argc, char **argv, const struct arflex_component_o
 	struct arflex_component *c = &comp;
 	struct arflex_task_opts to;
 	struct sigaction sa;
+	unsigned noutputs;
 	int r, code = ARFLEX_EXIT_OK;
 
 	memset(c, 0, sizeof(*c));
@@ -826,6 +953,11 @@ int arflex_component_main(int argc, char **argv, const struct arflex_component_o
 	sigemptyset(&sa.sa_mask);
 	sigaction(SIGTERM, &sa, NULL);
 	sigaction(SIGINT, &sa, NULL);
+	/* the supervisor's death must never kill us: no SIGPIPE, logging never blocks */
+	sa.sa_handler = SIG_IGN;
+	sigaction(SIGPIPE, &sa, NULL);
+	arflex_sys_nonblock_pipe(1);
+	arflex_sys_nonblock_pipe(2);
 
 	r = attach_ctl(c);
 	if (r) {
@@ -847,6 +979,14 @@ int arflex_component_main(int argc, char **argv, const struct arflex_component_o
 		      strerror(-r));
 		code = ARFLEX_EXIT_ATTACH;
 		goto out_failed;
+	}
+	if (c->ctl->config.cfg_flags & ARFLEX_CFG_SUPERVISOR_PIPE) {
+		r = start_watcher(c);
+		if (r) {
+			logf_(c, "cannot start the supervisor-pipe watcher: %s", strerror(-r));
+			code = ARFLEX_EXIT_ATTACH;
+			goto out_mailbox;
+		}
 	}
 
 	memset(&to, 0, sizeof(to));
@@ -889,11 +1029,15 @@ int arflex_component_main(int argc, char **argv, const struct arflex_component_o
 		do_stop(c);
 	if (ops->cleanup)
 		ops->cleanup(c, ops->user);
+	noutputs = c->noutputs;
 	close_ports(c);
 	arflex_task_report(&c->task, stderr);
 	arflex_task_deinit(&c->task);
 	arflex_mailbox_deinit(&c->mb);
 	STORE(&c->ctl->state, ARFLEX_STATE_EXITED);
+	stop_watcher(c);
+	if (c->orphaned)
+		unlink_own(c, noutputs);
 	arflex_sys_munmap(c->ctl, ARFLEX_CTL_SIZE);
 	return ARFLEX_EXIT_OK;
 
@@ -905,6 +1049,7 @@ out_mailbox:
 out_failed:
 	STORE(&c->ctl->exit_status, r < 0 ? r : -EINVAL);
 	STORE(&c->ctl->state, ARFLEX_STATE_FAILED);
+	stop_watcher(c);
 	arflex_sys_munmap(c->ctl, ARFLEX_CTL_SIZE);
 	return code;
 }

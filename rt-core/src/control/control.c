@@ -294,3 +294,24 @@ void arflex_ctl_set_runtime_hb(struct arflex_ctl *ctl, uint64_t now_ns)
 {
 	STORE(&ctl->runtime_hb_ns, now_ns);
 }
+
+bool arflex_hb_judge(struct arflex_hb_window *w, uint64_t hb, uint64_t now, uint64_t period_ns,
+		     uint64_t timeout_ns)
+{
+	uint64_t step;
+
+	if (!w->last_now) {
+		w->silence_ns = now > hb ? now - hb : 0;
+	} else if (hb != w->last_hb) {
+		w->silence_ns = 0;
+	} else {
+		/* a late cycle of our own is the machine, not the runtime: bounded step */
+		step = now > w->last_now ? now - w->last_now : 0;
+		if (step > 2 * period_ns)
+			step = 2 * period_ns;
+		w->silence_ns += step;
+	}
+	w->last_hb = hb;
+	w->last_now = now ? now : 1;
+	return timeout_ns && w->silence_ns > timeout_ns;
+}

@@ -160,6 +160,27 @@ int arflex_host_wait_exit(struct arflex_host *h, uint64_t timeout_ns)
 	return 0;
 }
 
+void arflex_host_drop_supervisor(struct arflex_host *h)
+{
+	if (h->sup_open) {
+		arflex_sys_close(h->sup_fd);
+		h->sup_open = false;
+	}
+}
+
+int arflex_host_output_fd(const struct arflex_host *h)
+{
+	return h->out_open ? h->out_fd : -1;
+}
+
+void arflex_host_close_output(struct arflex_host *h)
+{
+	if (h->out_open) {
+		arflex_sys_close(h->out_fd);
+		h->out_open = false;
+	}
+}
+
 void arflex_host_destroy(struct arflex_host *h)
 {
 	if (h->pid && !h->reaped) {
@@ -169,6 +190,9 @@ void arflex_host_destroy(struct arflex_host *h)
 			reap(h, true);
 		}
 	}
+	/* the child is gone: only now may its supervisor pipe close */
+	arflex_host_drop_supervisor(h);
+	arflex_host_close_output(h);
 	for (unsigned i = 0; i < h->noutputs; i++)
 		arflex_port_destroy(&h->outputs[i]);
 	h->noutputs = 0;
@@ -184,6 +208,13 @@ void arflex_host_destroy(struct arflex_host *h)
 int arflex_host_spawn(struct arflex_host *h, const char *exe, char *const extra[],
 		      char *const envp[])
 {
+	return arflex_host_spawn_ex(h, exe, extra, envp, 0);
+}
+
+int arflex_host_spawn_ex(struct arflex_host *h, const char *exe, char *const extra[],
+			 char *const envp[], unsigned flags)
+{
+	int sup[2] = { -1, -1 }, out[2] = { -1, -1 }, fds[3] = { -1, -1, -1 };
 	char *argv[40];
 	unsigned n = 0;
 	int r;
@@ -201,12 +232,56 @@ int arflex_host_spawn(struct arflex_host *h, const char *exe, char *const extra[
 		argv[n++] = extra[i];
 	}
 	argv[n] = NULL;
+	/* a respawn: the pipes of the previous child (reaped) go */
+	arflex_host_drop_supervisor(h);
+	arflex_host_close_output(h);
+	if (flags & ARFLEX_HOST_SUPERVISOR_PIPE) {
+		r = arflex_sys_pipe(sup);
+		if (r)
+			return r;
+		fds[0] = sup[0];
+	}
+	if (flags & ARFLEX_HOST_OUTPUT_PIPE) {
+		r = arflex_sys_pipe(out);
+		if (r)
+			goto out_sup;
+		fds[1] = fds[2] = out[1];
+	}
+	if (flags & ARFLEX_HOST_SUPERVISOR_PIPE)
+		h->ctl->config.cfg_flags |= ARFLEX_CFG_SUPERVISOR_PIPE;
+	else
+		h->ctl->config.cfg_flags &= ~(uint32_t)ARFLEX_CFG_SUPERVISOR_PIPE;
 	arflex_host_heartbeat(h);
 	h->reaped = false;
 	h->exit_status = 0;
-	r = arflex_sys_spawn(&h->pid, exe, argv, envp);
-	if (r)
+	r = arflex_sys_spawn_io(&h->pid, exe, argv, envp, fds);
+	if (r) {
 		h->pid = 0;
+		goto out_out;
+	}
+	/* the child's ends are the child's alone */
+	if (flags & ARFLEX_HOST_SUPERVISOR_PIPE) {
+		arflex_sys_close(sup[0]);
+		h->sup_fd = sup[1];
+		h->sup_open = true;
+	}
+	if (flags & ARFLEX_HOST_OUTPUT_PIPE) {
+		arflex_sys_close(out[1]);
+		h->out_fd = out[0];
+		h->out_open = true;
+	}
+	return 0;
+
+out_out:
+	if (out[0] >= 0) {
+		arflex_sys_close(out[0]);
+		arflex_sys_close(out[1]);
+	}
+out_sup:
+	if (sup[0] >= 0) {
+		arflex_sys_close(sup[0]);
+		arflex_sys_close(sup[1]);
+	}
 	return r;
 }
 

@@ -194,6 +194,43 @@ int arflex_sys_write_all(int fd, const void *buf, size_t len)
 	return 0;
 }
 
+long arflex_sys_read(int fd, void *buf, size_t len)
+{
+	ssize_t n;
+	int r = fault(EIO);
+
+	if (r)
+		return r;
+	do {
+		n = read(fd, buf, len);
+	} while (n < 0 && errno == EINTR);
+	return n < 0 ? -errno : (long)n;
+}
+
+int arflex_sys_pipe(int fds[2])
+{
+	int r = fault(EMFILE);
+
+	if (r)
+		return r;
+	return pipe2(fds, O_CLOEXEC) ? -errno : 0;
+}
+
+int arflex_sys_nonblock_pipe(int fd)
+{
+	struct stat st;
+	int fl;
+
+	if (fstat(fd, &st))
+		return -errno;
+	if (!S_ISFIFO(st.st_mode))
+		return 0;
+	fl = fcntl(fd, F_GETFL);
+	if (fl < 0 || fcntl(fd, F_SETFL, fl | O_NONBLOCK))
+		return -errno;
+	return 1;
+}
+
 int arflex_sys_mmap(void **out, size_t len, int prot, int flags, int fd, off_t off)
 {
 	void *p;
@@ -339,6 +376,26 @@ int arflex_sys_spawn(pid_t *pid, const char *path, char *const argv[], char *con
 	if (r)
 		return r;
 	return -posix_spawn(pid, path, NULL, NULL, argv, envp ? envp : environ);
+}
+
+int arflex_sys_spawn_io(pid_t *pid, const char *path, char *const argv[], char *const envp[],
+			const int fds[3])
+{
+	posix_spawn_file_actions_t fa;
+	int r = fault(EAGAIN);
+
+	if (r)
+		return r;
+	r = posix_spawn_file_actions_init(&fa);
+	if (r)
+		return -r;
+	for (int i = 0; i < 3 && !r; i++)
+		if (fds[i] >= 0)
+			r = posix_spawn_file_actions_adddup2(&fa, fds[i], i);
+	if (!r)
+		r = posix_spawn(pid, path, &fa, NULL, argv, envp ? envp : environ);
+	posix_spawn_file_actions_destroy(&fa);
+	return -r;
 }
 
 int arflex_sys_kill(pid_t pid, int sig)

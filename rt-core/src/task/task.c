@@ -336,7 +336,9 @@ int arflex_task_report(struct arflex_task *t, FILE *out)
 		}
 		t->reported[k] = c;
 	}
-	if (lines)
+	if (lines) {
 		fflush(out);
+		clearerr(out); /* a pipe nobody reads (EPIPE) or a full one (EAGAIN): dropped */
+	}
 	return lines;
 }

@@ -695,7 +695,8 @@ final class ContractValidator {
         Long window = millis(p, f, f.window, "fault/@window", 10_000, 1, 3_600_000);
         Long backoff = millis(p, f, f.backoff, "fault/@backoff", 100, 0, 60_000);
         Long heartbeat = millis(p, f, f.heartbeatTimeout, "fault/@heartbeatTimeout", 100, 1, 60_000);
-        if (window == null || backoff == null || heartbeat == null) {
+        Long orphanHold = millis(p, f, f.orphanHold, "fault/@orphanHold", FaultPolicy.DEFAULT_ORPHAN_HOLD_MS, 0, 60_000);
+        if (window == null || backoff == null || heartbeat == null || orphanHold == null) {
             ok = false;
         }
         if (heartbeat != null && timing != null && task != Contract.TaskType.SERVICE
@@ -704,7 +705,7 @@ final class ContractValidator {
                     + " is shorter than the period " + Values.formatDuration(timing.periodNs()));
             ok = false;
         }
-        return ok ? new FaultPolicy(restart, intensity, window, backoff, safe, heartbeat) : null;
+        return ok ? new FaultPolicy(restart, intensity, window, backoff, safe, heartbeat, orphanHold) : null;
     }
 
     private static Long millis(Problems p, Located node, String text, String field, long dflt, long min, long max) {

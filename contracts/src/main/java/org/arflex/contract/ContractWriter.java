@@ -116,6 +116,7 @@ public final class ContractWriter {
             w.writeAttribute("backoff", f.backoffMs() == 0 ? "0ms" : Values.formatDuration(f.backoffMs() * 1_000_000L));
             w.writeAttribute("safe", f.safeOutput().name().toLowerCase(Locale.ROOT));
             w.writeAttribute("heartbeatTimeout", Values.formatDuration(f.heartbeatTimeoutMs() * 1_000_000L));
+            w.writeAttribute("orphanHold", f.orphanHoldMs() == 0 ? "0ms" : Values.formatDuration(f.orphanHoldMs() * 1_000_000L));
             if (c.update().isPresent()) {
                 nl(w, 1);
                 w.writeEmptyElement("update");

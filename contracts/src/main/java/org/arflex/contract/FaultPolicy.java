@@ -12,9 +12,21 @@ package org.arflex.contract;
  * @param safeOutput         what the RT half's outputs do in safe mode
  * @param heartbeatTimeoutMs how long the RT half tolerates a silent runtime (then it calls its
  *                           safe hook), and the runtime a silent RT half (then it is hung)
+ * @param orphanHoldMs       how long an RT half whose supervisor (the runtime) died holds its
+ *                           safe outputs before it exits and removes its shared objects
  */
 public record FaultPolicy(
-        Restart restart, int intensity, long windowMs, long backoffMs, SafeOutput safeOutput, long heartbeatTimeoutMs) {
+        Restart restart, int intensity, long windowMs, long backoffMs, SafeOutput safeOutput, long heartbeatTimeoutMs,
+        long orphanHoldMs) {
+
+    /** The default {@code orphanHold}, milliseconds. */
+    public static final long DEFAULT_ORPHAN_HOLD_MS = 2_000;
+
+    /** With the default orphan hold. */
+    public FaultPolicy(Restart restart, int intensity, long windowMs, long backoffMs, SafeOutput safeOutput,
+            long heartbeatTimeoutMs) {
+        this(restart, intensity, windowMs, backoffMs, safeOutput, heartbeatTimeoutMs, DEFAULT_ORPHAN_HOLD_MS);
+    }
 
     /** Restart strategy, as OTP child specs. */
     public enum Restart {

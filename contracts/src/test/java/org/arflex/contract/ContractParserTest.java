@@ -162,6 +162,26 @@ class ContractParserTest {
     }
 
     @Test
+    void orphanHoldDefaultsToTwoSecondsAndIsParsedAndWritten() throws Exception {
+        String xml = resource("/good/sample-scaler.xml");
+        Contract c = PARSER.parse(xml, "s.xml");
+        assertEquals(2_000L, c.fault().orphanHoldMs());
+        for (var e : Map.of("500ms", 500L, "0ms", 0L, "0s", 0L, "60s", 60_000L).entrySet()) {
+            Contract h = PARSER.parse(xml.replace("heartbeatTimeout=\"100ms\"",
+                    "heartbeatTimeout=\"100ms\" orphanHold=\"" + e.getKey() + "\""), "s.xml");
+            assertEquals(e.getValue(), h.fault().orphanHoldMs(), e.getKey());
+            assertEquals(h, PARSER.parse(ContractWriter.create().write(h), "s.xml"), "round trip " + e.getKey());
+        }
+        for (var e : Map.of("61s", "out of range", "1500us", "whole number of milliseconds",
+                "2 s", "not a duration").entrySet()) {
+            List<Problem> p = PARSER.validate(xml.replace("heartbeatTimeout=\"100ms\"",
+                    "heartbeatTimeout=\"100ms\" orphanHold=\"" + e.getKey() + "\""), "s.xml");
+            assertTrue(p.stream().anyMatch(x -> x.field().equals("fault/@orphanHold") && x.message().contains(e.getValue())),
+                    e.getKey() + ": " + p);
+        }
+    }
+
+    @Test
     void sha256IsNormalisedToLowerCase() throws Exception {
         Contract c = PARSER.parse(resource("/good/camera.xml"), "camera.xml");
         assertEquals("e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855", c.update().orElseThrow().sha256());

@@ -129,6 +129,7 @@ public final class ContractXml extends Located {
         @JacksonXmlProperty(isAttribute = true) public String backoff;
         @JacksonXmlProperty(isAttribute = true) public String safe;
         @JacksonXmlProperty(isAttribute = true) public String heartbeatTimeout;
+        @JacksonXmlProperty(isAttribute = true) public String orphanHold;
     }
 
     /** {@code <update>}. */

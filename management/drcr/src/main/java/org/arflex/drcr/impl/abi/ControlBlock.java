@@ -16,7 +16,7 @@ public final class ControlBlock implements AutoCloseable {
 
     public static final long MAGIC = 0x4C5443584C465241L; // "ARFLXCTL"
     public static final int ABI_MAJOR = 1;
-    public static final int ABI_MINOR = 0;
+    public static final int ABI_MINOR = 1;
     public static final int SIZE = 40960;
 
     // header
@@ -42,6 +42,8 @@ public final class ControlBlock implements AutoCloseable {
     public static final int OFF_CFG_SAFE_MODE = 104;
     public static final int OFF_CFG_FLAGS = 108;
     public static final int OFF_CFG_PARAM_COUNT = 112;
+    /** config.orphan_hold_ns (ABI 1.1, ABI.md 6.2). */
+    public static final int OFF_CFG_ORPHAN_HOLD = 120;
     public static final int OFF_WARNINGS = 128;
     public static final int WARN_KINDS = 16;
     // stats (struct arflex_stats at 256)
@@ -97,17 +99,39 @@ public final class ControlBlock implements AutoCloseable {
     public static final int FLAG_MLOCKALL = 2;
     public static final int FLAG_SAFE_ACTIVE = 4;
     public static final int FLAG_RESET_REQUIRED = 8;
+    /** The RT half saw EOF on its supervisor pipe (fd 0): it is an orphan (ABI.md 6.2). */
+    public static final int FLAG_SUPERVISOR_LOST = 64;
     public static final int CFG_MOVES_HARDWARE = 1;
     public static final int CFG_NO_MLOCK = 2;
     public static final int CFG_NO_DMA_LATENCY = 4;
+    /** fd 0 of the RT half is a pipe the supervisor holds open for the half's life (ABI.md 6.2). */
+    public static final int CFG_SUPERVISOR_PIPE = 8;
+    /** The contract's default {@code fault/@orphanHold}. */
+    public static final long DEFAULT_ORPHAN_HOLD_NS = 2_000_000_000L;
     public static final int PARAM_BOOL = 1;
     public static final int PARAM_INT64 = 2;
     public static final int PARAM_DOUBLE = 3;
     public static final int PARAM_MUTABLE = 1;
 
-    /** Configuration written before spawn. */
+    /**
+     * Configuration written before spawn. {@code orphanHoldNs}: how long an RT half that lost its
+     * supervisor holds its safe outputs before it exits and removes its objects (ABI.md 6.2).
+     */
     public record Config(long periodNs, long deadlineNs, long hbTimeoutNs, long cpuMask, int priority,
-                         int taskType, int safeMode, int cfgFlags) {
+                         int taskType, int safeMode, int cfgFlags, long orphanHoldNs) {
+
+        /** With the contract's default orphan hold (2 s). */
+        public Config(long periodNs, long deadlineNs, long hbTimeoutNs, long cpuMask, int priority,
+                      int taskType, int safeMode, int cfgFlags) {
+            this(periodNs, deadlineNs, hbTimeoutNs, cpuMask, priority, taskType, safeMode, cfgFlags,
+                    DEFAULT_ORPHAN_HOLD_NS);
+        }
+
+        /** This configuration with {@link #CFG_SUPERVISOR_PIPE} set. */
+        public Config withSupervisorPipe() {
+            return new Config(periodNs, deadlineNs, hbTimeoutNs, cpuMask, priority, taskType, safeMode,
+                    cfgFlags | CFG_SUPERVISOR_PIPE, orphanHoldNs);
+        }
     }
 
     /** A parameter descriptor written before spawn. */
@@ -199,6 +223,7 @@ public final class ControlBlock implements AutoCloseable {
             s.putInt(OFF_CFG_SAFE_MODE, cfg.safeMode());
             s.putInt(OFF_CFG_FLAGS, cfg.cfgFlags());
             s.putInt(OFF_CFG_PARAM_COUNT, params.size());
+            s.putLong(OFF_CFG_ORPHAN_HOLD, cfg.orphanHoldNs());
             for (int m : new int[] {OFF_STATS_LATENCY, OFF_STATS_EXEC}) {
                 s.putLong(m + METRIC_MIN, -1L);
             }
@@ -244,6 +269,13 @@ public final class ControlBlock implements AutoCloseable {
 
     public int flags() {
         return shm.getIntAcquire(OFF_FLAGS);
+    }
+
+    /** The configuration as written in the block (read-only after the spawn). */
+    public Config config() {
+        return new Config(shm.getLong(OFF_CFG_PERIOD), shm.getLong(OFF_CFG_DEADLINE), shm.getLong(OFF_CFG_HB_TIMEOUT),
+                shm.getLong(OFF_CFG_CPU_MASK), shm.getInt(OFF_CFG_PRIORITY), shm.getInt(OFF_CFG_TASK_TYPE),
+                shm.getInt(OFF_CFG_SAFE_MODE), shm.getInt(OFF_CFG_FLAGS), shm.getLong(OFF_CFG_ORPHAN_HOLD));
     }
 
     public int pid() {

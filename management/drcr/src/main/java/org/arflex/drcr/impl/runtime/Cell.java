@@ -510,7 +510,8 @@ public final class Cell {
         return new ControlBlock.Config(c.timing().periodNs(), c.timing().deadlineNs(),
                 c.fault().heartbeatTimeoutMs() * 1_000_000L, cpu >= 0 ? 1L << cpu : 0L,
                 c.taskType() == Contract.TaskType.SERVICE ? 0 : c.timing().priority(), taskType,
-                c.fault().safeOutput() == FaultPolicy.SafeOutput.ZERO ? 1 : 0, flags);
+                c.fault().safeOutput() == FaultPolicy.SafeOutput.ZERO ? 1 : 0, flags,
+                c.fault().orphanHoldMs() * 1_000_000L);
     }
 
     static List<ControlBlock.Param> controlParams(Contract c, long[] values) {

@@ -3,6 +3,7 @@ package org.arflex.drcr.impl.supervisor;
 import java.io.BufferedReader;
 import java.io.IOException;
 import java.io.InputStreamReader;
+import java.io.OutputStream;
 import java.nio.charset.StandardCharsets;
 import java.util.ArrayDeque;
 import java.util.Deque;
@@ -18,6 +19,12 @@ import org.arflex.drcr.impl.abi.PortSegment;
  * Spawns RT halves as child processes. The child's stdout and stderr go, line by line, to the
  * log through one reader thread per process ({@code arflex-rt-<instance>}); the last lines are
  * kept for the failure reason.
+ *
+ * <p>The child's stdin is the supervisor pipe (ABI.md 6.2): this side keeps its write end open
+ * for the life of the RT half and closes it only in {@link ProcessRtHalf#cleanup()}, after the
+ * process exited or was killed; the control block carries {@code CFG_SUPERVISOR_PIPE}. If this
+ * JVM dies, the kernel closes the pipe and every RT half sees EOF at once: it goes safe within a
+ * cycle, holds for the contract's orphan hold, then exits and removes its objects itself.
  */
 public final class ProcessLauncher implements RtLauncher {
 
@@ -69,8 +76,8 @@ public final class ProcessLauncher implements RtLauncher {
     public RtHalf launch(Spec spec) throws IOException {
         String rid = spec.runtimeId();
         String inst = spec.instance();
-        ControlBlock ctl = ControlBlock.create(objectName(rid, inst, "ctl"), spec.config(), spec.params(),
-                spec.resetRequired());
+        ControlBlock ctl = ControlBlock.create(objectName(rid, inst, "ctl"), spec.config().withSupervisorPipe(),
+                spec.params(), spec.resetRequired());
         Mailbox mb;
         try {
             mb = Mailbox.create(objectName(rid, inst, "cmd"), objectName(rid, inst, "rsp"));
@@ -84,13 +91,13 @@ public final class ProcessLauncher implements RtLauncher {
                     .redirectErrorStream(true)
                     .redirectInput(ProcessBuilder.Redirect.PIPE);
             p = pb.start();
-            p.getOutputStream().close();
         } catch (IOException e) {
             mb.close();
             ctl.close();
             throw new IOException("cannot spawn " + spec.executable() + ": " + e.getMessage(), e);
         }
-        ProcessRtHalf half = new ProcessRtHalf(inst, p, ctl, mb);
+        // p.getOutputStream() is the supervisor pipe: held open until cleanup()
+        ProcessRtHalf half = new ProcessRtHalf(inst, p, ctl, mb, p.getOutputStream());
         half.pumpOutput(log);
         // Wait for READY (or a failure) with a deadline; the RT half attaches, configures and
         // declares its ports in between.
@@ -153,6 +160,7 @@ public final class ProcessLauncher implements RtLauncher {
         private final Process process;
         private final ControlBlock ctl;
         private final Mailbox mb;
+        private final OutputStream supervisorPipe;
         private final Deque<String> tail = new ArrayDeque<>();
         private Thread pump;
         private final CompletableFuture<Exit> exit;
@@ -161,11 +169,12 @@ public final class ProcessLauncher implements RtLauncher {
         // control block, so every ctl access and the cleanup hold this object's lock.
         private boolean cleaned;
 
-        ProcessRtHalf(String inst, Process process, ControlBlock ctl, Mailbox mb) {
+        ProcessRtHalf(String inst, Process process, ControlBlock ctl, Mailbox mb, OutputStream supervisorPipe) {
             this.inst = inst;
             this.process = process;
             this.ctl = ctl;
             this.mb = mb;
+            this.supervisorPipe = supervisorPipe;
             this.exit = process.onExit().thenApply(pr -> describe(pr.exitValue(), stopping));
         }
 
@@ -382,12 +391,22 @@ public final class ProcessLauncher implements RtLauncher {
             process.destroyForcibly();
         }
 
+        /**
+         * Removes the objects and closes the supervisor pipe. Callers do so once the process has
+         * exited or was killed; one still alive would take the closed pipe as its supervisor's
+         * death (hold, then exit and unlink, ABI.md 6.2).
+         */
         @Override
         public synchronized void cleanup() {
             if (!cleaned) {
                 cleaned = true;
                 mb.close();
                 ctl.close();
+                try {
+                    supervisorPipe.close();
+                } catch (IOException ignored) {
+                    // the child is gone; nothing reads the pipe any more
+                }
             }
         }
     }

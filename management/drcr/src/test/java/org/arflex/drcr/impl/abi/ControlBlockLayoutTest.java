@@ -38,6 +38,7 @@ class ControlBlockLayoutTest {
         expect.put("offsetof(struct arflex_ctl, config.safe_mode)", (long) ControlBlock.OFF_CFG_SAFE_MODE);
         expect.put("offsetof(struct arflex_ctl, config.cfg_flags)", (long) ControlBlock.OFF_CFG_FLAGS);
         expect.put("offsetof(struct arflex_ctl, config.param_count)", (long) ControlBlock.OFF_CFG_PARAM_COUNT);
+        expect.put("offsetof(struct arflex_ctl, config.orphan_hold_ns)", (long) ControlBlock.OFF_CFG_ORPHAN_HOLD);
         expect.put("offsetof(struct arflex_ctl, warnings)", (long) ControlBlock.OFF_WARNINGS);
         expect.put("ARFLEX_WARN_KINDS", (long) ControlBlock.WARN_KINDS);
         expect.put("offsetof(struct arflex_ctl, stats.seq)", (long) ControlBlock.OFF_STATS_SEQ);
@@ -77,8 +78,11 @@ class ControlBlockLayoutTest {
         expect.put("ARFLEX_STATE_FAILED", (long) ControlBlock.STATE_FAILED);
         expect.put("ARFLEX_FLAG_SAFE_ACTIVE", (long) ControlBlock.FLAG_SAFE_ACTIVE);
         expect.put("ARFLEX_FLAG_RESET_REQUIRED", (long) ControlBlock.FLAG_RESET_REQUIRED);
+        expect.put("ARFLEX_FLAG_SUPERVISOR_LOST", (long) ControlBlock.FLAG_SUPERVISOR_LOST);
         expect.put("ARFLEX_CFG_MOVES_HARDWARE", (long) ControlBlock.CFG_MOVES_HARDWARE);
         expect.put("ARFLEX_CFG_NO_MLOCK", (long) ControlBlock.CFG_NO_MLOCK);
+        expect.put("ARFLEX_CFG_NO_DMA_LATENCY", (long) ControlBlock.CFG_NO_DMA_LATENCY);
+        expect.put("ARFLEX_CFG_SUPERVISOR_PIPE", (long) ControlBlock.CFG_SUPERVISOR_PIPE);
         expect.put("ARFLEX_PARAM_BOOL", (long) ControlBlock.PARAM_BOOL);
         expect.put("ARFLEX_PARAM_INT64", (long) ControlBlock.PARAM_INT64);
         expect.put("ARFLEX_PARAM_DOUBLE", (long) ControlBlock.PARAM_DOUBLE);
