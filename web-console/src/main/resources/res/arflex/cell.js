@@ -92,9 +92,9 @@
       const s = i.stats || {};
       return el('tr', {'data-component': i.name},
         el('td', {}, el('a', {href: pageUrl('arflex-component', {name: i.name})}, i.name)),
-        el('td', {class: 'arflex-state-cell'}, stateBadge(i.state)),
+        el('td', {class: 'arflex-state-cell'}, stateBadge(i.holding && i.state === 'ACTIVE' ? 'HOLDING' : i.state)),
         el('td', {}, i.targetState || ''),
-        el('td', {class: 'arflex-reason'}, i.failureReason || (i.awaitingReset ? 'waiting for operator reset (safe mode)' : (i.safeMode ? 'safe mode' : ''))),
+        el('td', {class: 'arflex-reason'}, i.holding || i.failureReason || ''),
         el('td', {}, String(i.restarts) + ' (' + i.restartsLeft + ' left)'),
         el('td', {}, i.pid ? String(i.pid) : ''),
         el('td', {}, i.cpu >= 0 ? String(i.cpu) : ''),
@@ -122,7 +122,9 @@
         el('td', {}, fmtBytes(res.networkUsed) + '/s of ' + fmtBytes(res.networkBps) + '/s')));
       resources.push(el('tr', {}, el('td', {}, 'WCET overruns'), el('td', {colspan: 2}, String(res.wcetOverruns))));
     }
-    const problems = (cell.problems || []).map(p => el('li', {}, p));
+    // a component that holds the arm is a problem people must see (SAFETY.md 5)
+    const problems = (cell.instances || []).filter(i => i.holding).map(i => el('li', {class: 'arflex-holding'}, i.name + ': ' + i.holding))
+      .concat((cell.problems || []).map(p => el('li', {}, p)));
     body.replaceChildren(table,
       el('h2', {}, 'Budgets'), el('table', {class: 'arflex-table', id: 'arflex-resources'}, resources),
       el('h2', {}, 'Problems'), problems.length ? el('ul', {id: 'arflex-problems'}, problems) : el('p', {}, 'None.'));

@@ -63,6 +63,10 @@ final class CellRig {
         List<String> names = new ArrayList<>();
         rt.installAndStart(SIM_ROBOT);
         names.add("sim-robot");
+        // the robot holds without a fresh safety input (SAFETY.md 1): the guard is part of an arm
+        assertBuilt(FORCE_GUARD);
+        rt.installAndStart(FORCE_GUARD);
+        names.add("force-guard");
         rt.waitUntil("sim-robot known", T, () -> rt.instance("sim-robot") != null);
         String info = rt.cmd("arflex:info sim-robot");
         String jr = info.lines().filter(l -> l.contains("in joint_ref")).findFirst().orElse("");
@@ -100,6 +104,11 @@ final class CellRig {
      * those whose RT half latched RESET_REQUIRED itself (a moving component after a runtime
      * heartbeat loss, the force guard after a trip; read from the control block).
      */
+    /** Motion sources that hold after a reset until a fresh command (DTO holding, SAFETY.md 2). */
+    static List<String> awaitingCommand(Runtime rt) {
+        return Runtime.names(rt.dto(), i -> String.valueOf(i.get("holding")).startsWith("stopped: waits for a fresh command"));
+    }
+
     static List<String> awaitingReset(Runtime rt) {
         return Runtime.names(rt.dto(), i -> Boolean.TRUE.equals(i.get("awaitingReset"))
                 || (CellPorts.ctlFlags(Path.of("/dev/shm/arflex." + rt.rid + "." + i.get("name") + ".ctl"))
@@ -158,6 +167,10 @@ final class CellRig {
                 rt.cmd("arflex:reset " + n);
                 resets.merge(n, 1, Integer::sum);
                 total++;
+            }
+            // a reset permits motion, it does not start it: the operator's fresh command
+            for (String n : awaitingCommand(rt)) {
+                rt.cmd("arflex:set " + n + " run true");
             }
         }
     }

@@ -19,7 +19,8 @@ import org.junit.jupiter.api.Test;
  * after the push shows in the wrist sensor (cycle timestamps of the two RT halves, not the
  * test's clock). The trajectory then decelerates along its path and its joint_ref stays
  * bit-identical for more than 1000 of its cycles, through the end of the push, until the
- * operator's {@code arflex:reset force-guard}; then the motion resumes. The robot's drives take
+ * operator's {@code arflex:reset force-guard}; the motion resumes only after a fresh command
+ * ({@code arflex:set trajectory run true}): a reset permits, it does not start (issue 15). The robot's drives take
  * the guard's power limit: sim-robot's {@code servo_power} is 1 while NORMAL, drops to the
  * guard's {@code safe_power_fraction} in the same or the next robot cycle after the stop, and is
  * 1 again after the reset.
@@ -36,7 +37,6 @@ class ForceGuardIT {
         CellRig.assertBuilt(CellRig.SIM_ROBOT, CellRig.TRAJECTORY, CellRig.FORCE_GUARD);
         try (Runtime rt = new Runtime("forceguard")) {
             List<String> cell = new ArrayList<>(CellRig.installArm(rt));
-            rt.installAndStart(CellRig.FORCE_GUARD);
             // The motion: a program file in the runtime's data directory (<runtime>/data, where
             // the RT halves' working directory is): the base swings +-0.3 rad around the home
             // pose and back, in a loop. Not the built-in program: the simulated arm's drives
@@ -45,7 +45,6 @@ class ForceGuardIT {
             // reads as contact; bundles/force-guard/README.md).
             java.nio.file.Files.createDirectories(rt.dir.resolve("data"));
             java.nio.file.Files.writeString(rt.dir.resolve("data/program-1.arp"), PROGRAM);
-            cell.add("force-guard");
             rt.awaitState("ACTIVE", T, "sim-robot", "force-guard");
             rt.installAndStart(CellRig.TRAJECTORY);
             cell.add("trajectory");
@@ -147,11 +146,24 @@ class ForceGuardIT {
                         () -> powerT.size() > 0 && powerT.last().value() == fraction);
                 int refMark = refT.size();
 
-                // Operator reset: NORMAL again, the motion resumes from the held pose.
+                // While stopped the shell and the DTO say so: HOLDING, with the guard named.
+                String list = rt.cmd("arflex:list");
+                assertTrue(list.lines().anyMatch(l -> l.startsWith("trajectory") && l.contains("HOLDING")
+                        && l.contains("safety input 'safety' in a protective stop (provider force-guard")), list);
+                // Operator reset: NORMAL again; the reset permits motion, it does not start it.
                 String r = rt.cmd("arflex:reset force-guard");
                 assertTrue(r.startsWith("force-guard: reset"), r);
                 rt.waitUntil("NORMAL after the reset", T, () -> safetyT.last().mode() == CellRig.Safety.NORMAL);
                 rt.waitUntil("full servo power after the reset", T, () -> powerT.last().value() == 1.0);
+                rt.waitUntil("trajectory holding for a fresh command", T, () -> String.valueOf(
+                        rt.instance("trajectory").get("holding")).startsWith("stopped: waits for a fresh command"));
+                int afterReset = refT.size();
+                rt.waitUntil("500 trajectory cycles after the reset", T, () -> refT.size() > afterReset + 500);
+                for (CellRig.Ref x : refT.snapshot().subList(afterReset, refT.size())) {
+                    assertTrue(Arrays.equals(x.q(), heldQ), "the motion resumed after the reset without a command: " + x);
+                }
+                // The fresh command.
+                CellRig.set(rt, "trajectory", "run", "true");
                 rt.waitUntil("the motion resumes", T,
                         () -> refT.size() > refMark && CellRig.maxDiff(refT.last().q(), heldQ) > 1e-3);
                 assertEquals(guardPid, rt.pid("force-guard"), "the guard was restarted");

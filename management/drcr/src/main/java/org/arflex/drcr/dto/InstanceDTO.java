@@ -26,6 +26,13 @@ public class InstanceDTO {
     public boolean awaitingReset;
     /** Since 0.4.0: the RT half runs its safe hook instead of its update (heartbeat lost or reset required). */
     public boolean safeMode;
+    /**
+     * Since 0.6.0: why this instance holds the arm (or its outputs) now, or null when it does
+     * not: supervisor lost, a safety input that does not permit motion (which input, why, and its
+     * provider's state), waiting for an operator reset (and why), waiting for a fresh command
+     * after a reset, safe mode. An ACTIVE instance with a non-null value is shown as HOLDING.
+     */
+    public String holding;
     /** Id of the bundle that carries the contract. */
     public long bundleId;
     /** The wires of this instance's inputs. */

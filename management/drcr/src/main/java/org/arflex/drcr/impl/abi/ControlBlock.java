@@ -31,6 +31,12 @@ public final class ControlBlock implements AutoCloseable {
     public static final int OFF_EXIT_STATUS = 36;
     public static final int OFF_RUNTIME_HB = 40;
     public static final int OFF_RT_HB = 48;
+    /** ctl.hold (uint32): why the component holds the arm by itself; cause | detail << 8 | input << 16. */
+    public static final int OFF_HOLD = 56;
+    public static final int HOLD_NONE = 0;
+    public static final int HOLD_SAFETY_INPUT = 1;
+    public static final int HOLD_AWAIT_COMMAND = 2;
+    public static final int HOLD_REFERENCE = 3;
     // config (struct arflex_ctl_config at 64)
     public static final int OFF_CONFIG = 64;
     public static final int OFF_CFG_PERIOD = 64;
@@ -269,6 +275,11 @@ public final class ControlBlock implements AutoCloseable {
 
     public int flags() {
         return shm.getIntAcquire(OFF_FLAGS);
+    }
+
+    /** The hold word (0: the component does not hold the arm by itself). */
+    public int hold() {
+        return shm.getIntAcquire(OFF_HOLD);
     }
 
     /** The configuration as written in the block (read-only after the spawn). */

@@ -711,7 +711,9 @@ public final class Cell {
         try {
             half.reset();
         } catch (IOException e) {
-            throw new IllegalStateException(name + ": RESET failed: " + e.getMessage());
+            String why = Holding.reason(this, inst, half.flags(), half.hold(), true);
+            throw new IllegalStateException(name + ": reset refused, the cause persists: "
+                    + (why != null ? why : e.getMessage()) + " (" + e.getMessage() + ")");
         }
         inst.awaitingReset = false;
         if (inst.life.state() == State.ACTIVE) {
@@ -861,6 +863,11 @@ public final class Cell {
     /** New capacities: re-plan (the lowest criticality goes first). */
     public Plan capacities(Capacities c) {
         return apply(Change.capacities(c));
+    }
+
+    /** The instance of that name, or null. */
+    Instance find(String name) {
+        return instances.get(name);
     }
 
     Instance require(String name) {

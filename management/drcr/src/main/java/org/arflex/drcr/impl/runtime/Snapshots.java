@@ -113,6 +113,7 @@ public final class Snapshots {
         int flags = half != null ? half.flags() : 0;
         d.awaitingReset = i.awaitingReset || (flags & ControlBlock.FLAG_RESET_REQUIRED) != 0;
         d.safeMode = (flags & ControlBlock.FLAG_SAFE_ACTIVE) != 0;
+        d.holding = Holding.reason(cell, i, flags, half != null ? half.hold() : 0, d.awaitingReset);
         d.evaluationSegments = new java.util.TreeMap<>(i.evaluationSegments);
         d.bundleId = i.bundleId;
         List<BindingDTO> bs = new ArrayList<>();

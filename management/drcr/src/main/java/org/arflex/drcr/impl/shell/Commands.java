@@ -64,8 +64,10 @@ public final class Commands {
         }
         StringBuilder sb = new StringBuilder(String.format("%-" + w + "s  %-11s  %7s  %3s  %s%n", "NAME", "STATE", "PID", "CPU", "REASON"));
         for (InstanceDTO i : c.instances) {
-            sb.append(String.format("%-" + w + "s  %-11s  %7s  %3s  %s%n", i.name, i.state, i.pid == 0 ? "-" : Long.toString(i.pid),
-                    i.cpu < 0 ? "-" : Integer.toString(i.cpu), i.failureReason == null ? "" : i.failureReason));
+            boolean holding = i.holding != null && "ACTIVE".equals(i.state);
+            String reason = holding ? i.holding : i.failureReason == null ? "" : i.failureReason;
+            sb.append(String.format("%-" + w + "s  %-11s  %7s  %3s  %s%n", i.name, holding ? "HOLDING" : i.state,
+                    i.pid == 0 ? "-" : Long.toString(i.pid), i.cpu < 0 ? "-" : Integer.toString(i.cpu), reason));
         }
         for (String p : c.problems) {
             sb.append("problem: ").append(p).append('\n');
@@ -86,6 +88,9 @@ public final class Commands {
         sb.append("  state ").append(i.state).append(", target ").append(i.targetState);
         if (i.failureReason != null) {
             sb.append(", reason: ").append(i.failureReason);
+        }
+        if (i.holding != null) {
+            sb.append(", HOLDING: ").append(i.holding);
         }
         sb.append('\n');
         sb.append("  pid ").append(i.pid == 0 ? "-" : i.pid).append(", cpu ").append(i.cpu < 0 ? "-" : i.cpu)
@@ -248,8 +253,11 @@ public final class Commands {
         });
     }
 
-    /** Operator reset. */
+    /** Operator reset of one component, or of every one that waits ({@code --cell}). */
     public String reset(String name) {
+        if ("--cell".equals(name)) {
+            return guard(() -> CellReset.run(drcr, n -> cm(n).reset()));
+        }
         return guard(() -> {
             cm(name).reset();
             return name + ": reset; now " + drcr.instance(name).map(i -> i.state).orElse("?");

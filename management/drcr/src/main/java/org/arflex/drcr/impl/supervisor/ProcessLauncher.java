@@ -325,6 +325,14 @@ public final class ProcessLauncher implements RtLauncher {
         }
 
         @Override
+        public synchronized int hold() {
+            if (cleaned) {
+                return 0;
+            }
+            return ctl.hold();
+        }
+
+        @Override
         public synchronized long rtHeartbeatNs() {
             if (cleaned) {
                 return 0;

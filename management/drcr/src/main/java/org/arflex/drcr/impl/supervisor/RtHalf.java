@@ -58,6 +58,11 @@ public interface RtHalf {
     /** Control block flags. */
     int flags();
 
+    /** The control block's hold word (ControlBlock.OFF_HOLD); 0 when none or gone. */
+    default int hold() {
+        return 0;
+    }
+
     /** The RT thread's heartbeat, CLOCK_MONOTONIC ns (0 before its first cycle). */
     long rtHeartbeatNs();
 

@@ -1,0 +1,64 @@
+package org.arflex.drcr.impl.runtime;
+
+import java.util.List;
+import org.arflex.contract.PortSpec;
+import org.arflex.drcr.impl.abi.ControlBlock;
+
+/**
+ * Says in words why an instance holds the arm (or its outputs): from its control block's flags
+ * and hold word, and the planner's wires for the provider of a safety input. Null when it does
+ * not hold (SAFETY.md 5: "holding" is a state with a reason, never hidden behind ACTIVE).
+ */
+final class Holding {
+
+    private static final String[] VERDICTS = {"normal", "limited", "in a protective stop", "without a provider",
+        "bound, no value yet", "stale (no fresh value)", "invalid (value rejected)", "damaged (segment header changed)"};
+
+    private Holding() {
+    }
+
+    static String reason(Cell cell, Instance i, int flags, int hold, boolean awaitingReset) {
+        if ((flags & ControlBlock.FLAG_SUPERVISOR_LOST) != 0) {
+            return "supervisor lost: holds, then exits (orphan)";
+        }
+        int cause = hold & 0xff;
+        String why = null;
+        if (cause == ControlBlock.HOLD_SAFETY_INPUT) {
+            why = "protective stop: " + safetyInput(cell, i, (hold >> 8) & 0xff, (hold >> 16) & 0xff);
+        } else if (cause == ControlBlock.HOLD_AWAIT_COMMAND && !awaitingReset) {
+            why = "stopped: waits for a fresh command (set run true, or a program) after the reset";
+        } else if (cause == ControlBlock.HOLD_REFERENCE) {
+            why = "holds: its reference does not meet the arm";
+        }
+        if (awaitingReset) {
+            String r = (flags & ControlBlock.FLAG_SAFE_ACTIVE) != 0 ? "safe mode, awaiting operator reset"
+                    : "awaiting operator reset";
+            return why == null ? r : why + "; " + r;
+        }
+        if (why == null && (flags & ControlBlock.FLAG_SAFE_ACTIVE) != 0) {
+            why = "safe mode: runtime heartbeat lost";
+        }
+        return why;
+    }
+
+    private static String safetyInput(Cell cell, Instance i, int verdict, int index) {
+        String v = verdict < VERDICTS.length ? VERDICTS[verdict] : "verdict " + verdict;
+        List<PortSpec> ins = i.contract.inputs();
+        if (index >= ins.size()) {
+            return "safety input #" + index + " " + v;
+        }
+        String port = ins.get(index).name();
+        String provider = null;
+        for (var w : cell.planner().wires()) {
+            if (w.consumer().equals(i.name) && w.inPort().equals(port)) {
+                provider = w.provider();
+            }
+        }
+        String p = "";
+        if (provider != null) {
+            Instance pi = cell.find(provider);
+            p = " (provider " + provider + (pi != null ? " " + pi.life.state() : "") + ")";
+        }
+        return "safety input '" + port + "' " + v + p;
+    }
+}
