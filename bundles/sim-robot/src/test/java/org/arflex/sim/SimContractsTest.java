@@ -76,7 +76,7 @@ class SimContractsTest {
                 "OUT servo_power arflex.Sample STATE"), ports);
         Set<String> rt = rtParams(BUNDLES.resolve("sim-robot/native/sim_robot.cc"),
                 Pattern.compile("\\{\"([a-z_]+)\", [-0-9.]+, '[dib]'\\}"));
-        assertEquals(19, rt.size(), "parameters found in sim_robot.cc: " + rt);
+        assertEquals(20, rt.size(), "parameters found in sim_robot.cc: " + rt);
         assertEquals(rt, props(c), "contract properties == parameters the RT half reads");
     }
 
