@@ -10,62 +10,10 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
-#include "arflex/mailbox.h"
-#include "arflex/task.h"
-
-#define LOAD(p) __atomic_load_n((p), __ATOMIC_ACQUIRE)
-#define STORE(p, v) __atomic_store_n((p), (v), __ATOMIC_RELEASE)
-#define XCHG(p, v) __atomic_exchange_n((p), (v), __ATOMIC_ACQ_REL)
+#include "internal.h"
 
 #define POLL_NS 100000000u          /* mailbox thread wakes at least every 100 ms */
-#define ORPHAN_POLL_NS 10000000u    /* ... every 10 ms once the supervisor is lost */
-#define ORPHAN_SAFE_WAIT_NS 1000000000u /* after the hold: wait this long at most for the
-					 * RT thread's first safe cycle of the orphan */
 #define APPLY_WAIT_NS 1000000000u   /* SET_PARAM/BIND wait for the cycle boundary */
-
-struct arflex_input {
-	char name[ARFLEX_NAME_SIZE];
-	char type_name[ARFLEX_TYPE_NAME_SIZE];
-	struct arflex_port_type type;
-	enum arflex_port_method method;
-	struct arflex_port *cur;      /* RT thread's binding (NULL: unbound) */
-	struct arflex_port *pending;  /* mailbox -> RT; &unbind_marker = unbind */
-	struct arflex_port *retired;  /* RT -> mailbox: to unmap */
-	uint32_t pend_seq;            /* mailbox: requests posted */
-	uint32_t done_seq;            /* RT: requests taken */
-	uint32_t binding;             /* RT: providers taken (arflex_input_binding) */
-	bool bound;                   /* mailbox thread's view */
-};
-
-struct arflex_component {
-	const struct arflex_component_ops *ops;
-	const char *name;
-	char rid[ARFLEX_ID_MAX + 1];
-	char inst[ARFLEX_ID_MAX + 1];
-	char ctl_name[ARFLEX_OBJ_NAME_SIZE];
-	struct arflex_ctl *ctl;
-	struct arflex_mailbox mb;
-	struct arflex_task task;
-	bool running;
-	bool configuring;
-	bool safe;                    /* RT thread */
-	bool safe_first;
-	bool lost_seen;               /* RT thread: this cycle saw SUPERVISOR_LOST */
-	bool orphan_safe;             /* RT -> mailbox: a safe cycle ran after the loss */
-	bool hb_stale;                /* RT -> mailbox: the windowed heartbeat judgement */
-	struct arflex_hb_window hbw;  /* RT thread */
-	uint64_t lost_ns;             /* watcher -> mailbox: when the supervisor was lost */
-	bool lost_noticed;            /* mailbox thread */
-	bool orphaned;                /* mailbox thread: left the loop as an orphan */
-	pthread_t watcher;
-	bool watching;                /* main thread: the watcher runs */
-	struct arflex_port outputs[ARFLEX_MAX_OUTPUTS];
-	char output_names[ARFLEX_MAX_OUTPUTS][ARFLEX_NAME_SIZE];
-	unsigned noutputs;
-	struct arflex_input inputs[ARFLEX_MAX_INPUTS];
-	unsigned ninputs;
-	struct arflex_stats stats_copy;
-};
 
 static struct arflex_port unbind_marker;
 static volatile sig_atomic_t got_signal;
@@ -75,13 +23,10 @@ static void on_signal(int sig)
 	got_signal = sig;
 }
 
-static void logf_(const struct arflex_component *c, const char *fmt, ...)
-	__attribute__((format(printf, 2, 3)));
-
 #include <stdarg.h>
 /* One line, one write: stderr may be a non-blocking pipe (a line is dropped, never split or
  * waited for) or a pipe nobody reads any more (EPIPE, SIGPIPE is ignored). */
-static void logf_(const struct arflex_component *c, const char *fmt, ...)
+void arflex_comp_log(const struct arflex_component *c, const char *fmt, ...)
 {
 	char line[512];
 	va_list ap;
@@ -234,7 +179,7 @@ int arflex_component_output(struct arflex_component *c, const char *port,
 		return r;
 	r = arflex_port_open(&c->outputs[c->noutputs], name, true, true, method, type);
 	if (r) {
-		logf_(c, "output port '%s' (%s): %s", port, name, strerror(-r));
+		arflex_comp_log(c, "output port '%s' (%s): %s", port, name, strerror(-r));
 		return r;
 	}
 	snprintf(c->output_names[c->noutputs], ARFLEX_NAME_SIZE, "%s", port);
@@ -562,7 +507,7 @@ static int do_bind(struct arflex_component *c, struct arflex_msg *m)
 	r = arflex_port_open(p, b->shm_name, in->method == ARFLEX_PORT_STREAM, false, in->method,
 			     &in->type);
 	if (r) {
-		logf_(c, "BIND %s to %s: %s", b->port, b->shm_name, strerror(-r));
+		arflex_comp_log(c, "BIND %s to %s: %s", b->port, b->shm_name, strerror(-r));
 		free(p);
 		return r;
 	}
@@ -693,36 +638,6 @@ static bool serve(struct arflex_component *c, struct arflex_msg *m)
 	return quit;
 }
 
-/* The orphan policy (ABI.md 6.2): once the watcher saw the supervisor go, safe mode holds
- * (the RT thread enters it within a cycle; when not running the flags say so too) for
- * config.orphan_hold_ns from the loss, and at least one safe cycle has run if running; then
- * true: the half leaves as on SHUTDOWN and removes its own objects. */
-static bool orphan_done(struct arflex_component *c)
-{
-	struct arflex_ctl *ctl = c->ctl;
-	uint64_t lost = LOAD(&c->lost_ns), hold = ctl->config.orphan_hold_ns, now;
-
-	if (!lost)
-		return false;
-	if (!c->lost_noticed) {
-		c->lost_noticed = true;
-		logf_(c, "supervisor lost (EOF on its pipe): safe mode, holding %llu ms, then "
-		      "exiting and removing my objects", (unsigned long long)(hold / 1000000u));
-	}
-	if (!c->running) {
-		if (ctl->config.cfg_flags & ARFLEX_CFG_MOVES_HARDWARE)
-			__atomic_or_fetch(&ctl->flags, ARFLEX_FLAG_RESET_REQUIRED,
-					  __ATOMIC_RELEASE);
-		__atomic_or_fetch(&ctl->flags, ARFLEX_FLAG_SAFE_ACTIVE, __ATOMIC_RELEASE);
-	}
-	now = arflex_sys_now_ns();
-	if (now - lost < hold)
-		return false;
-	if (c->running && !LOAD(&c->orphan_safe) && now - lost < hold + ORPHAN_SAFE_WAIT_NS)
-		return false;
-	return true;
-}
-
 static void serve_loop(struct arflex_component *c)
 {
 	struct arflex_msg m;
@@ -730,14 +645,14 @@ static void serve_loop(struct arflex_component *c)
 	while (!got_signal) {
 		int r;
 
-		if (orphan_done(c)) {
+		if (arflex_comp_orphan_done(c)) {
 			c->orphaned = true;
 			break;
 		}
 		arflex_task_report(&c->task, stderr);
 		if (!c->running)
 			arflex_ctl_param_apply_all(c->ctl, false);
-		r = arflex_mailbox_recv(&c->mb, &m, LOAD(&c->lost_ns) ? ORPHAN_POLL_NS : POLL_NS);
+		r = arflex_mailbox_recv(&c->mb, &m, LOAD(&c->lost_ns) ? ARFLEX_ORPHAN_POLL_NS : POLL_NS);
 		if (r == -ETIMEDOUT)
 			continue;
 		if (r == -EPROTO) {
@@ -751,7 +666,7 @@ static void serve_loop(struct arflex_component *c)
 			continue;
 		}
 		if (r) {
-			logf_(c, "mailbox receive failed: %s", strerror(-r));
+			arflex_comp_log(c, "mailbox receive failed: %s", strerror(-r));
 			wait_short();
 			continue;
 		}
@@ -817,65 +732,6 @@ static int parse_args(struct arflex_component *c, int argc, char **argv)
 		return -EINVAL;
 	}
 	return 0;
-}
-
-/* The supervisor-pipe watcher (ARFLEX_CFG_SUPERVISOR_PIPE): blocks in read() on fd 0; EOF or
- * an error means the supervisor is gone. Not the RT thread; it only sets two words. */
-static void *watch_supervisor(void *arg)
-{
-	struct arflex_component *c = arg;
-	char buf[64];
-	long n;
-
-	do {
-		n = arflex_sys_read(0, buf, sizeof(buf)); /* data is ignored */
-	} while (n > 0);
-	STORE(&c->lost_ns, arflex_sys_now_ns());
-	__atomic_or_fetch(&c->ctl->flags, ARFLEX_FLAG_SUPERVISOR_LOST, __ATOMIC_RELEASE);
-	return NULL;
-}
-
-static int start_watcher(struct arflex_component *c)
-{
-	sigset_t all, old;
-	int r;
-
-	sigemptyset(&all);
-	sigaddset(&all, SIGTERM);
-	sigaddset(&all, SIGINT);
-	pthread_sigmask(SIG_BLOCK, &all, &old);
-	r = arflex_sys_thread_create(&c->watcher, NULL, watch_supervisor, c);
-	pthread_sigmask(SIG_SETMASK, &old, NULL);
-	c->watching = !r;
-	return r;
-}
-
-/* Before the control block is unmapped: the watcher must not write to it any more. It is
- * blocked in read() (a cancellation point) or about to return. */
-static void stop_watcher(struct arflex_component *c)
-{
-	if (!c->watching)
-		return;
-	pthread_cancel(c->watcher);
-	arflex_sys_thread_join(c->watcher, NULL);
-	c->watching = false;
-}
-
-/* No manager is left to remove the objects of an orphan (ABI.md 2, DECISIONS.md D10). */
-static void unlink_own(struct arflex_component *c, unsigned noutputs)
-{
-	char name[ARFLEX_OBJ_NAME_SIZE], chan[ARFLEX_NAME_SIZE + 8];
-
-	for (unsigned i = 0; i < noutputs; i++) {
-		snprintf(chan, sizeof(chan), "out.%s", c->output_names[i]);
-		if (!arflex_ctl_obj_name(name, sizeof(name), c->rid, c->inst, chan))
-			arflex_sys_shm_unlink(name);
-	}
-	if (!arflex_ctl_obj_name(name, sizeof(name), c->rid, c->inst, "cmd"))
-		arflex_sys_mq_unlink(name);
-	if (!arflex_ctl_obj_name(name, sizeof(name), c->rid, c->inst, "rsp"))
-		arflex_sys_mq_unlink(name);
-	arflex_sys_shm_unlink(c->ctl_name);
 }
 
 static int attach_ctl(struct arflex_component *c)
@@ -961,7 +817,7 @@ int arflex_component_main(int argc, char **argv, const struct arflex_component_o
 
 	r = attach_ctl(c);
 	if (r) {
-		logf_(c, "cannot attach control block %s: %s", c->ctl_name, strerror(-r));
+		arflex_comp_log(c, "cannot attach control block %s: %s", c->ctl_name, strerror(-r));
 		return ARFLEX_EXIT_ATTACH;
 	}
 	STORE(&c->ctl->pid, (int32_t)getpid());
@@ -975,15 +831,15 @@ int arflex_component_main(int argc, char **argv, const struct arflex_component_o
 	init_params(c->ctl);
 	r = arflex_mailbox_attach(&c->mb, c->rid, c->inst);
 	if (r) {
-		logf_(c, "cannot open queues /arflex.%s.%s.{cmd,rsp}: %s", c->rid, c->inst,
+		arflex_comp_log(c, "cannot open queues /arflex.%s.%s.{cmd,rsp}: %s", c->rid, c->inst,
 		      strerror(-r));
 		code = ARFLEX_EXIT_ATTACH;
 		goto out_failed;
 	}
 	if (c->ctl->config.cfg_flags & ARFLEX_CFG_SUPERVISOR_PIPE) {
-		r = start_watcher(c);
+		r = arflex_comp_watch_start(c);
 		if (r) {
-			logf_(c, "cannot start the supervisor-pipe watcher: %s", strerror(-r));
+			arflex_comp_log(c, "cannot start the supervisor-pipe watcher: %s", strerror(-r));
 			code = ARFLEX_EXIT_ATTACH;
 			goto out_mailbox;
 		}
@@ -1006,7 +862,7 @@ int arflex_component_main(int argc, char **argv, const struct arflex_component_o
 	to.name = c->name;
 	r = arflex_task_init(&c->task, &to);
 	if (r) {
-		logf_(c, "invalid timing in the control block (period %llu ns, deadline %llu ns, "
+		arflex_comp_log(c, "invalid timing in the control block (period %llu ns, deadline %llu ns, "
 		      "priority %d)", (unsigned long long)to.period_ns,
 		      (unsigned long long)to.deadline_ns, to.priority);
 		code = ARFLEX_EXIT_CONFIGURE;
@@ -1017,7 +873,7 @@ int arflex_component_main(int argc, char **argv, const struct arflex_component_o
 	r = ops->configure ? ops->configure(c, ops->user) : 0;
 	c->configuring = false;
 	if (r) {
-		logf_(c, "configure failed: %s", strerror(r < 0 ? -r : r));
+		arflex_comp_log(c, "configure failed: %s", strerror(r < 0 ? -r : r));
 		code = ARFLEX_EXIT_CONFIGURE;
 		goto out_task;
 	}
@@ -1035,9 +891,9 @@ int arflex_component_main(int argc, char **argv, const struct arflex_component_o
 	arflex_task_deinit(&c->task);
 	arflex_mailbox_deinit(&c->mb);
 	STORE(&c->ctl->state, ARFLEX_STATE_EXITED);
-	stop_watcher(c);
+	arflex_comp_watch_stop(c);
 	if (c->orphaned)
-		unlink_own(c, noutputs);
+		arflex_comp_unlink_own(c, noutputs);
 	arflex_sys_munmap(c->ctl, ARFLEX_CTL_SIZE);
 	return ARFLEX_EXIT_OK;
 
@@ -1049,7 +905,7 @@ out_mailbox:
 out_failed:
 	STORE(&c->ctl->exit_status, r < 0 ? r : -EINVAL);
 	STORE(&c->ctl->state, ARFLEX_STATE_FAILED);
-	stop_watcher(c);
+	arflex_comp_watch_stop(c);
 	arflex_sys_munmap(c->ctl, ARFLEX_CTL_SIZE);
 	return code;
 }

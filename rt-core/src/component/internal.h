@@ -1,0 +1,75 @@
+/* rt-core internal: the state of an RT half shared by component.c (the template: ports, the RT
+ * loop, the mailbox) and supervisor.c (the supervisor's death and the orphan policy). Not
+ * installed, not API. */
+#ifndef ARFLEX_COMPONENT_INTERNAL_H
+#define ARFLEX_COMPONENT_INTERNAL_H
+
+#include <pthread.h>
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "arflex/component.h"
+#include "arflex/mailbox.h"
+#include "arflex/task.h"
+
+#define LOAD(p) __atomic_load_n((p), __ATOMIC_ACQUIRE)
+#define STORE(p, v) __atomic_store_n((p), (v), __ATOMIC_RELEASE)
+#define XCHG(p, v) __atomic_exchange_n((p), (v), __ATOMIC_ACQ_REL)
+
+
+struct arflex_input {
+	char name[ARFLEX_NAME_SIZE];
+	char type_name[ARFLEX_TYPE_NAME_SIZE];
+	struct arflex_port_type type;
+	enum arflex_port_method method;
+	struct arflex_port *cur;      /* RT thread's binding (NULL: unbound) */
+	struct arflex_port *pending;  /* mailbox -> RT; &unbind_marker = unbind */
+	struct arflex_port *retired;  /* RT -> mailbox: to unmap */
+	uint32_t pend_seq;            /* mailbox: requests posted */
+	uint32_t done_seq;            /* RT: requests taken */
+	uint32_t binding;             /* RT: providers taken (arflex_input_binding) */
+	bool bound;                   /* mailbox thread's view */
+};
+
+struct arflex_component {
+	const struct arflex_component_ops *ops;
+	const char *name;
+	char rid[ARFLEX_ID_MAX + 1];
+	char inst[ARFLEX_ID_MAX + 1];
+	char ctl_name[ARFLEX_OBJ_NAME_SIZE];
+	struct arflex_ctl *ctl;
+	struct arflex_mailbox mb;
+	struct arflex_task task;
+	bool running;
+	bool configuring;
+	bool safe;                    /* RT thread */
+	bool safe_first;
+	bool lost_seen;               /* RT thread: this cycle saw SUPERVISOR_LOST */
+	bool orphan_safe;             /* RT -> mailbox: a safe cycle ran after the loss */
+	bool hb_stale;                /* RT -> mailbox: the windowed heartbeat judgement */
+	struct arflex_hb_window hbw;  /* RT thread */
+	uint64_t lost_ns;             /* watcher -> mailbox: when the supervisor was lost */
+	bool lost_noticed;            /* mailbox thread */
+	bool orphaned;                /* mailbox thread: left the loop as an orphan */
+	pthread_t watcher;
+	bool watching;                /* main thread: the watcher runs */
+	struct arflex_port outputs[ARFLEX_MAX_OUTPUTS];
+	char output_names[ARFLEX_MAX_OUTPUTS][ARFLEX_NAME_SIZE];
+	unsigned noutputs;
+	struct arflex_input inputs[ARFLEX_MAX_INPUTS];
+	unsigned ninputs;
+	struct arflex_stats stats_copy;
+};
+
+/* One log line on stderr, one write (component.c). */
+void arflex_comp_log(const struct arflex_component *c, const char *fmt, ...)
+	__attribute__((format(printf, 2, 3)));
+
+/* supervisor.c (ABI.md 6.2, DECISIONS.md D10) */
+#define ARFLEX_ORPHAN_POLL_NS 10000000u /* mailbox wakes every 10 ms once the supervisor is lost */
+int arflex_comp_watch_start(struct arflex_component *c);
+void arflex_comp_watch_stop(struct arflex_component *c);
+bool arflex_comp_orphan_done(struct arflex_component *c);
+void arflex_comp_unlink_own(struct arflex_component *c, unsigned noutputs);
+
+#endif /* ARFLEX_COMPONENT_INTERNAL_H */

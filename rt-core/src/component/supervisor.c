@@ -1,0 +1,100 @@
+/* The supervisor's death and the orphan policy of an RT half (ABI.md 6.2, DECISIONS.md D10):
+ * a watcher thread takes EOF on fd 0 (the supervisor's pipe) as its death; the mailbox thread
+ * then holds safe mode for config.orphan_hold_ns, leaves as on SHUTDOWN and removes the
+ * instance's own objects, since no manager is left to do it. */
+#include "internal.h"
+
+#include <signal.h>
+#include <stdio.h>
+
+#define ORPHAN_SAFE_WAIT_NS 1000000000u /* after the hold: wait this long at most for the
+					 * RT thread's first safe cycle of the orphan */
+
+/* The orphan policy (ABI.md 6.2): once the watcher saw the supervisor go, safe mode holds
+ * (the RT thread enters it within a cycle; when not running the flags say so too) for
+ * config.orphan_hold_ns from the loss, and at least one safe cycle has run if running; then
+ * true: the half leaves as on SHUTDOWN and removes its own objects. */
+bool arflex_comp_orphan_done(struct arflex_component *c)
+{
+	struct arflex_ctl *ctl = c->ctl;
+	uint64_t lost = LOAD(&c->lost_ns), hold = ctl->config.orphan_hold_ns, now;
+
+	if (!lost)
+		return false;
+	if (!c->lost_noticed) {
+		c->lost_noticed = true;
+		arflex_comp_log(c, "supervisor lost (EOF on its pipe): safe mode, holding %llu ms, then "
+		      "exiting and removing my objects", (unsigned long long)(hold / 1000000u));
+	}
+	if (!c->running) {
+		if (ctl->config.cfg_flags & ARFLEX_CFG_MOVES_HARDWARE)
+			__atomic_or_fetch(&ctl->flags, ARFLEX_FLAG_RESET_REQUIRED,
+					  __ATOMIC_RELEASE);
+		__atomic_or_fetch(&ctl->flags, ARFLEX_FLAG_SAFE_ACTIVE, __ATOMIC_RELEASE);
+	}
+	now = arflex_sys_now_ns();
+	if (now - lost < hold)
+		return false;
+	if (c->running && !LOAD(&c->orphan_safe) && now - lost < hold + ORPHAN_SAFE_WAIT_NS)
+		return false;
+	return true;
+}
+
+/* The supervisor-pipe watcher (ARFLEX_CFG_SUPERVISOR_PIPE): blocks in read() on fd 0; EOF or
+ * an error means the supervisor is gone. Not the RT thread; it only sets two words. */
+static void *watch_supervisor(void *arg)
+{
+	struct arflex_component *c = arg;
+	char buf[64];
+	long n;
+
+	do {
+		n = arflex_sys_read(0, buf, sizeof(buf)); /* data is ignored */
+	} while (n > 0);
+	STORE(&c->lost_ns, arflex_sys_now_ns());
+	__atomic_or_fetch(&c->ctl->flags, ARFLEX_FLAG_SUPERVISOR_LOST, __ATOMIC_RELEASE);
+	return NULL;
+}
+
+int arflex_comp_watch_start(struct arflex_component *c)
+{
+	sigset_t all, old;
+	int r;
+
+	sigemptyset(&all);
+	sigaddset(&all, SIGTERM);
+	sigaddset(&all, SIGINT);
+	pthread_sigmask(SIG_BLOCK, &all, &old);
+	r = arflex_sys_thread_create(&c->watcher, NULL, watch_supervisor, c);
+	pthread_sigmask(SIG_SETMASK, &old, NULL);
+	c->watching = !r;
+	return r;
+}
+
+/* Before the control block is unmapped: the watcher must not write to it any more. It is
+ * blocked in read() (a cancellation point) or about to return. */
+void arflex_comp_watch_stop(struct arflex_component *c)
+{
+	if (!c->watching)
+		return;
+	pthread_cancel(c->watcher);
+	arflex_sys_thread_join(c->watcher, NULL);
+	c->watching = false;
+}
+
+/* No manager is left to remove the objects of an orphan (ABI.md 2, DECISIONS.md D10). */
+void arflex_comp_unlink_own(struct arflex_component *c, unsigned noutputs)
+{
+	char name[ARFLEX_OBJ_NAME_SIZE], chan[ARFLEX_NAME_SIZE + 8];
+
+	for (unsigned i = 0; i < noutputs; i++) {
+		snprintf(chan, sizeof(chan), "out.%s", c->output_names[i]);
+		if (!arflex_ctl_obj_name(name, sizeof(name), c->rid, c->inst, chan))
+			arflex_sys_shm_unlink(name);
+	}
+	if (!arflex_ctl_obj_name(name, sizeof(name), c->rid, c->inst, "cmd"))
+		arflex_sys_mq_unlink(name);
+	if (!arflex_ctl_obj_name(name, sizeof(name), c->rid, c->inst, "rsp"))
+		arflex_sys_mq_unlink(name);
+	arflex_sys_shm_unlink(c->ctl_name);
+}
