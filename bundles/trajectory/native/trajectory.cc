@@ -76,7 +76,7 @@ struct State {
   // Reset permits, it does not start (SAFETY.md 2): after a stop (a protective stop or loss
   // of the guard that had permitted motion, rt-core safe mode, a restart that needs a reset)
   // the output holds until a fresh command: a write of `run` (true) or `program` taken after
-  // the stop's causes are gone. cmd_seq is the command slots' applied_seq sum as last seen
+  // the stop's causes are gone. cmd_seq is CommandSeq (arflex_param_writes) as last seen
   // while the stop held, so commands sent before the reset are discarded.
   bool await_command = false;
   uint64_t cmd_seq = 0;
@@ -186,11 +186,9 @@ uint64_t SafetyMaxAgeNs(struct arflex_component* c) {
              : kSafetyMaxAgeNs;
 }
 
-// Sum of the applied_seq of the command parameters (run, program): changes with every write.
+// Changes with every write of a command parameter (run, program).
 uint64_t CommandSeq(struct arflex_component* c) {
-  const struct arflex_ctl* ctl = arflex_component_ctl(c);
-  return __atomic_load_n(&ctl->params[g.p_run].applied_seq, __ATOMIC_ACQUIRE) +
-         __atomic_load_n(&ctl->params[g.p_program].applied_seq, __ATOMIC_ACQUIRE);
+  return arflex_param_writes(c, g.p_run) + arflex_param_writes(c, g.p_program);
 }
 
 int Start(struct arflex_component* c, void*) {

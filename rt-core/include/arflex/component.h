@@ -138,6 +138,10 @@ ARFLEX_API int arflex_component_param(const struct arflex_component *c, const ch
 ARFLEX_API int64_t arflex_param_i64(const struct arflex_component *c, int idx);
 ARFLEX_API double arflex_param_f64(const struct arflex_component *c, int idx);
 ARFLEX_API bool arflex_param_bool(const struct arflex_component *c, int idx);
+/** A number that changes with every write of parameter @idx that was taken, also of the same
+ *  value (the slot's applied sequence). A component that takes a write as a command (a fresh
+ *  "run" after a stop) compares it with the one it saw last. */
+ARFLEX_API uint64_t arflex_param_writes(const struct arflex_component *c, int idx);
 
 /** True while an input has a provider. */
 ARFLEX_API bool arflex_input_bound(const struct arflex_input *in);

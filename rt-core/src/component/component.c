@@ -63,6 +63,11 @@ double arflex_param_f64(const struct arflex_component *c, int idx)
 	return arflex_bits_f64(arflex_ctl_param_value(c->ctl, (unsigned)idx));
 }
 
+uint64_t arflex_param_writes(const struct arflex_component *c, int idx)
+{
+	return LOAD(&c->ctl->params[idx].applied_seq);
+}
+
 bool arflex_param_bool(const struct arflex_component *c, int idx)
 {
 	return arflex_ctl_param_value(c->ctl, (unsigned)idx) != 0;
