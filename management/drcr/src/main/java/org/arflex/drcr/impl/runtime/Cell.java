@@ -865,11 +865,6 @@ public final class Cell {
         return apply(Change.capacities(c));
     }
 
-    /** The instance of that name, or null. */
-    Instance find(String name) {
-        return instances.get(name);
-    }
-
     Instance require(String name) {
         Instance inst = instances.get(name);
         if (inst == null) {

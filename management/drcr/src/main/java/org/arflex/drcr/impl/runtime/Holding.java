@@ -14,6 +14,8 @@ final class Holding {
     private static final String[] VERDICTS = {"normal", "limited", "in a protective stop", "without a provider",
         "bound, no value yet", "stale (no fresh value)", "invalid (value rejected)", "damaged (segment header changed)"};
 
+    private static final String SAFETY_TYPE = "arflex.SafetyState";
+
     private Holding() {
     }
 
@@ -43,11 +45,10 @@ final class Holding {
 
     private static String safetyInput(Cell cell, Instance i, int verdict, int index) {
         String v = verdict < VERDICTS.length ? VERDICTS[verdict] : "verdict " + verdict;
-        List<PortSpec> ins = i.contract.inputs();
-        if (index >= ins.size()) {
+        String port = safetyPort(i.contract.inputs(), index);
+        if (port == null) {
             return "safety input #" + index + " " + v;
         }
-        String port = ins.get(index).name();
         String provider = null;
         for (var w : cell.planner().wires()) {
             if (w.consumer().equals(i.name) && w.inPort().equals(port)) {
@@ -56,9 +57,24 @@ final class Holding {
         }
         String p = "";
         if (provider != null) {
-            Instance pi = cell.find(provider);
-            p = " (provider " + provider + (pi != null ? " " + pi.life.state() : "") + ")";
+            String name = provider;
+            String state = cell.instances().stream().filter(x -> x.name.equals(name)).findFirst()
+                    .map(x -> " " + x.life.state()).orElse("");
+            p = " (provider " + provider + state + ")";
         }
         return "safety input '" + port + "' " + v + p;
+    }
+
+    /**
+     * The input the hold word names. Its index counts the inputs in the order the RT half
+     * declared them, which need not be the contract's: the contract's input at that index is
+     * taken when it is an arflex.SafetyState input, else the contract's only such input.
+     */
+    static String safetyPort(List<PortSpec> ins, int index) {
+        if (index < ins.size() && SAFETY_TYPE.equals(ins.get(index).type())) {
+            return ins.get(index).name();
+        }
+        List<PortSpec> safety = ins.stream().filter(p -> SAFETY_TYPE.equals(p.type())).toList();
+        return safety.size() == 1 ? safety.get(0).name() : null;
     }
 }

@@ -457,6 +457,42 @@ class CellTest {
         assertEquals("ACTIVE", d.state);
     }
 
+    /** Issue 15 finding 4: a component that holds the arm says so, with the input and its provider. */
+    @Test
+    void theDtoSaysWhyAComponentHoldsTheArm() throws Exception {
+        install(contract("guard", "<out name=\"safety\" type=\"arflex.SafetyState\" typeVersion=\"1.0\" method=\"state\"/>",
+                PERMANENT, false, 5, "50us"));
+        install(contract("arm", "<in name=\"ref\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\" optional=\"true\">"
+                + "<bind component=\"prov\" port=\"y\"/></in>"
+                + "<in name=\"safety\" type=\"arflex.SafetyState\" typeVersion=\"1.0\" method=\"state\" optional=\"true\">"
+                + "<bind component=\"guard\" port=\"safety\"/></in>", PERMANENT, true, 4, "50us"));
+        assertEquals(State.ACTIVE, state("arm"));
+        FakeLauncher.FakeHalf h = launcher.running.get("arm");
+        assertEquals(null, Snapshots.instance(cell, "arm").orElseThrow().holding);
+        // hold word: SAFETY_INPUT, verdict 5 (stale), input 1 (declared second, as in the contract)
+        h.hold = ControlBlock.HOLD_SAFETY_INPUT | 5 << 8 | 1 << 16;
+        InstanceDTO d = Snapshots.instance(cell, "arm").orElseThrow();
+        assertEquals("protective stop: safety input 'safety' stale (no fresh value) (provider guard ACTIVE)", d.holding);
+        assertEquals("ACTIVE", d.state);
+        // an RT half that declared its inputs in another order still names the safety input
+        h.hold = ControlBlock.HOLD_SAFETY_INPUT | 2 << 8;
+        assertEquals("protective stop: safety input 'safety' in a protective stop (provider guard ACTIVE)",
+                Snapshots.instance(cell, "arm").orElseThrow().holding);
+        // the reset latched too
+        h.flags = ControlBlock.FLAG_RESET_REQUIRED | ControlBlock.FLAG_SAFE_ACTIVE;
+        assertTrue(Snapshots.instance(cell, "arm").orElseThrow().holding.endsWith("; safe mode, awaiting operator reset"));
+        // after the reset: waiting for the fresh command
+        h.flags = 0;
+        h.hold = ControlBlock.HOLD_AWAIT_COMMAND;
+        assertTrue(Snapshots.instance(cell, "arm").orElseThrow().holding.startsWith("stopped: waits for a fresh command"));
+        // the supervisor lost (seen by a later runtime's snapshot of an orphan)
+        h.flags = ControlBlock.FLAG_SUPERVISOR_LOST | ControlBlock.FLAG_SAFE_ACTIVE;
+        assertTrue(Snapshots.instance(cell, "arm").orElseThrow().holding.startsWith("supervisor lost"));
+        h.flags = 0;
+        h.hold = 0;
+        assertEquals(null, Snapshots.instance(cell, "arm").orElseThrow().holding);
+    }
+
     @Test
     void nameOwnedByAnotherBundleIsRefused() throws Exception {
         install(contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us"));

@@ -34,6 +34,8 @@ final class FakeLauncher implements RtLauncher {
         boolean cleaned;
         /** What flags() reports (control block flags); tests set it. */
         int flags;
+        /** What hold() reports (the control block's hold word); tests set it. */
+        int hold;
         /** What stats() reports; tests set it. */
         ControlBlock.Stats stats = new ControlBlock.Stats(0, 0, 0, 0, 0, 0, 0, 0, 0, 0);
 
@@ -105,6 +107,11 @@ final class FakeLauncher implements RtLauncher {
         @Override
         public int flags() {
             return flags;
+        }
+
+        @Override
+        public int hold() {
+            return hold;
         }
 
         @Override
