@@ -146,6 +146,13 @@ struct Robot {
   // pose and the acquired reference is taken up smoothly instead of as a step.
   JointVector blend_offset{};
   double blend_t = kBlendSeconds;  // simulated seconds since the acquisition; >= kBlendSeconds: done
+  // Reset permits, it does not start (SAFETY.md 2): after a stop (a safety hold or safe mode)
+  // the held pose is kept, offset and all, while the acquired reference stays the same; the
+  // blend starts when the reference moves (the motion source's fresh command), not at the reset.
+  bool after_stop = false;
+  bool hold_stops_motion = false;
+  bool blend_wait = false;
+  JointVector wait_ref{};
 };
 
 Robot g_robot;
@@ -400,6 +407,8 @@ int Start(arflex_component* c, void* user) {
   Robot& r = *static_cast<Robot*>(user);
   r.acquired = false;  // after STOP/START the reference must meet the arm again
   r.refusing = false;
+  r.after_stop = false;
+  r.blend_wait = false;
   r.guard_hold = false;
   r.guard_permitted = false;
   r.loss_latched = false;
@@ -411,6 +420,7 @@ int Start(arflex_component* c, void* user) {
 
 int Update(arflex_component* c, void* user, uint64_t release_ns) {
   Robot& r = *static_cast<Robot*>(user);
+  if (r.safe) r.after_stop = true;  // the first cycle after safe mode (the reset)
   r.safe = false;
   ApplyParams(c, r);
   // The safety input permits motion, or the arm holds (fail closed). Its power limit is
@@ -421,11 +431,13 @@ int Update(arflex_component* c, void* user, uint64_t release_ns) {
     if (!r.guard_hold) {
       HoldMeasured(r);
       r.guard_hold = true;
+      r.hold_stops_motion = r.guard_permitted;  // not merely waiting for a first guard
     }
     return StepAndPublish(c, r, release_ns);
   }
   if (r.guard_hold) {  // the reference must meet the arm again (D9)
     r.guard_hold = false;
+    r.after_stop = r.hold_stops_motion;
     r.acquired = false;
     r.refusing = false;
   }
@@ -454,6 +466,12 @@ int Update(arflex_component* c, void* user, uint64_t release_ns) {
       if (!r.acquired) {  // the offset from what the servo held to the acquired reference
         for (int i = 0; i < kNumJoints; ++i) r.blend_offset[i] = ref.q[i] - r.q_ref[i];
         r.blend_t = 0;
+        r.blend_wait = r.after_stop;
+        r.after_stop = false;
+        for (int i = 0; i < kNumJoints; ++i) r.wait_ref[i] = ref.q[i];
+      } else if (r.blend_wait) {
+        for (int i = 0; i < kNumJoints; ++i)
+          if (ref.q[i] != r.wait_ref[i]) r.blend_wait = false;  // the reference moves
       }
       r.acquired = true;
       r.refusing = false;
@@ -465,7 +483,7 @@ int Update(arflex_component* c, void* user, uint64_t release_ns) {
     const double u = r.blend_t / kBlendSeconds;
     const double rest = 1.0 - u * u * u * (10.0 + u * (-15.0 + 6.0 * u));  // 1 - quintic
     for (int i = 0; i < kNumJoints; ++i) servo[i] -= r.blend_offset[i] * rest;
-    r.blend_t += P(c, r, kStepsPerPeriod) * r.cell->timestep();
+    if (!r.blend_wait) r.blend_t += P(c, r, kStepsPerPeriod) * r.cell->timestep();
   }
   r.cell->SetJointReference(servo);
   const int pub = StepAndPublish(c, r, release_ns);

@@ -589,6 +589,25 @@ TEST_F(SimComponents, RobotTakesThePowerLimitOfTheSafetyInput) {
   const uint64_t s0 = js.seq;
   ASSERT_TRUE(WaitFor([&] { return Latest(&js_port, &js, &hj) && js.seq > s0 + 300; }));
   EXPECT_NEAR(js.q[0], q_hold, 2e-3) << "resumed the old reference after the reset";
+  // A held reference near the arm (a motion source that stopped a little further along its
+  // path) is acquired but not moved to: the reset permits, the reference does not move.
+  const double q_arm = js.q[0];
+  double near_ref[6] = {q_arm + 0.02, 0.5, 0.3, 0.0, 0.8, 0.0};
+  for (int k = 0; k < 200; ++k) WriteReference(near_ref);  // the same value, new sequence
+  const uint64_t s1 = js.seq;
+  double peak = 0;
+  ASSERT_TRUE(WaitFor([&] {
+    if (!Latest(&js_port, &js, &hj)) return false;
+    for (int i = 0; i < 6; ++i) peak = std::max(peak, std::fabs(js.qd[i]));
+    return js.seq > s1 + 500;
+  }));
+  EXPECT_NEAR(js.q[0], q_arm, 1e-4) << "moved to a held reference after the reset";
+  EXPECT_LT(peak, 1e-3) << "joint speed after the reset without a moving reference";
+  // The reference moves (the fresh command): the offset is blended out while it moves.
+  near_ref[0] += 0.001;
+  WriteReference(near_ref);
+  ASSERT_TRUE(WaitFor([&] { return Latest(&js_port, &js, &hj) && std::fabs(js.q[0] - near_ref[0]) < 1e-3; }))
+      << "did not follow the moving reference, q0 " << js.q[0];
   EXPECT_EQ(arflex_host_stop(&robot_, kCall), 0);
   arflex_port_close(&pw_port);
   arflex_port_close(&js_port);

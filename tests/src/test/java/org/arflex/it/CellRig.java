@@ -369,9 +369,18 @@ final class CellRig {
     }
 
     /** arflex.JointState: t_ns, seq, q[6], qd[6], tau[6]. */
-    record JointState(long tNs, long seq, double[] q) {
+    record JointState(long tNs, long seq, double[] q, double[] qd) {
         static JointState of(java.nio.ByteBuffer v) {
-            return v == null ? null : new JointState(v.getLong(0), v.getLong(8), doubles(v, 16, 6));
+            return v == null ? null : new JointState(v.getLong(0), v.getLong(8), doubles(v, 16, 6), doubles(v, 64, 6));
+        }
+
+        /** The largest joint speed (rad/s). */
+        double maxSpeed() {
+            double m = 0;
+            for (double x : qd) {
+                m = Math.max(m, Math.abs(x));
+            }
+            return m;
         }
     }
 
