@@ -549,7 +549,8 @@ static bool inject(struct arflex_port *w, struct reader *y, double value, unsign
 
 /* rt.sample.nan: NaN and infinity written into counter.count (the counter stopped) are not
  * used by the scaler: y never carries them and holds its last value, every bad input counts
- * an update error; a valid value after them is scaled again, and so is the counter's flow. */
+ * an update error; a valid value after them is scaled again, an overwritten segment header
+ * is counted in ARFLEX_WARN_INPUT, and after all that the counter's flow is scaled again. */
 static int case_nan(void)
 {
 	struct reader x, y;
@@ -597,6 +598,22 @@ static int case_nan(void)
 			reader_poll(&y);
 		CHECK(y.v.seq == s.seq && y.v.value == 3.0, "y after a valid value: seq %llu %g",
 		      (unsigned long long)y.v.seq, y.v.value);
+		/* An overwritten header is noticed by the read (ARFLEX_WARN_INPUT); restored, the
+		 * next value flows. */
+		w.hdr->magic ^= 1;
+		deadline = arflex_sys_now_ns() + WAIT_TIMEOUT;
+		while (__atomic_load_n(&scaler_h.ctl->warnings[ARFLEX_WARN_INPUT], __ATOMIC_RELAXED) == 0 &&
+		       arflex_sys_now_ns() < deadline)
+			;
+		w.hdr->magic ^= 1;
+		CHECK(scaler_h.ctl->warnings[ARFLEX_WARN_INPUT] > 0, "damaged header not counted");
+		s.seq++;
+		s.value = -2.0;
+		CHECK(arflex_state_write(&w, &s, sizeof(s)) == 0, "write -2.0");
+		while (y.v.seq != s.seq && arflex_sys_now_ns() < deadline)
+			reader_poll(&y);
+		CHECK(y.v.seq == s.seq && y.v.value == -3.0, "y after the header was restored: %g",
+		      y.v.value);
 	}
 	arflex_port_close(&w);
 	nopen--;
