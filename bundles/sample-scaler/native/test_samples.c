@@ -523,7 +523,9 @@ static uint64_t update_errors(struct arflex_host *h)
 {
 	struct arflex_stats st;
 
-	return arflex_ctl_stats_read(h->ctl, &st) == 0 ? st.update_errors : 0;
+	while (arflex_ctl_stats_read(h->ctl, &st) != 0)
+		; /* the RT thread is updating the block: read again */
+	return st.update_errors;
 }
 
 /* Writes @n values into the counter's count segment through @w; true when the scaler's
@@ -574,6 +576,9 @@ static int case_nan(void)
 	CHECK(arflex_port_open(&w, arflex_host_output_name(&counter_h, "count"), true, true,
 			       ARFLEX_PORT_STATE, &sample_port_type) == 0, "open count for writing");
 	nopen++;
+	/* The counter may have stopped between completing a slot and publishing head: skip one
+	 * index so that no value of ours carries the seq the scaler read last. */
+	w.next_idx++;
 	deadline = arflex_sys_now_ns() + 20 * MS;
 	while (arflex_sys_now_ns() < deadline)
 		reader_poll(&y); /* drain: y's last value before the bad input */
