@@ -2,7 +2,6 @@
 #include "arflex/safety_gate.h"
 
 #include <errno.h>
-#include <math.h>
 #include <string.h>
 
 void arflex_safety_gate_init(struct arflex_safety_gate *g, struct arflex_input *in,
@@ -14,11 +13,11 @@ void arflex_safety_gate_init(struct arflex_safety_gate *g, struct arflex_input *
 	g->verdict = ARFLEX_SAFETY_NO_PROVIDER;
 }
 
-bool arflex_safety_state_valid(const struct arflex_safety_state *s)
+/* A known mode, and the bounds arflex.SafetyState declares (finite fields, power scale in
+ * [0, 1], forces >= 0: the generated arflex_safety_state_valid). */
+static bool state_ok(const struct arflex_safety_state *s)
 {
-	return s->mode <= ARFLEX_SAFETY_STATE_MODE_PROTECTIVE_STOP && isfinite(s->power_scale) &&
-	       s->power_scale >= 0.0 && s->power_scale <= 1.0 && isfinite(s->force_norm) &&
-	       s->force_norm >= 0.0 && isfinite(s->force_limit) && s->force_limit >= 0.0;
+	return s->mode <= ARFLEX_SAFETY_STATE_MODE_PROTECTIVE_STOP && arflex_safety_state_valid(s);
 }
 
 bool arflex_safety_permits(enum arflex_safety_verdict v)
@@ -50,7 +49,7 @@ static enum arflex_safety_verdict judge(struct arflex_safety_gate *g, struct arf
 		return ARFLEX_SAFETY_NO_PROVIDER;
 	r = arflex_state_read(p, &s, sizeof(s), NULL);
 	if (r == 1) {
-		g->bad = !arflex_safety_state_valid(&s);
+		g->bad = !state_ok(&s);
 		if (g->bad) {
 			g->rejected++;
 			g->seen = false; /* the last valid value is not the provider's word now */

@@ -328,6 +328,43 @@ static void stream_drop_oldest_exact_counts(void **state)
 	stream_counts_exact(ARFLEX_OVERFLOW_DROP_OLDEST, "oldest");
 }
 
+/* Every state read re-checks the mapped header: an overwritten magic or geometry is -EPROTO
+ * (the value is not copied), and reads resume once the header is restored. */
+static void state_read_refuses_a_damaged_header(void **state)
+{
+	struct arflex_port_spec spec = { .method = ARFLEX_PORT_STATE, .type = sample_type };
+	struct arflex_port mgr, w, r;
+	struct sample v, got;
+	char name[ARFLEX_OBJ_NAME_SIZE];
+
+	(void)state;
+	th_rid(rid, sizeof(rid), "hdr");
+	name_of(name, "x");
+	assert_int_equal(arflex_port_create(&mgr, name, &spec), 0);
+	assert_int_equal(arflex_port_open(&w, name, true, true, ARFLEX_PORT_STATE, &sample_type), 0);
+	assert_int_equal(arflex_port_open(&r, name, false, false, ARFLEX_PORT_STATE, &sample_type), 0);
+	fill(&v, 1);
+	assert_int_equal(arflex_state_write(&w, &v, sizeof(v)), 0);
+	mgr.hdr->magic = 0;
+	memset(&got, 0, sizeof(got));
+	assert_int_equal(arflex_state_read(&r, &got, sizeof(got), NULL), -EPROTO);
+	assert_int_equal(got.seq, 0); /* not copied */
+	mgr.hdr->magic = ARFLEX_PORT_MAGIC;
+	assert_int_equal(arflex_state_read(&r, &got, sizeof(got), NULL), 1);
+	assert_true(intact(&got));
+	mgr.hdr->depth = 2;
+	fill(&v, 2);
+	assert_int_equal(arflex_state_write(&w, &v, sizeof(v)), 0);
+	assert_int_equal(arflex_state_read(&r, &got, sizeof(got), NULL), -EPROTO);
+	mgr.hdr->depth = 1;
+	assert_int_equal(arflex_state_read(&r, &got, sizeof(got), NULL), 1);
+	assert_true(intact(&got));
+	arflex_port_close(&r);
+	arflex_port_close(&w);
+	assert_int_equal(arflex_port_destroy(&mgr), 0);
+	th_assert_clean(rid);
+}
+
 static void stream_single_process_semantics(void **state)
 {
 	struct arflex_port_spec spec = {
@@ -461,6 +498,7 @@ int main(void)
 		cmocka_unit_test(state_port_no_torn_no_lost),
 		cmocka_unit_test(port_open_checks_type),
 		cmocka_unit_test(port_age_and_header_recheck),
+		cmocka_unit_test(state_read_refuses_a_damaged_header),
 		cmocka_unit_test(stream_single_process_semantics),
 		cmocka_unit_test(stream_drop_newest_exact_counts),
 		cmocka_unit_test(stream_drop_oldest_exact_counts),

@@ -16,6 +16,12 @@
  * input's seq and time are carried through, so a reader can match y to x). No new value: no
  * write. Input unbound (UNBIND, or never bound): y stops changing; with safe mode "zero" one
  * sample { last seq, now, 0.0 } is written when the input goes away, then nothing.
+ *
+ * Validation (contracts/README.md "Valid values"): an input value that fails
+ * arflex_sample_valid (NaN, infinity) is not used: update returns -EINVAL (counted in
+ * stats.update_errors) and y holds the last valid value. A product that is not finite
+ * (overflow) is refused the same way with -ERANGE. A damaged input header is -EPROTO from the
+ * read (counted the same way, and in the ARFLEX_WARN_INPUT warning).
  */
 #include <errno.h>
 #include <stdint.h>
@@ -115,10 +121,14 @@ static int scaler_update(struct arflex_component *c, void *user, uint64_t releas
 	k->was_bound = true;
 	if (ret <= 0)
 		return ret; /* 0: no new value this cycle */
-	k->last_in = in;
+	if (!arflex_sample_valid(&in))
+		return -EINVAL; /* not used: y holds the last valid value */
 	out.seq = in.seq;
 	out.t_ns = in.t_ns;
 	out.value = arflex_param_f64(c, k->p_gain) * in.value;
+	if (!arflex_sample_valid(&out))
+		return -ERANGE;
+	k->last_in = in;
 	return scaler_emit(k, &out);
 }
 

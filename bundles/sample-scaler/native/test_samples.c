@@ -3,7 +3,7 @@
  * API, wired together as the DRCR would wire them (counter.count -> scaler.x).
  *
  *   test_samples <case> <sample-counter exe> <sample-scaler exe>
- *   cases: counter, scale, set_param, unbind, safe
+ *   cases: counter, scale, set_param, unbind, safe, nan
  *
  * Every case creates its objects under its own runtime id, and ends by checking that no
  * /dev/shm/arflex.<rid>.* or /dev/mqueue/arflex.<rid>.* object and no child process is left.
@@ -15,6 +15,7 @@
 #include <fcntl.h>
 #include <mqueue.h>
 #include <math.h>
+#include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -518,6 +519,128 @@ out:
 	return 0;
 }
 
+static uint64_t update_errors(struct arflex_host *h)
+{
+	struct arflex_stats st;
+
+	while (arflex_ctl_stats_read(h->ctl, &st) != 0)
+		; /* the RT thread is updating the block: read again */
+	return st.update_errors;
+}
+
+/* Writes @n values into the counter's count segment through @w; true when the scaler's
+ * update_errors grew past @errs meanwhile (it took at least one), *@y_bad set when y showed a
+ * non-finite value. */
+static bool inject(struct arflex_port *w, struct reader *y, double value, unsigned n,
+		   uint64_t errs, bool *y_bad)
+{
+	uint64_t deadline = arflex_sys_now_ns() + WAIT_TIMEOUT;
+	struct arflex_sample s = { .seq = 1u << 30, .value = value };
+
+	for (unsigned i = 0; i < n && arflex_sys_now_ns() < deadline; i++) {
+		s.seq++;
+		s.t_ns = (int64_t)arflex_sys_now_ns();
+		arflex_state_write(w, &s, sizeof(s));
+		/* wait for the scaler to take it: an error counted, then 2 ms for y */
+		while (update_errors(&scaler_h) <= errs + i && arflex_sys_now_ns() < deadline)
+			if (reader_poll(y) == 1 && !isfinite(y->v.value))
+				*y_bad = true;
+	}
+	return update_errors(&scaler_h) > errs;
+}
+
+/* rt.sample.nan: NaN and infinity written into counter.count (the counter stopped) are not
+ * used by the scaler: y never carries them and holds its last value, every bad input counts
+ * an update error; a valid value after them is scaled again, an overwritten segment header
+ * is counted in ARFLEX_WARN_INPUT, and after all that the counter's flow is scaled again. */
+static int case_nan(void)
+{
+	struct reader x, y;
+	struct arflex_port w;
+	unsigned n_old, n_new;
+	uint64_t errs, held_seq, deadline;
+	bool y_bad = false, stopped = false;
+	int nopen = 0;
+
+	CHECK(make_counter() == 0, "counter create/spawn");
+	CHECK(make_scaler(1.5) == 0, "scaler create/spawn");
+	CHECK(reader_open(&x, &counter_h, "count") == 0, "open count");
+	nopen++;
+	CHECK(reader_open(&y, &scaler_h, "y") == 0, "open y");
+	nopen++;
+	CHECK(start_pair(true) == 0, "start");
+	CHECK(match_outputs(&x, &y, 50, 1.5, 1.5, UINT64_MAX, &n_old, &n_new) == 0, "before");
+	/* The counter stops writing; the test writes its segment instead. */
+	CHECK(kill(counter_h.pid, SIGSTOP) == 0, "SIGSTOP counter");
+	stopped = true;
+	CHECK(arflex_port_open(&w, arflex_host_output_name(&counter_h, "count"), true, true,
+			       ARFLEX_PORT_STATE, &sample_port_type) == 0, "open count for writing");
+	nopen++;
+	/* The counter may have stopped between completing a slot and publishing head: skip one
+	 * index so that no value of ours carries the seq the scaler read last. */
+	w.next_idx++;
+	deadline = arflex_sys_now_ns() + 20 * MS;
+	while (arflex_sys_now_ns() < deadline)
+		reader_poll(&y); /* drain: y's last value before the bad input */
+	held_seq = y.v.seq;
+	errs = update_errors(&scaler_h);
+	CHECK(inject(&w, &y, NAN, 20, errs, &y_bad), "NaN: no update error counted (%llu)",
+	      (unsigned long long)update_errors(&scaler_h));
+	CHECK(inject(&w, &y, INFINITY, 5, errs + 20, &y_bad), "Inf: no update error counted");
+	CHECK(update_errors(&scaler_h) >= errs + 25, "%llu update errors for 25 bad values",
+	      (unsigned long long)(update_errors(&scaler_h) - errs));
+	CHECK(!y_bad, "y carried a non-finite value");
+	CHECK(y.v.seq == held_seq && isfinite(y.v.value), "y did not hold: seq %llu value %g",
+	      (unsigned long long)y.v.seq, y.v.value);
+	/* A valid value flows again. */
+	{
+		struct arflex_sample s = { .seq = 7u << 30, .value = 2.0 };
+
+		s.t_ns = (int64_t)arflex_sys_now_ns();
+		CHECK(arflex_state_write(&w, &s, sizeof(s)) == 0, "write 2.0");
+		deadline = arflex_sys_now_ns() + WAIT_TIMEOUT;
+		while (y.v.seq != s.seq && arflex_sys_now_ns() < deadline)
+			reader_poll(&y);
+		CHECK(y.v.seq == s.seq && y.v.value == 3.0, "y after a valid value: seq %llu %g",
+		      (unsigned long long)y.v.seq, y.v.value);
+		/* An overwritten header is noticed by the read (ARFLEX_WARN_INPUT); restored, the
+		 * next value flows. */
+		w.hdr->magic ^= 1;
+		deadline = arflex_sys_now_ns() + WAIT_TIMEOUT;
+		while (__atomic_load_n(&scaler_h.ctl->warnings[ARFLEX_WARN_INPUT], __ATOMIC_RELAXED) == 0 &&
+		       arflex_sys_now_ns() < deadline)
+			;
+		w.hdr->magic ^= 1;
+		CHECK(scaler_h.ctl->warnings[ARFLEX_WARN_INPUT] > 0, "damaged header not counted");
+		s.seq++;
+		s.value = -2.0;
+		CHECK(arflex_state_write(&w, &s, sizeof(s)) == 0, "write -2.0");
+		while (y.v.seq != s.seq && arflex_sys_now_ns() < deadline)
+			reader_poll(&y);
+		CHECK(y.v.seq == s.seq && y.v.value == -3.0, "y after the header was restored: %g",
+		      y.v.value);
+	}
+	arflex_port_close(&w);
+	nopen--;
+	CHECK(kill(counter_h.pid, SIGCONT) == 0, "SIGCONT counter");
+	stopped = false;
+	CHECK(match_outputs(&x, &y, 50, 1.5, 1.5, UINT64_MAX, &n_old, &n_new) == 0, "after");
+	CHECK(arflex_host_shutdown(&scaler_h, CALL_TIMEOUT) == 0, "SHUTDOWN scaler");
+	CHECK(arflex_host_shutdown(&counter_h, CALL_TIMEOUT) == 0, "SHUTDOWN counter");
+out:
+	if (failures)
+		dump();
+	if (stopped)
+		kill(counter_h.pid, SIGCONT);
+	if (nopen > 2)
+		arflex_port_close(&w);
+	if (nopen > 1)
+		arflex_port_close(&y.port);
+	if (nopen > 0)
+		arflex_port_close(&x.port);
+	return 0;
+}
+
 int main(int argc, char **argv)
 {
 	static const struct {
@@ -529,11 +652,12 @@ int main(int argc, char **argv)
 		{ "set_param", case_set_param },
 		{ "unbind", case_unbind },
 		{ "safe", case_safe },
+		{ "nan", case_nan },
 	};
 	int (*fn)(void) = NULL;
 
 	if (argc != 4) {
-		fprintf(stderr, "usage: %s counter|scale|set_param|unbind|safe <sample-counter> "
+		fprintf(stderr, "usage: %s counter|scale|set_param|unbind|safe|nan <sample-counter> "
 			"<sample-scaler>\n", argv[0]);
 		return 2;
 	}

@@ -3,6 +3,8 @@
 #ifndef ARFLEX_TYPES_JOINT_REF_H
 #define ARFLEX_TYPES_JOINT_REF_H
 
+#include <math.h>
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -37,5 +39,14 @@ ARFLEX_TYPES_STATIC_ASSERT(sizeof(struct arflex_joint_ref) == 64, "arflex.JointR
 ARFLEX_TYPES_STATIC_ASSERT(offsetof(struct arflex_joint_ref, t_ns) == 0, "arflex.JointRef.t_ns offset");
 ARFLEX_TYPES_STATIC_ASSERT(offsetof(struct arflex_joint_ref, seq) == 8, "arflex.JointRef.seq offset");
 ARFLEX_TYPES_STATIC_ASSERT(offsetof(struct arflex_joint_ref, q) == 16, "arflex.JointRef.q offset");
+
+/** True when every field with declared bounds is within them (q finite). RT safe. */
+static inline bool arflex_joint_ref_valid(const struct arflex_joint_ref *v)
+{
+	for (size_t i = 0; i < 6u; i++)
+		if (!isfinite(v->q[i]))
+			return false;
+	return true;
+}
 
 #endif /* ARFLEX_TYPES_JOINT_REF_H */

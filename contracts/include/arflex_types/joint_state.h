@@ -3,6 +3,8 @@
 #ifndef ARFLEX_TYPES_JOINT_STATE_H
 #define ARFLEX_TYPES_JOINT_STATE_H
 
+#include <math.h>
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -41,5 +43,20 @@ ARFLEX_TYPES_STATIC_ASSERT(offsetof(struct arflex_joint_state, seq) == 8, "arfle
 ARFLEX_TYPES_STATIC_ASSERT(offsetof(struct arflex_joint_state, q) == 16, "arflex.JointState.q offset");
 ARFLEX_TYPES_STATIC_ASSERT(offsetof(struct arflex_joint_state, qd) == 64, "arflex.JointState.qd offset");
 ARFLEX_TYPES_STATIC_ASSERT(offsetof(struct arflex_joint_state, tau) == 112, "arflex.JointState.tau offset");
+
+/** True when every field with declared bounds is within them (q finite; qd finite; tau finite). RT safe. */
+static inline bool arflex_joint_state_valid(const struct arflex_joint_state *v)
+{
+	for (size_t i = 0; i < 6u; i++)
+		if (!isfinite(v->q[i]))
+			return false;
+	for (size_t i = 0; i < 6u; i++)
+		if (!isfinite(v->qd[i]))
+			return false;
+	for (size_t i = 0; i < 6u; i++)
+		if (!isfinite(v->tau[i]))
+			return false;
+	return true;
+}
 
 #endif /* ARFLEX_TYPES_JOINT_STATE_H */

@@ -3,6 +3,8 @@
 #ifndef ARFLEX_TYPES_SAFETY_STATE_H
 #define ARFLEX_TYPES_SAFETY_STATE_H
 
+#include <math.h>
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -58,5 +60,17 @@ ARFLEX_TYPES_STATIC_ASSERT(offsetof(struct arflex_safety_state, flags) == 20, "a
 ARFLEX_TYPES_STATIC_ASSERT(offsetof(struct arflex_safety_state, power_scale) == 24, "arflex.SafetyState.power_scale offset");
 ARFLEX_TYPES_STATIC_ASSERT(offsetof(struct arflex_safety_state, force_norm) == 32, "arflex.SafetyState.force_norm offset");
 ARFLEX_TYPES_STATIC_ASSERT(offsetof(struct arflex_safety_state, force_limit) == 40, "arflex.SafetyState.force_limit offset");
+
+/** True when every field with declared bounds is within them (power_scale finite, 0..1; force_norm finite, 0..; force_limit finite, 0..). RT safe. */
+static inline bool arflex_safety_state_valid(const struct arflex_safety_state *v)
+{
+	if (!(isfinite(v->power_scale) && v->power_scale >= 0.0 && v->power_scale <= 1.0))
+		return false;
+	if (!(isfinite(v->force_norm) && v->force_norm >= 0.0))
+		return false;
+	if (!(isfinite(v->force_limit) && v->force_limit >= 0.0))
+		return false;
+	return true;
+}
 
 #endif /* ARFLEX_TYPES_SAFETY_STATE_H */

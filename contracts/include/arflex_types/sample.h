@@ -3,6 +3,8 @@
 #ifndef ARFLEX_TYPES_SAMPLE_H
 #define ARFLEX_TYPES_SAMPLE_H
 
+#include <math.h>
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -37,5 +39,13 @@ ARFLEX_TYPES_STATIC_ASSERT(sizeof(struct arflex_sample) == 24, "arflex.Sample si
 ARFLEX_TYPES_STATIC_ASSERT(offsetof(struct arflex_sample, seq) == 0, "arflex.Sample.seq offset");
 ARFLEX_TYPES_STATIC_ASSERT(offsetof(struct arflex_sample, t_ns) == 8, "arflex.Sample.t_ns offset");
 ARFLEX_TYPES_STATIC_ASSERT(offsetof(struct arflex_sample, value) == 16, "arflex.Sample.value offset");
+
+/** True when every field with declared bounds is within them (value finite). RT safe. */
+static inline bool arflex_sample_valid(const struct arflex_sample *v)
+{
+	if (!isfinite(v->value))
+		return false;
+	return true;
+}
 
 #endif /* ARFLEX_TYPES_SAMPLE_H */

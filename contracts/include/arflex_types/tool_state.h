@@ -3,6 +3,8 @@
 #ifndef ARFLEX_TYPES_TOOL_STATE_H
 #define ARFLEX_TYPES_TOOL_STATE_H
 
+#include <math.h>
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -58,5 +60,12 @@ ARFLEX_TYPES_STATIC_ASSERT(offsetof(struct arflex_tool_state, tcp_quat) == 48, "
 ARFLEX_TYPES_STATIC_ASSERT(offsetof(struct arflex_tool_state, mass) == 80, "arflex.ToolState.mass offset");
 ARFLEX_TYPES_STATIC_ASSERT(offsetof(struct arflex_tool_state, com) == 88, "arflex.ToolState.com offset");
 ARFLEX_TYPES_STATIC_ASSERT(offsetof(struct arflex_tool_state, command) == 112, "arflex.ToolState.command offset");
+
+/** True when every field with declared bounds is within them (none declared). RT safe. */
+static inline bool arflex_tool_state_valid(const struct arflex_tool_state *v)
+{
+	(void)v;
+	return true;
+}
 
 #endif /* ARFLEX_TYPES_TOOL_STATE_H */

@@ -3,6 +3,8 @@
 #ifndef ARFLEX_TYPES_WRENCH_H
 #define ARFLEX_TYPES_WRENCH_H
 
+#include <math.h>
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -39,5 +41,17 @@ ARFLEX_TYPES_STATIC_ASSERT(offsetof(struct arflex_wrench, t_ns) == 0, "arflex.Wr
 ARFLEX_TYPES_STATIC_ASSERT(offsetof(struct arflex_wrench, seq) == 8, "arflex.Wrench.seq offset");
 ARFLEX_TYPES_STATIC_ASSERT(offsetof(struct arflex_wrench, force) == 16, "arflex.Wrench.force offset");
 ARFLEX_TYPES_STATIC_ASSERT(offsetof(struct arflex_wrench, torque) == 40, "arflex.Wrench.torque offset");
+
+/** True when every field with declared bounds is within them (force finite; torque finite). RT safe. */
+static inline bool arflex_wrench_valid(const struct arflex_wrench *v)
+{
+	for (size_t i = 0; i < 3u; i++)
+		if (!isfinite(v->force[i]))
+			return false;
+	for (size_t i = 0; i < 3u; i++)
+		if (!isfinite(v->torque[i]))
+			return false;
+	return true;
+}
 
 #endif /* ARFLEX_TYPES_WRENCH_H */

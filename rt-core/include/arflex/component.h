@@ -157,7 +157,8 @@ ARFLEX_API struct arflex_port *arflex_input_port(struct arflex_input *in);
 /** arflex_port_age on the bound provider (age of its newest value at @now_ns, header
  *  re-checked); -ENOTCONN when unbound. RT safe. */
 ARFLEX_API int arflex_input_age(const struct arflex_input *in, uint64_t now_ns, uint64_t *age_ns);
-/** arflex_state_read on the bound provider; -ENOTCONN when unbound. */
+/** arflex_state_read on the bound provider; -ENOTCONN when unbound. A damaged provider
+ *  header (-EPROTO) is also counted in the ARFLEX_WARN_INPUT warning. RT safe. */
 ARFLEX_API int arflex_input_state_read(struct arflex_input *in, void *out, size_t len,
 				       uint64_t *seq);
 /** arflex_stream_pop on the bound provider; -ENOTCONN when unbound. */

@@ -203,7 +203,9 @@ ARFLEX_API int arflex_state_write(struct arflex_port *p, const void *val, size_t
  * Reads the latest value into @out (@len <= elem_size bytes copied) if it is newer than the
  * one this handle returned last. Returns 1 (new value, *@seq = its write count if @seq is not
  * NULL), 0 (no new value, or the writer kept it busy for ARFLEX_STATE_READ_RETRIES attempts:
- * @out untouched), -EINVAL. RT safe.
+ * @out untouched), -EPROTO (the segment header no longer matches what was opened: magic,
+ * method or geometry overwritten; @out untouched; reads succeed again once it is restored),
+ * -EINVAL. RT safe.
  */
 ARFLEX_API int arflex_state_read(struct arflex_port *p, void *out, size_t len, uint64_t *seq);
 

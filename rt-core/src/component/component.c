@@ -134,7 +134,14 @@ int arflex_input_age(const struct arflex_input *in, uint64_t now_ns, uint64_t *a
 
 int arflex_input_state_read(struct arflex_input *in, void *out, size_t len, uint64_t *seq)
 {
-	return in->cur ? arflex_state_read(in->cur, out, len, seq) : -ENOTCONN;
+	int r;
+
+	if (!in->cur)
+		return -ENOTCONN;
+	r = arflex_state_read(in->cur, out, len, seq);
+	if (r == -EPROTO && in->warnings)
+		__atomic_add_fetch(&in->warnings[ARFLEX_WARN_INPUT], 1, __ATOMIC_RELAXED);
+	return r;
 }
 
 int arflex_input_stream_pop(struct arflex_input *in, void *out, size_t len)
@@ -214,6 +221,7 @@ int arflex_component_input(struct arflex_component *c, const char *port,
 	in->type = *type;
 	in->type.name = in->type_name;
 	in->method = method;
+	in->warnings = c->ctl->warnings;
 	*out = in;
 	return 0;
 }

@@ -29,6 +29,7 @@ struct arflex_input {
 	uint32_t done_seq;            /* RT: requests taken */
 	uint32_t binding;             /* RT: providers taken (arflex_input_binding) */
 	bool bound;                   /* mailbox thread's view */
+	uint64_t *warnings;           /* the control block's warning counters */
 };
 
 struct arflex_component {

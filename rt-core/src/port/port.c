@@ -253,6 +253,14 @@ int arflex_state_write(struct arflex_port *p, const void *val, size_t len)
 	return 0;
 }
 
+/* The identification cannot change while mapped: anything else is damage (an overwritten
+ * header). Relaxed loads of one cache line, cheap enough for every read. */
+static inline bool hdr_intact(const struct arflex_port *p)
+{
+	return LOADR(&p->hdr->magic) == ARFLEX_PORT_MAGIC && LOADR(&p->hdr->method) == p->method &&
+	       LOADR(&p->hdr->slot_stride) == p->stride && LOADR(&p->hdr->depth) == p->depth;
+}
+
 int arflex_port_age(const struct arflex_port *p, uint64_t now_ns, uint64_t *age_ns)
 {
 	const struct arflex_slot_hdr *s;
@@ -260,9 +268,7 @@ int arflex_port_age(const struct arflex_port *p, uint64_t now_ns, uint64_t *age_
 
 	if (!p->hdr || !age_ns)
 		return -EINVAL;
-	/* the identification cannot change while mapped: anything else is damage */
-	if (LOADR(&p->hdr->magic) != ARFLEX_PORT_MAGIC || LOADR(&p->hdr->method) != p->method ||
-	    LOADR(&p->hdr->slot_stride) != p->stride || LOADR(&p->hdr->depth) != p->depth)
+	if (!hdr_intact(p))
 		return -EPROTO;
 	head = LOAD(&p->hdr->head);
 	if (head == 0)
@@ -279,6 +285,8 @@ int arflex_state_read(struct arflex_port *p, void *out, size_t len, uint64_t *se
 
 	if (!p->hdr || p->method != ARFLEX_PORT_STATE || len > p->elem_size)
 		return -EINVAL;
+	if (!hdr_intact(p))
+		return -EPROTO;
 	s = slot(p, 0);
 	for (int i = 0; i < ARFLEX_STATE_READ_RETRIES; i++) {
 		uint64_t s1 = LOAD(&s->seq), s2;

@@ -82,10 +82,6 @@ ARFLEX_API bool arflex_safety_permits(enum arflex_safety_verdict v);
 /** Power fraction the verdict allows: 1 NORMAL, state.power_scale LIMITED, 0 otherwise. */
 ARFLEX_API double arflex_safety_gate_scale(const struct arflex_safety_gate *g);
 
-/** True when @s is a valid arflex.SafetyState value (known mode, finite fields, power scale
- *  in [0, 1], forces >= 0). */
-ARFLEX_API bool arflex_safety_state_valid(const struct arflex_safety_state *s);
-
 /** Short English name of a verdict ("stale", "no provider", ...). */
 ARFLEX_API const char *arflex_safety_verdict_name(enum arflex_safety_verdict v);
 

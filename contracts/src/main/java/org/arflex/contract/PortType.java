@@ -1,6 +1,9 @@
 package org.arflex.contract;
 
+import java.nio.ByteBuffer;
+import java.nio.ByteOrder;
 import java.nio.charset.StandardCharsets;
+import java.util.ArrayList;
 import java.util.List;
 import java.util.Optional;
 import java.util.Set;
@@ -92,13 +95,92 @@ public record PortType(String name, TypeVersion version, Set<PortSpec.Method> me
      * @param padding     true for an explicit pad
      * @param unit        unit text, may be empty
      * @param description free text
+     * @param bounds      what a valid value of each element is ({@link Bounds#NONE} when nothing is declared)
      */
     public record Field(String name, Scalar scalar, int count, boolean array, int offset, boolean padding,
-            String unit, String description) {
+            String unit, String description, Bounds bounds) {
+        public Field {
+            bounds = bounds == null ? Bounds.NONE : bounds;
+        }
+
         /** Size in bytes. */
         public int size() {
             return scalar.size() * count;
         }
+    }
+
+    /**
+     * Validation metadata of a floating-point field (spec §13.2): every element must be finite
+     * (no NaN, no infinity) when {@code finite}, and within {@code min..max} when declared (a NaN
+     * is never within a range). Not part of the layout: it changes neither size, offsets nor the
+     * type id, so adding it is no version change (§13.4).
+     *
+     * @param finite NaN and ±infinity are invalid
+     * @param min    smallest valid value, {@code -Infinity} when not declared
+     * @param max    largest valid value, {@code +Infinity} when not declared
+     */
+    public record Bounds(boolean finite, double min, double max) {
+        /** Nothing declared: every value is valid. */
+        public static final Bounds NONE = new Bounds(false, Double.NEGATIVE_INFINITY, Double.POSITIVE_INFINITY);
+
+        /** True when a lower bound was declared. */
+        public boolean hasMin() {
+            return min != Double.NEGATIVE_INFINITY;
+        }
+
+        /** True when an upper bound was declared. */
+        public boolean hasMax() {
+            return max != Double.POSITIVE_INFINITY;
+        }
+
+        /** True when anything is declared. */
+        public boolean declared() {
+            return finite || hasMin() || hasMax();
+        }
+
+        /** True when {@code v} is a valid element value. */
+        public boolean accepts(double v) {
+            if (finite && !Double.isFinite(v)) {
+                return false;
+            }
+            return !(hasMin() || hasMax()) || (v >= min && v <= max);
+        }
+
+        /** The bounds as a reader sees them, e.g. {@code finite, 0..1}; empty for {@link #NONE}. */
+        @Override
+        public String toString() {
+            String range = hasMin() || hasMax()
+                    ? (hasMin() ? num(min) : "") + ".." + (hasMax() ? num(max) : "") : "";
+            return finite ? (range.isEmpty() ? "finite" : "finite, " + range) : range;
+        }
+
+        private static String num(double d) {
+            return d == Math.rint(d) && Math.abs(d) < 1e15 ? Long.toString((long) d) : Double.toString(d);
+        }
+    }
+
+    /**
+     * The fields of the value at byte {@code at} of {@code b} (little endian) that violate their
+     * {@link Bounds}, one text per bad element ({@code power_scale = 1.5, not finite, 0..1}); empty
+     * when the value is valid. For monitors and the console; the RT check is the generated C
+     * function {@code arflex_<type>_valid}.
+     */
+    public List<String> violations(ByteBuffer b, int at) {
+        ByteBuffer le = b.duplicate().order(ByteOrder.LITTLE_ENDIAN);
+        List<String> out = new ArrayList<>();
+        for (Field f : fields) {
+            if (f.padding() || !f.bounds().declared()) {
+                continue;
+            }
+            for (int i = 0; i < f.count(); i++) {
+                int pos = at + f.offset() + i * f.scalar().size();
+                double v = f.scalar() == Scalar.F32 ? le.getFloat(pos) : le.getDouble(pos);
+                if (!f.bounds().accepts(v)) {
+                    out.add(f.name() + (f.array() ? "[" + i + "]" : "") + " = " + v + ", not " + f.bounds());
+                }
+            }
+        }
+        return out;
     }
 
     /**

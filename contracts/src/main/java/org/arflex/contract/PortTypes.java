@@ -242,14 +242,16 @@ public final class PortTypes {
             if (m.pad) {
                 String field = "pad[" + pads + "]/@bytes";
                 Integer n = m.bytes == null ? null : Values.integer(m.bytes);
-                if (m.name != null || m.type != null || m.count != null || m.unit != null) {
+                if (m.name != null || m.type != null || m.count != null || m.unit != null || m.finite != null
+                        || m.min != null || m.max != null) {
                     p.at(m, "13.2", "pad[" + pads + "]", "a pad has only a bytes attribute");
                 }
                 if (n == null || n < 1 || n > 64) {
                     p.at(m, "13.2", field, m.bytes == null ? "required attribute is missing"
                             : "'" + m.bytes + "' is not a byte count 1..64");
                 } else {
-                    fields.add(new PortType.Field("_pad" + pads, PortType.Scalar.U8, n, true, offset, true, "", ""));
+                    fields.add(new PortType.Field("_pad" + pads, PortType.Scalar.U8, n, true, offset, true, "", "",
+                            PortType.Bounds.NONE));
                     offset += n;
                 }
                 pads++;
@@ -294,7 +296,7 @@ public final class PortTypes {
                             + "\"/> before it or reorder fields");
                 }
                 fields.add(new PortType.Field(fname, scalar, count, m.count != null, offset, false, unit,
-                        Values.text(m.text)));
+                        Values.text(m.text), bounds(m, base, scalar, p)));
                 offset += scalar.size() * count;
             }
         }
@@ -337,6 +339,36 @@ public final class PortTypes {
         }
         return new PortType(name, version, methods, fields, constants, offset, maxPayload,
                 x.description == null ? "" : x.description.value.trim(), src);
+    }
+
+    /** The {@code finite}, {@code min}, {@code max} attributes of a field (§13.2), only on f32 and f64. */
+    private static PortType.Bounds bounds(PortTypeXml.Member m, String base, PortType.Scalar scalar, Problems p) {
+        if (m.finite == null && m.min == null && m.max == null) {
+            return PortType.Bounds.NONE;
+        }
+        if (scalar != PortType.Scalar.F32 && scalar != PortType.Scalar.F64) {
+            p.at(m, "13.2", base, "finite, min and max apply to f32 and f64 fields only");
+            return PortType.Bounds.NONE;
+        }
+        Boolean finite = m.finite == null ? Boolean.FALSE : Values.bool(m.finite);
+        if (finite == null) {
+            p.at(m, "13.2", base + "/@finite", "'" + m.finite + "' is not true or false");
+        }
+        Double min = m.min == null ? Double.valueOf(Double.NEGATIVE_INFINITY) : Values.decimal(m.min);
+        if (min == null) {
+            p.at(m, "13.2", base + "/@min", "'" + m.min + "' is not a finite decimal number");
+        }
+        Double max = m.max == null ? Double.valueOf(Double.POSITIVE_INFINITY) : Values.decimal(m.max);
+        if (max == null) {
+            p.at(m, "13.2", base + "/@max", "'" + m.max + "' is not a finite decimal number");
+        }
+        if (finite == null || min == null || max == null) {
+            return PortType.Bounds.NONE;
+        }
+        if (min > max) {
+            p.at(m, "13.2", base + "/@min", "min " + m.min + " is greater than max " + m.max);
+        }
+        return new PortType.Bounds(finite, min, max);
     }
 
     private static boolean fits(PortType.Scalar s, long v) {

@@ -196,4 +196,53 @@ class PortTypesTest {
         ContractException e = assertThrows(ContractException.class, () -> PortTypes.load(dir));
         assertTrue(e.getMessage().contains("must be named arflex.T.xml"), e.getMessage());
     }
+
+    @Test
+    void floatFieldsDeclareFinitenessAndRangesThatTheJavaSideChecks() throws Exception {
+        PortType s = PortTypes.builtin().find("arflex.SafetyState").orElseThrow();
+        PortType.Bounds b = s.field("power_scale").orElseThrow().bounds();
+        assertEquals(new PortType.Bounds(true, 0, 1), b);
+        assertEquals("finite, 0..1", b.toString());
+        assertTrue(b.accepts(0.5) && !b.accepts(Double.NaN) && !b.accepts(1.5) && !b.accepts(-0.1));
+        assertEquals(PortType.Bounds.NONE, PortTypes.builtin().find("arflex.Pose").orElseThrow().field("p").orElseThrow().bounds());
+        for (String[] f : List.of(new String[] {"arflex.JointRef", "q"}, new String[] {"arflex.Sample", "value"},
+                new String[] {"arflex.Wrench", "force"}, new String[] {"arflex.Wrench", "torque"},
+                new String[] {"arflex.JointState", "q"}, new String[] {"arflex.JointState", "qd"},
+                new String[] {"arflex.JointState", "tau"})) {
+            PortType.Bounds fb = PortTypes.builtin().find(f[0]).orElseThrow().field(f[1]).orElseThrow().bounds();
+            assertEquals(new PortType.Bounds(true, Double.NEGATIVE_INFINITY, Double.POSITIVE_INFINITY), fb,
+                    f[0] + "." + f[1]);
+        }
+        PortType js = PortTypes.builtin().find("arflex.JointState").orElseThrow();
+        ByteBuffer v = ByteBuffer.allocate(js.size() + 8);
+        assertEquals(List.of(), js.violations(v, 8));
+        JointStateLayout.qd(v, 8, 2, Double.POSITIVE_INFINITY);
+        JointStateLayout.tau(v, 8, 5, Double.NaN);
+        assertEquals(List.of("qd[2] = Infinity, not finite", "tau[5] = NaN, not finite"), js.violations(v, 8));
+    }
+
+    @Test
+    void generatedHeaderValidatesTheDeclaredBounds() {
+        String h = PortTypeGenerator.generate(PortTypes.builtin()).get("include/arflex_types/safety_state.h");
+        assertTrue(h.contains("static inline bool arflex_safety_state_valid(const struct arflex_safety_state *v)\n{\n"
+                + "\tif (!(isfinite(v->power_scale) && v->power_scale >= 0.0 && v->power_scale <= 1.0))\n"
+                + "\t\treturn false;\n\tif (!(isfinite(v->force_norm) && v->force_norm >= 0.0))\n"), h);
+        String pose = PortTypeGenerator.generate(PortTypes.builtin()).get("include/arflex_types/pose.h");
+        assertTrue(pose.contains("arflex_pose_valid(const struct arflex_pose *v)\n{\n\t(void)v;\n\treturn true;"), pose);
+    }
+
+    @Test
+    void boundsApplyToFloatFieldsOnlyAndMustBeNumbers() throws Exception {
+        List<Problem> p = problems(type("<field name=\"a\" type=\"u64\" finite=\"true\"/>"
+                + "<field name=\"b\" type=\"f64\" finite=\"yes\" min=\"NaN\" max=\"x\"/>"
+                + "<field name=\"c\" type=\"f64\" min=\"2\" max=\"1\"/><pad bytes=\"8\" finite=\"true\"/>"));
+        List<String> fields = p.stream().map(Problem::field).toList();
+        assertEquals(List.of("field[a]", "field[b]/@finite", "field[b]/@min", "field[b]/@max", "field[c]/@min",
+                "pad[0]"), fields, p.toString());
+        PortType ok = PortTypes.parse(new ByteArrayInputStream(type("<field name=\"a\" type=\"f32\" count=\"2\" "
+                + "min=\"-1.5\"/>").getBytes(StandardCharsets.UTF_8)), "t.xml");
+        assertEquals(new PortType.Bounds(false, -1.5, Double.POSITIVE_INFINITY), ok.fields().get(0).bounds());
+        assertTrue(PortTypeGenerator.generate(PortTypes.of(List.of(ok))).get("include/arflex_types/t.h")
+                .contains("\tfor (size_t i = 0; i < 2u; i++)\n\t\tif (!(v->a[i] >= -1.5f))\n"));
+    }
 }

@@ -163,7 +163,7 @@ public final class PortTypeGenerator {
         b.append("/* ").append(MARKER).append(" from contracts/types/").append(t.name())
                 .append(".xml.\n * Do not edit: change the definition and regenerate (contracts/README.md). */\n");
         b.append("#ifndef ARFLEX_TYPES_").append(up).append("_H\n#define ARFLEX_TYPES_").append(up).append("_H\n\n");
-        b.append("#include <stddef.h>\n#include <stdint.h>\n\n");
+        b.append("#include <math.h>\n#include <stdbool.h>\n#include <stddef.h>\n#include <stdint.h>\n\n");
         b.append("#ifndef ARFLEX_TYPES_STATIC_ASSERT\n#ifdef __cplusplus\n#define ARFLEX_TYPES_STATIC_ASSERT static_assert\n")
                 .append("#else\n#define ARFLEX_TYPES_STATIC_ASSERT _Static_assert\n#endif\n#endif\n\n");
         b.append("#define ").append(m).append("_NAME \"").append(t.name()).append("\"\n");
@@ -213,8 +213,61 @@ public final class PortTypeGenerator {
                     .append(") == ").append(f.offset()).append(", \"").append(t.name()).append('.').append(f.name())
                     .append(" offset\");\n");
         }
+        validator(t, st, b);
         b.append("\n#endif /* ARFLEX_TYPES_").append(up).append("_H */\n");
         return b.toString();
+    }
+
+    /**
+     * {@code static inline bool arflex_<type>_valid(const struct arflex_<type> *v)}: true when
+     * every element of every field with declared bounds (finite, min, max) is within them. Inline,
+     * no allocation, no call but isfinite: RT safe. Every header has one (true for a type that
+     * declares nothing), so generic code can always call it.
+     */
+    private static void validator(PortType t, String st, StringBuilder b) {
+        b.append("\n/** True when every field with declared bounds is within them");
+        List<String> decl = new ArrayList<>();
+        for (PortType.Field f : t.fields()) {
+            if (f.bounds().declared()) {
+                decl.add(f.name() + " " + f.bounds());
+            }
+        }
+        b.append(decl.isEmpty() ? " (none declared)" : " (" + String.join("; ", decl) + ")")
+                .append(". RT safe. */\n");
+        b.append("static inline bool ").append(st).append("_valid(const struct ").append(st).append(" *v)\n{\n");
+        if (decl.isEmpty()) {
+            b.append("\t(void)v;\n");
+        }
+        for (PortType.Field f : t.fields()) {
+            if (!f.bounds().declared()) {
+                continue;
+            }
+            String x = "v->" + f.name() + (f.array() ? "[i]" : "");
+            String indent = f.array() ? "\t\t" : "\t";
+            if (f.array()) {
+                b.append("\tfor (size_t i = 0; i < ").append(f.count()).append("u; i++)\n");
+            }
+            List<String> c = checks(f, x);
+            String cond = c.size() == 1 && f.bounds().finite() ? c.get(0) : "(" + String.join(" && ", c) + ")";
+            b.append(indent).append("if (!").append(cond).append(")\n")
+                    .append(indent).append("\treturn false;\n");
+        }
+        b.append("\treturn true;\n}\n");
+    }
+
+    private static List<String> checks(PortType.Field f, String x) {
+        List<String> c = new ArrayList<>();
+        String suffix = f.scalar() == PortType.Scalar.F32 ? "f" : "";
+        if (f.bounds().finite()) {
+            c.add("isfinite(" + x + ")");
+        }
+        if (f.bounds().hasMin()) {
+            c.add(x + " >= " + Double.toString(f.bounds().min()) + suffix);
+        }
+        if (f.bounds().hasMax()) {
+            c.add(x + " <= " + Double.toString(f.bounds().max()) + suffix);
+        }
+        return c;
     }
 
     private static String cConst(PortType.Constant c) {

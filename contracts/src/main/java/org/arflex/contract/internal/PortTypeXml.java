@@ -22,7 +22,7 @@ public final class PortTypeXml extends Located {
     @JsonSetter("pad") void pad(Member m) { m.pad = true; members.add(m); }
     @JsonSetter("const") void constant(Const c) { constants.add(c); }
 
-    /** {@code <field name type count unit>doc</field>} or {@code <pad bytes/>}. */
+    /** {@code <field name type count unit finite min max>doc</field>} or {@code <pad bytes/>}. */
     public static final class Member extends Located {
         public boolean pad;
         @JacksonXmlProperty(isAttribute = true) public String name;
@@ -30,6 +30,9 @@ public final class PortTypeXml extends Located {
         @JacksonXmlProperty(isAttribute = true) public String count;
         @JacksonXmlProperty(isAttribute = true) public String unit;
         @JacksonXmlProperty(isAttribute = true) public String bytes;
+        @JacksonXmlProperty(isAttribute = true) public String finite;
+        @JacksonXmlProperty(isAttribute = true) public String min;
+        @JacksonXmlProperty(isAttribute = true) public String max;
         @JacksonXmlText public String text;
     }
 

@@ -2,6 +2,9 @@ package org.arflex.drcr.impl.abi;
 
 import java.io.IOException;
 import java.nio.charset.StandardCharsets;
+import java.nio.file.Files;
+import java.nio.file.NoSuchFileException;
+import java.nio.file.Path;
 
 /**
  * An output port segment {@code /arflex.<rid>.<inst>.out.<port>}: Java side of struct
@@ -43,9 +46,15 @@ public final class PortSegment implements AutoCloseable {
     public static final long MAX_ELEM = 64L << 20;
 
     private final ShmSegment shm;
+    private final int method;
+    private final int depth;
+    private final int stride;
 
-    private PortSegment(ShmSegment shm) {
+    private PortSegment(ShmSegment shm, int method, int depth, int stride) {
         this.shm = shm;
+        this.method = method;
+        this.depth = depth;
+        this.stride = stride;
     }
 
     /** FNV-1a 64 over the bytes of the type name, as arflex_port_type_hash. */
@@ -99,7 +108,37 @@ public final class PortSegment implements AutoCloseable {
         s.putLong(OFF_TYPE_HASH, typeHash(typeName));
         s.putString(OFF_TYPE_NAME, TYPE_NAME_SIZE, typeName);
         s.setLongRelease(OFF_MAGIC, MAGIC); // ABI.md 6.1: header magic last
-        return new PortSegment(s);
+        return new PortSegment(s, method, d, stride(elemSize));
+    }
+
+    /**
+     * Why this segment is no longer what {@link #create} made, or null when it is intact: the
+     * object in /dev/shm is gone or has another size (checked first: touching the mapping of a
+     * truncated object would fault), or the header's magic, method, depth or slot stride was
+     * overwritten (what rt-core's readers re-check, ABI.md §4).
+     */
+    public String damage() {
+        long now;
+        try {
+            now = Files.size(Path.of("/dev/shm", shm.name()));
+        } catch (NoSuchFileException e) {
+            return "removed from /dev/shm";
+        } catch (IOException e) {
+            return "cannot stat: " + e.getMessage();
+        }
+        if (now != shm.size()) {
+            return "size " + now + " B, created with " + shm.size() + " B";
+        }
+        long magic = shm.getLongAcquire(OFF_MAGIC);
+        if (magic != MAGIC) {
+            return String.format("magic 0x%016x, not 0x%016x", magic, MAGIC);
+        }
+        if (shm.getInt(OFF_METHOD) != method || shm.getInt(OFF_DEPTH) != depth
+                || shm.getInt(OFF_SLOT_STRIDE) != stride) {
+            return "geometry overwritten: method " + shm.getInt(OFF_METHOD) + " depth " + shm.getInt(OFF_DEPTH)
+                    + " stride " + shm.getInt(OFF_SLOT_STRIDE) + ", created " + method + "/" + depth + "/" + stride;
+        }
+        return null;
     }
 
     public String name() {

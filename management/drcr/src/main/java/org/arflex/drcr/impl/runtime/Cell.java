@@ -698,11 +698,13 @@ public final class Cell {
         actor.checkThread();
         Instance inst = require(name);
         if (inst.life.state() == State.FAILED) {
+            List<String> repaired = OutputRepair.dropDamaged(name, inst.outputs, log);
             inst.policy.reset();
             inst.life.to(State.UNSATISFIED, "reset by operator");
             execute(planner.apply(Change.unblock(name)));
             changed();
-            return name + ": reset from FAILED, now " + inst.life.state();
+            return name + ": reset from FAILED, now " + inst.life.state() + (repaired.isEmpty() ? ""
+                    : "; " + String.join("; ", repaired));
         }
         RtHalf half = inst.half;
         if (half == null) {

@@ -63,6 +63,11 @@ public final class ProcessLauncher implements RtLauncher {
             }
 
             @Override
+            public synchronized String damage() {
+                return closed ? null : seg.damage();
+            }
+
+            @Override
             public synchronized void close() {
                 if (!closed) {
                     closed = true;

@@ -33,6 +33,11 @@ public interface RtLauncher {
         /** Elements published by the producer. */
         long published();
 
+        /** Why the segment is damaged (truncated, header overwritten), or null when intact. */
+        default String damage() {
+            return null;
+        }
+
         @Override
         void close();
     }

@@ -214,6 +214,42 @@ class CellTest {
     }
 
     @Test
+    void resetFromFailedRecreatesADamagedOutputSegmentAndKeepsAnIntactOne() throws Exception {
+        installBoth();
+        for (int i = 0; i < 3; i++) {
+            launcher.running.get("prov").crash(139, "killed by signal 11");
+            actor.runAll();
+            actor.advance(500);
+        }
+        assertEquals(State.FAILED, state("prov"));
+        String seg = "/arflex.t.prov.out.y";
+        long creates = launcher.events.stream().filter(e -> e.startsWith("CREATE " + seg + " ")).count();
+        launcher.damaged.put(seg, "size 0 B, created with 4096 B");
+        String reply = actor.call(() -> cell.reset("prov"), 0);
+        assertTrue(reply.contains("output prov.y (" + seg + ") was damaged: size 0 B"), reply);
+        assertTrue(log.stream().anyMatch(l -> l.contains("output prov.y (" + seg + ") was damaged")), log.toString());
+        assertEquals(creates + 1, launcher.events.stream().filter(e -> e.startsWith("CREATE " + seg + " ")).count(),
+                launcher.events.toString());
+        int created = launcher.events.lastIndexOf(launcher.events.stream()
+                .filter(e -> e.startsWith("CREATE " + seg + " ")).reduce((a, b) -> b).orElseThrow());
+        assertTrue(created < launcher.events.lastIndexOf("prov START"), launcher.events.toString());
+        assertEquals(1, launcher.openOutputs.get(seg), "the old segment is closed, one new one open");
+        assertEquals(State.ACTIVE, state("prov"));
+        assertEquals(State.ACTIVE, state("cons"));
+        // an intact segment survives a reset from FAILED
+        launcher.damaged.clear();
+        for (int i = 0; i < 3; i++) {
+            launcher.running.get("prov").crash(139, "killed by signal 11");
+            actor.runAll();
+            actor.advance(500);
+        }
+        assertEquals(State.FAILED, state("prov"));
+        String again = actor.call(() -> cell.reset("prov"), 0);
+        assertFalse(again.contains("damaged"), again);
+        assertEquals(creates + 1, launcher.events.stream().filter(e -> e.startsWith("CREATE " + seg + " ")).count());
+    }
+
+    @Test
     void failingStartUsesTheRestartPolicy() throws Exception {
         launcher.failLaunches.put("prov", 1);
         install(contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us"));

@@ -17,6 +17,8 @@ final class FakeLauncher implements RtLauncher {
     final Map<String, FakeHalf> running = new HashMap<>();
     final List<Spec> specs = new ArrayList<>();
     final Map<String, Integer> openOutputs = new HashMap<>();
+    /** Segment name -> what damage() of its output reports (tests set it). */
+    final Map<String, String> damaged = new HashMap<>();
     /** Instances whose next launches fail. */
     final Map<String, Integer> failLaunches = new HashMap<>();
     private long nextPid = 1000;
@@ -186,6 +188,11 @@ final class FakeLauncher implements RtLauncher {
             @Override
             public long published() {
                 return 0;
+            }
+
+            @Override
+            public String damage() {
+                return closed ? null : damaged.get(segmentName);
             }
 
             @Override
