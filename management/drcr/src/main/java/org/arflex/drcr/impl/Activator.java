@@ -22,6 +22,7 @@ import org.arflex.drcr.impl.services.ResourceManagerImpl;
 import org.arflex.drcr.impl.services.Services;
 import org.arflex.drcr.impl.shell.Commands;
 import org.arflex.drcr.impl.supervisor.ProcessLauncher;
+import org.arflex.drcr.impl.supervisor.VerifiedExecutables;
 import org.arflex.planner.Planner;
 import org.osgi.annotation.bundle.Header;
 import org.osgi.framework.Bundle;
@@ -98,6 +99,8 @@ public final class Activator implements BundleActivator {
         long memory = Commands.parseSize(prop(ctx, "arflex.memory", "1g"));
         long network = Commands.parseSize(prop(ctx, "arflex.network", "125000000"));
         actor = new ThreadActor(log);
+        VerifiedExecutables executables = new VerifiedExecutables(
+                java.nio.file.Path.of(prop(ctx, Constants.FRAMEWORK_STORAGE, "felix-cache")), log);
         Cell.Config cfg = new Cell.Config(rid, Long.parseLong(prop(ctx, "arflex.ready.timeout.ms", "5000")), 3_000,
                 Boolean.parseBoolean(prop(ctx, "arflex.nomlock", "false")), types, Posix::monotonicNs,
                 Boolean.parseBoolean(prop(ctx, "arflex.evaluation", "false")));
@@ -106,7 +109,7 @@ public final class Activator implements BundleActivator {
         cell = actor.call(() -> {
             ResourceManagerImpl tmp = new ResourceManagerImpl(null, cap, reserved);
             Planner planner = new Planner(tmp.capacities(cpus, memory, network));
-            Cell c = new Cell(cfg, actor, new ProcessLauncher(log), planner, log);
+            Cell c = new Cell(cfg, actor, new ProcessLauncher(log, executables), planner, log);
             rm[0] = new ResourceManagerImpl(c, cap, reserved);
             return c;
         }, 10_000);
@@ -152,7 +155,8 @@ public final class Activator implements BundleActivator {
         }, HEARTBEAT_MS, HEARTBEAT_MS, TimeUnit.MILLISECONDS);
         ticker.scheduleAtFixedRate(() -> actor.submit(() -> rm[0].overruns(cell.sample())), SAMPLE_MS, SAMPLE_MS,
                 TimeUnit.MILLISECONDS);
-        tracker = new BundleTracker<>(ctx, ContractExtender.MASK, new ContractExtender(cell, reader, ctx, log));
+        tracker = new BundleTracker<>(ctx, ContractExtender.MASK, new ContractExtender(cell, reader, ctx,
+                (dir, name, source) -> executables.extract(dir, name, source::open), log));
         tracker.open();
         log.accept("arflex: DRCR started, runtime id " + rid + ", cpus " + cpus + ", memory " + memory + ", network "
                 + network);
