@@ -41,9 +41,18 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
     private final BundleContext own;
     private final Consumer<String> log;
     private final Extractor extractor;
+    private final Admission admission;
+
+    /** The code gate: whether a bundle may run its RT halves. */
+    @FunctionalInterface
+    public interface Admission {
+        /** Null when admitted, else why not (naming the bundle and its location). */
+        String refusal(Bundle bundle);
+    }
 
     public ContractExtender(Cell cell, ContractReader reader, BundleContext own, Extractor extractor,
-                            Consumer<String> log) {
+                            Admission admission, Consumer<String> log) {
+        this.admission = admission;
         this.cell = cell;
         this.reader = reader;
         this.own = own;
@@ -132,6 +141,19 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
         String label = label(bundle);
         long t0 = System.nanoTime();
         List<String> installed = new ArrayList<>();
+        // Nothing is extracted or spawned from code that did not come through the verified path
+        // (issue 16 finding 3): its components stay INSTALLED and the problem says why.
+        String refused = t.contracts.isEmpty() ? null : admission.refusal(bundle);
+        if (refused != null) {
+            String p = refused + "; its RT halves are not started";
+            cell.actor().call(() -> {
+                cell.problem(p);
+                return null;
+            }, CALL_MS);
+            t.active = installed;
+            log.accept("arflex: " + label + " started but not admitted: " + refused);
+            return;
+        }
         for (Contract c : t.contracts) {
             Path exe;
             try {
@@ -157,6 +179,9 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
             return;
         }
         t.active = null;
+        if (names.isEmpty()) {
+            return;
+        }
         String why = label(bundle) + " stopped";
         List<Contract> cs = t.contracts;
         cell.actor().call(() -> {
