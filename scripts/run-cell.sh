@@ -11,6 +11,11 @@
 # simulator's ground truth (the true TCP), which only this summary reads (simulator/README.md,
 # "Ground truth"). ARFLEX_EVALUATION=false turns it off.
 set -euo pipefail
+# Everything the runtime creates (felix-cache, the extracted RT executables, logs) is private to
+# its user: under umask 000 another user could replace an RT executable that runs as root
+# (issue 16 finding 5; the DRCR also sets its own folders 0700 and checks every executable's
+# SHA-256 before it spawns it).
+umask 077
 RUNTIME_DIR=${1:?runtime directory}
 HEADLESS=${2:-}
 cd "$RUNTIME_DIR"

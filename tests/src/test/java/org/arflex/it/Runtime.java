@@ -93,6 +93,7 @@ final class Runtime implements AutoCloseable {
         boolean mlock = Boolean.getBoolean("arflex.it.mlock");
         ProcessBuilder pb = new ProcessBuilder(Path.of(System.getProperty("java.home"), "bin", "java").toString(),
                 "-Darflex.runtime.id=" + rid, "-Darflex.nomlock=" + !mlock, "-Dorg.osgi.service.http.port=0",
+                "-Darflex.code.trusted=" + trustedFolders(),
                 "-jar", "bin/felix.jar").directory(dir.toFile());
         process = pb.start();
         stdin = new OutputStreamWriter(process.getOutputStream(), StandardCharsets.UTF_8);
@@ -103,6 +104,16 @@ final class Runtime implements AutoCloseable {
         if (waitForDrcr) {
             waitUntil("the DRCR to start", 60_000, () -> cmd("arflex:dto").startsWith("{"));
         }
+    }
+
+    /**
+     * The code gate's trusted folders (docs/DECISIONS.md D12): the runtime's own, and where the
+     * tests take their jars from (this checkout's builds, and the jars they write into temporary
+     * folders). A test of the gate itself starts its runtime without them.
+     */
+    static String trustedFolders() {
+        Path checkout = Path.of(System.getProperty("user.dir")).toAbsolutePath().getParent();
+        return String.join(",", "bundle", "cell", "tools", checkout.toString(), System.getProperty("java.io.tmpdir"));
     }
 
     private void pump(BufferedReader r, boolean stdout) {

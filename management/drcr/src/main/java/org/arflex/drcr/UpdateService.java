@@ -12,4 +12,14 @@ public interface UpdateService {
      * @throws IllegalStateException with the reason when the update was refused or failed
      */
     String update(String name);
+
+    /**
+     * Records a jar the caller is about to install as verified: its SHA-256 must equal
+     * {@code sha256}, the pin the caller checked it against (the console's Deploy page). Only a
+     * verified jar, or the file in a trusted folder it was installed from, may run RT halves.
+     *
+     * @param origin where the jar came from, for the log
+     * @throws IllegalArgumentException when the jar's SHA-256 is not {@code sha256} or it is not a jar
+     */
+    void verified(byte[] jar, String sha256, String origin);
 }

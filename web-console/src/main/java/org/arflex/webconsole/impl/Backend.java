@@ -467,6 +467,17 @@ public class Backend {
         }
         Path kept = Artifacts.keep(s, dataDir.resolve("installed"));
         String location = kept.toUri().toString();
+        // The DRCR runs RT halves only of code verified against a pin (docs/DECISIONS.md D12):
+        // the staged jar was checked against the SHA-256 the operator pinned and confirmed.
+        UpdateService u = updates;
+        if (u == null) {
+            throw new HttpError(503, "the DRCR is not running (no UpdateService registered)");
+        }
+        try {
+            u.verified(Files.readAllBytes(kept), s.sha256(), "console Deploy of " + s.origin());
+        } catch (IllegalArgumentException e) {
+            throw new HttpError(409, "install of " + s.symbolicName() + " refused: " + e.getMessage());
+        }
         try (InputStream in = Files.newInputStream(kept)) {
             Bundle existing = null;
             for (Bundle b : context.getBundles()) {

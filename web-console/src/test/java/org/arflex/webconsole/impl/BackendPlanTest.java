@@ -84,9 +84,17 @@ class BackendPlanTest {
                 return "plan: capacity";
             }
         };
-        backend.updates = name -> {
-            updated.add(name);
-            return name + ": updated to 1.1.0";
+        backend.updates = new org.arflex.drcr.UpdateService() {
+            @Override
+            public String update(String name) {
+                updated.add(name);
+                return name + ": updated to 1.1.0";
+            }
+
+            @Override
+            public void verified(byte[] jar, String sha256, String origin) {
+                updated.add("verified " + origin);
+            }
         };
     }
 

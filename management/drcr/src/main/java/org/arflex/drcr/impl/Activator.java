@@ -19,9 +19,12 @@ import org.arflex.drcr.impl.lifecycle.ThreadActor;
 import org.arflex.drcr.impl.runtime.Cell;
 import org.arflex.drcr.impl.runtime.ContractReader;
 import org.arflex.drcr.impl.services.ResourceManagerImpl;
+import org.arflex.drcr.impl.services.CodeGate;
 import org.arflex.drcr.impl.services.Services;
+import org.arflex.drcr.impl.services.VerifiedInstaller;
 import org.arflex.drcr.impl.shell.Commands;
 import org.arflex.drcr.impl.supervisor.ProcessLauncher;
+import org.arflex.drcr.impl.supervisor.VerifiedExecutables;
 import org.arflex.planner.Planner;
 import org.osgi.annotation.bundle.Header;
 import org.osgi.framework.Bundle;
@@ -41,7 +44,9 @@ import org.osgi.util.tracker.BundleTracker;
  * to components naming them in {@code timing/@cpus}; default none), {@code arflex.cpu.cap}
  * (utilisation cap per CPU, default 1.0), {@code arflex.memory} (default 1g), {@code arflex.network} (default 125m B/s),
  * {@code arflex.ready.timeout.ms} (default 5000), {@code arflex.nomlock} (true: RT halves skip
- * mlockall, for tests with many instances).
+ * mlockall, for tests with many instances), {@code arflex.code.trusted} (the folders whose jars
+ * may run RT halves without a pinned SHA-256, comma separated; default
+ * {@code bundle,cell,tools} of the working directory: docs/DECISIONS.md D12).
  */
 @Header(name = Constants.BUNDLE_ACTIVATOR, value = "${@class}")
 public final class Activator implements BundleActivator {
@@ -98,6 +103,8 @@ public final class Activator implements BundleActivator {
         long memory = Commands.parseSize(prop(ctx, "arflex.memory", "1g"));
         long network = Commands.parseSize(prop(ctx, "arflex.network", "125000000"));
         actor = new ThreadActor(log);
+        VerifiedExecutables executables = new VerifiedExecutables(
+                java.nio.file.Path.of(prop(ctx, Constants.FRAMEWORK_STORAGE, "felix-cache")), log);
         Cell.Config cfg = new Cell.Config(rid, Long.parseLong(prop(ctx, "arflex.ready.timeout.ms", "5000")), 3_000,
                 Boolean.parseBoolean(prop(ctx, "arflex.nomlock", "false")), types, Posix::monotonicNs,
                 Boolean.parseBoolean(prop(ctx, "arflex.evaluation", "false")));
@@ -106,12 +113,14 @@ public final class Activator implements BundleActivator {
         cell = actor.call(() -> {
             ResourceManagerImpl tmp = new ResourceManagerImpl(null, cap, reserved);
             Planner planner = new Planner(tmp.capacities(cpus, memory, network));
-            Cell c = new Cell(cfg, actor, new ProcessLauncher(log), planner, log);
+            Cell c = new Cell(cfg, actor, new ProcessLauncher(log, executables), planner, log);
             rm[0] = new ResourceManagerImpl(c, cap, reserved);
             return c;
         }, 10_000);
         ContractReader reader = new ContractReader(types);
-        services = new Services(cell, rm[0], reader, ctx, log);
+        CodeGate gate = new CodeGate(trustedFolders(prop(ctx, "arflex.code.trusted", "bundle,cell,tools")), log);
+        services = new Services(cell, rm[0], reader, ctx, gate, log);
+        VerifiedInstaller installer = new VerifiedInstaller(ctx, gate, log);
         cell.onChange(services::sync);
         regs.add(ctx.registerService(DrcrService.class, services, null));
         regs.add(ctx.registerService(UpdateService.class, services, null));
@@ -121,7 +130,17 @@ public final class Activator implements BundleActivator {
         shell.put("osgi.command.function", Commands.FUNCTIONS);
         // The shell finds management services in the registry, as any other client does.
         regs.add(ctx.registerService(Commands.class, new Commands(services, rm[0], services, name -> lookup(ctx, name),
-                (id, location) -> felixUpdate(ctx, id, location)), shell));
+                new Commands.BundleUpdater() {
+                    @Override
+                    public String update(long id, String location, String sha256) {
+                        return installer.update(id, location, sha256);
+                    }
+
+                    @Override
+                    public String deploy(String location, String sha256) {
+                        return installer.deploy(location, sha256);
+                    }
+                }), shell));
         // The runtime heartbeat is what keeps the RT halves out of safe mode: its thread runs at a
         // low SCHED_FIFO priority (below every component, above all ordinary load) so that a
         // busy machine cannot starve it past a 100 ms heartbeat timeout.
@@ -152,7 +171,8 @@ public final class Activator implements BundleActivator {
         }, HEARTBEAT_MS, HEARTBEAT_MS, TimeUnit.MILLISECONDS);
         ticker.scheduleAtFixedRate(() -> actor.submit(() -> rm[0].overruns(cell.sample())), SAMPLE_MS, SAMPLE_MS,
                 TimeUnit.MILLISECONDS);
-        tracker = new BundleTracker<>(ctx, ContractExtender.MASK, new ContractExtender(cell, reader, ctx, log));
+        tracker = new BundleTracker<>(ctx, ContractExtender.MASK, new ContractExtender(cell, reader, ctx,
+                (dir, name, source) -> executables.extract(dir, name, source::open), gate::refusal, log));
         tracker.open();
         log.accept("arflex: DRCR started, runtime id " + rid + ", cpus " + cpus + ", memory " + memory + ", network "
                 + network);
@@ -178,23 +198,15 @@ public final class Activator implements BundleActivator {
         return java.util.Optional.empty();
     }
 
-    private static String felixUpdate(BundleContext ctx, long id, String location) {
-        Bundle b = ctx.getBundle(id);
-        if (b == null) {
-            throw new IllegalArgumentException("no bundle " + id);
-        }
-        try {
-            if (location == null) {
-                b.update();
-            } else {
-                try (java.io.InputStream in = java.net.URI.create(location).toURL().openStream()) {
-                    b.update(in);
-                }
+    /** The trusted folders of the code gate: a comma list, relative to the working directory. */
+    private static List<java.nio.file.Path> trustedFolders(String list) {
+        List<java.nio.file.Path> l = new ArrayList<>();
+        for (String f : list.split(",")) {
+            if (!f.isBlank()) {
+                l.add(java.nio.file.Path.of(f.trim()).toAbsolutePath().normalize());
             }
-        } catch (org.osgi.framework.BundleException | java.io.IOException | IllegalArgumentException e) {
-            throw new IllegalStateException("update of bundle " + id + " failed: " + e.getMessage());
         }
-        return "";
+        return l;
     }
 
     private static List<Integer> allCpus() {

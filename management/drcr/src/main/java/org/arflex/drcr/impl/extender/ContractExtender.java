@@ -3,10 +3,7 @@ package org.arflex.drcr.impl.extender;
 import java.io.IOException;
 import java.io.InputStream;
 import java.net.URL;
-import java.nio.file.Files;
 import java.nio.file.Path;
-import java.nio.file.StandardCopyOption;
-import java.nio.file.attribute.PosixFilePermissions;
 import java.util.ArrayList;
 import java.util.List;
 import java.util.function.Consumer;
@@ -43,11 +40,23 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
     private final ContractReader reader;
     private final BundleContext own;
     private final Consumer<String> log;
+    private final Extractor extractor;
+    private final Admission admission;
 
-    public ContractExtender(Cell cell, ContractReader reader, BundleContext own, Consumer<String> log) {
+    /** The code gate: whether a bundle may run its RT halves. */
+    @FunctionalInterface
+    public interface Admission {
+        /** Null when admitted, else why not (naming the bundle and its location). */
+        String refusal(Bundle bundle);
+    }
+
+    public ContractExtender(Cell cell, ContractReader reader, BundleContext own, Extractor extractor,
+                            Admission admission, Consumer<String> log) {
+        this.admission = admission;
         this.cell = cell;
         this.reader = reader;
         this.own = own;
+        this.extractor = extractor;
         this.log = log;
     }
 
@@ -132,6 +141,19 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
         String label = label(bundle);
         long t0 = System.nanoTime();
         List<String> installed = new ArrayList<>();
+        // Nothing is extracted or spawned from code that did not come through the verified path
+        // (issue 16 finding 3): its components stay INSTALLED and the problem says why.
+        String refused = t.contracts.isEmpty() ? null : admission.refusal(bundle);
+        if (refused != null) {
+            String p = refused + "; its RT halves are not started";
+            cell.actor().call(() -> {
+                cell.problem(p);
+                return null;
+            }, CALL_MS);
+            t.active = installed;
+            log.accept("arflex: " + label + " started but not admitted: " + refused);
+            return;
+        }
         for (Contract c : t.contracts) {
             Path exe;
             try {
@@ -157,6 +179,9 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
             return;
         }
         t.active = null;
+        if (names.isEmpty()) {
+            return;
+        }
         String why = label(bundle) + " stopped";
         List<Contract> cs = t.contracts;
         cell.actor().call(() -> {
@@ -172,9 +197,22 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
         log.accept("arflex: " + why + ": destroyed " + names);
     }
 
+    /** Copies an executable out of its bundle into a folder; returns where it is. */
+    @FunctionalInterface
+    public interface Extractor {
+        Path extract(Path dir, String name, Opener source) throws IOException;
+    }
+
+    /** Opens the bundle's entry again (the extractor may need to re-extract it). */
+    @FunctionalInterface
+    public interface Opener {
+        InputStream open() throws IOException;
+    }
+
     /**
-     * Copies {@code native/linux-x86_64/<exe>} into the bundle's data area (our own data area
-     * when the bundle has none), mode 0700, replacing an older copy atomically.
+     * Hands {@code native/linux-x86_64/<exe>} to the extractor, into the bundle's data area (our
+     * own data area when the bundle has none). Every start extracts afresh: nothing is reused by
+     * its timestamp (issue 16 finding 5).
      */
     Path extract(Bundle bundle, String exe) throws IOException {
         URL u = bundle.getEntry(ContractReader.NATIVE_DIR + exe);
@@ -189,22 +227,12 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
         if (dir == null) {
             throw new IOException("the framework has no data area for bundles");
         }
-        Path d = dir.toPath();
-        Files.createDirectories(d);
-        Path target = d.resolve(exe);
-        // Same bundle revision started again: the copy from last time is still right.
-        if (Files.isRegularFile(target) && Files.getLastModifiedTime(target).toMillis() >= bundle.getLastModified()
-                && Files.isExecutable(target)) {
-            return target;
-        }
-        Path tmp = Files.createTempFile(d, exe, ".tmp");
-        try (InputStream in = u.openStream()) {
-            Files.copy(in, tmp, StandardCopyOption.REPLACE_EXISTING);
-            Files.setPosixFilePermissions(tmp, PosixFilePermissions.fromString("rwx------"));
-            Files.move(tmp, target, StandardCopyOption.REPLACE_EXISTING, StandardCopyOption.ATOMIC_MOVE);
-        } finally {
-            Files.deleteIfExists(tmp);
-        }
-        return target;
+        return extractor.extract(dir.toPath(), exe, () -> {
+            URL again = bundle.getEntry(ContractReader.NATIVE_DIR + exe);
+            if (again == null) {
+                throw new IOException("no longer in the bundle");
+            }
+            return again.openStream();
+        });
     }
 }

@@ -1,12 +1,8 @@
 package org.arflex.drcr.impl.services;
 
 import java.io.ByteArrayInputStream;
-import java.io.ByteArrayOutputStream;
 import java.io.IOException;
-import java.io.InputStream;
 import java.net.URI;
-import java.net.URL;
-import java.net.URLConnection;
 import java.security.MessageDigest;
 import java.security.NoSuchAlgorithmException;
 import java.util.ArrayList;
@@ -47,19 +43,19 @@ public final class Services implements DrcrService, UpdateService {
 
     /** Timeout of a call into the actor (starting a component can take a few seconds). */
     static final long CALL_MS = 60_000;
-    /** Largest bundle accepted by plan install and update. */
-    static final int MAX_JAR = 64 << 20;
 
     private final Cell cell;
     private final ResourceManagerImpl resources;
     private final ContractReader reader;
     private final BundleContext context;
     private final Consumer<String> log;
+    private final CodeGate gate;
     private final Map<String, ServiceRegistration<ComponentManagement>> regs = new HashMap<>();
 
     public Services(Cell cell, ResourceManagerImpl resources, ContractReader reader, BundleContext context,
-                    Consumer<String> log) {
+                    CodeGate gate, Consumer<String> log) {
         this.cell = cell;
+        this.gate = gate;
         this.resources = resources;
         this.reader = reader;
         this.context = context;
@@ -137,7 +133,7 @@ public final class Services implements DrcrService, UpdateService {
     public String planInstall(String location) {
         byte[] jar;
         try {
-            jar = download(URI.create(location));
+            jar = Fetch.read(URI.create(location));
         } catch (IOException | IllegalArgumentException e) {
             throw new IllegalArgumentException("cannot read " + location + ": " + e.getMessage());
         }
@@ -198,7 +194,7 @@ public final class Services implements DrcrService, UpdateService {
         }, CALL_MS);
         byte[] jar;
         try {
-            jar = download(t.spec().url());
+            jar = Fetch.read(t.spec().url());
         } catch (IOException | IllegalArgumentException e) {
             throw new IllegalStateException(name + ": update not installed, the old version keeps running: cannot download "
                     + t.spec().url() + ": " + e.getMessage());
@@ -224,8 +220,9 @@ public final class Services implements DrcrService, UpdateService {
             throw new IllegalStateException(name + ": bundle " + f.bundleId() + " is gone");
         }
         try {
+            gate.verified(f.jar(), "arflex:update " + name + " from " + f.url() + ", sha256 " + f.sha());
             b.update(new ByteArrayInputStream(f.jar()));
-        } catch (BundleException e) {
+        } catch (BundleException | IOException e) {
             throw new IllegalStateException(name + ": bundle update failed, the old version keeps running: " + e.getMessage());
         }
         String v = f.result().contracts().stream().filter(c -> c.name().equals(name)).map(Contract::version).findFirst()
@@ -234,35 +231,24 @@ public final class Services implements DrcrService, UpdateService {
         return name + ": updated to " + v + " from " + f.url() + " (sha256 verified)";
     }
 
+    @Override
+    public void verified(byte[] jar, String sha256, String origin) {
+        String got = sha256(jar);
+        if (!got.equalsIgnoreCase(sha256)) {
+            throw new IllegalArgumentException("SHA-256 of " + origin + " is " + got + ", not " + sha256);
+        }
+        try {
+            gate.verified(jar, origin + ", sha256 " + got);
+        } catch (IOException e) {
+            throw new IllegalArgumentException(origin + " is not a jar: " + e.getMessage());
+        }
+    }
+
     static String sha256(byte[] data) {
         try {
             return HexFormat.of().formatHex(MessageDigest.getInstance("SHA-256").digest(data));
         } catch (NoSuchAlgorithmException e) {
             throw new IllegalStateException(e);
-        }
-    }
-
-    /** Reads a whole file: or https: URL (other schemes are refused), at most {@link #MAX_JAR} bytes. */
-    static byte[] download(URI uri) throws IOException {
-        String scheme = uri.getScheme() == null ? "" : uri.getScheme().toLowerCase();
-        if (!scheme.equals("file") && !scheme.equals("https")) {
-            throw new IOException("scheme '" + scheme + "' refused: only https and file URLs are allowed");
-        }
-        URL url = uri.toURL();
-        URLConnection conn = url.openConnection();
-        conn.setConnectTimeout(10_000);
-        conn.setReadTimeout(30_000);
-        try (InputStream in = conn.getInputStream()) {
-            ByteArrayOutputStream out = new ByteArrayOutputStream();
-            byte[] buf = new byte[65536];
-            int n;
-            while ((n = in.read(buf)) > 0) {
-                out.write(buf, 0, n);
-                if (out.size() > MAX_JAR) {
-                    throw new IOException("larger than " + MAX_JAR + " bytes");
-                }
-            }
-            return out.toByteArray();
         }
     }
 

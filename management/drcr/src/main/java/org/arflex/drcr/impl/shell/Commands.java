@@ -28,7 +28,7 @@ public final class Commands {
 
     /** Service property values for the Gogo registration. */
     public static final String SCOPE = "arflex";
-    public static final String[] FUNCTIONS = {"list", "info", "bindings", "get", "set", "plan", "update",
+    public static final String[] FUNCTIONS = {"list", "info", "bindings", "get", "set", "plan", "update", "deploy",
         "resources", "stats", "port", "reset", "dto"};
 
     private final DrcrService drcr;
@@ -37,10 +37,16 @@ public final class Commands {
     private final Function<String, Optional<ComponentManagement>> management;
     private final BundleUpdater bundles;
 
-    /** Felix's own bundle update, for {@code update <bundle-id> [url]} typed without a scope. */
+    /** Bundle installs and updates through the DRCR's fetch and code gate. */
     public interface BundleUpdater {
-        /** Updates bundle {@code id} (from {@code location} when not null); returns a report. */
-        String update(long id, String location);
+        /**
+         * Updates bundle {@code id} (from {@code location} when not null, checked against
+         * {@code sha256} when not null); returns a report.
+         */
+        String update(long id, String location, String sha256);
+
+        /** Installs (or updates) and starts the bundle at {@code location}, checked against {@code sha256}. */
+        String deploy(String location, String sha256);
     }
 
     public Commands(DrcrService drcr, ResourceManager resources, UpdateService updates,
@@ -166,18 +172,26 @@ public final class Commands {
     /**
      * Pulls the update of a component from its contract's update URL. A number is a bundle id
      * (component names start with a letter): Gogo resolves a bare {@code update} to this scope,
-     * so {@code update <id> [url]} is handed to Felix and behaves as {@code felix:update}.
+     * so {@code update <id> [url [sha256]]} behaves as {@code felix:update}, but reads through
+     * the DRCR's fetch (https/file, timeouts) and, with a SHA-256, records the jar as verified.
      */
     public String update(String... args) {
         return guard(() -> {
-            if (args.length >= 1 && args.length <= 2 && args[0].matches("\\d{1,18}")) {
-                return bundles.update(Long.parseLong(args[0]), args.length == 2 ? args[1] : null);
+            if (args.length >= 1 && args.length <= 3 && args[0].matches("\\d{1,18}")) {
+                return bundles.update(Long.parseLong(args[0]), args.length >= 2 ? args[1] : null,
+                        args.length == 3 ? args[2] : null);
             }
             if (args.length != 1) {
-                return "usage: update <component> | update <bundle-id> [url]";
+                return "usage: update <component> | update <bundle-id> [url [sha256]]";
             }
             return updates.update(args[0]);
         });
+    }
+
+    /** {@code deploy <https-or-file-url> <sha256>}: the verified install of a bundle, then its start. */
+    public String deploy(String... args) {
+        return guard(() -> args.length == 2 ? bundles.deploy(args[0], args[1])
+                : "usage: deploy <https-or-file-url> <sha256>");
     }
 
     /** {@code resources} prints capacities; {@code resources set cpus 0,1 memory 512m network 10m} changes them. */

@@ -35,9 +35,12 @@ public final class ProcessLauncher implements RtLauncher {
     private static final long FAILED_EXIT_GRACE_MS = 500;
 
     private final Consumer<String> log;
+    private final VerifiedExecutables executables;
 
-    public ProcessLauncher(Consumer<String> log) {
+    /** @param executables every executable is checked against it before it is spawned */
+    public ProcessLauncher(Consumer<String> log, VerifiedExecutables executables) {
         this.log = log;
+        this.executables = executables;
     }
 
     /** The name of a shared object of an instance. */
@@ -81,6 +84,8 @@ public final class ProcessLauncher implements RtLauncher {
     public RtHalf launch(Spec spec) throws IOException {
         String rid = spec.runtimeId();
         String inst = spec.instance();
+        // every spawn, restarts included, runs the bytes recorded when the bundle was started
+        String exe = executables.verify(spec.executable()).toString();
         ControlBlock ctl = ControlBlock.create(objectName(rid, inst, "ctl"), spec.config().withSupervisorPipe(),
                 spec.params(), spec.resetRequired());
         Mailbox mb;
@@ -92,7 +97,7 @@ public final class ProcessLauncher implements RtLauncher {
         }
         Process p;
         try {
-            ProcessBuilder pb = new ProcessBuilder(spec.executable().toString(), "--runtime", rid, "--instance", inst)
+            ProcessBuilder pb = new ProcessBuilder(exe, "--runtime", rid, "--instance", inst)
                     .redirectErrorStream(true)
                     .redirectInput(ProcessBuilder.Redirect.PIPE);
             p = pb.start();

@@ -128,8 +128,16 @@ class CommandsTest {
         }
     };
 
-    private final UpdateService upd = name -> {
-        throw new IllegalStateException(name + ": SHA-256 mismatch");
+    private final UpdateService upd = new UpdateService() {
+        @Override
+        public String update(String name) {
+            throw new IllegalStateException(name + ": SHA-256 mismatch");
+        }
+
+        @Override
+        public void verified(byte[] jar, String sha256, String origin) {
+            throw new UnsupportedOperationException();
+        }
     };
 
     private final ComponentManagement cm = new ComponentManagement() {
@@ -200,17 +208,35 @@ class CommandsTest {
     };
 
     private final Commands cmd = new Commands(drcr, rm, upd, n -> n.equals("cons") ? Optional.of(cm) : Optional.empty(),
-            (id, loc) -> {
-                calls.add("felix update " + id + " " + loc);
-                return "";
+            new Commands.BundleUpdater() {
+                @Override
+                public String update(long id, String location, String sha256) {
+                    calls.add("felix update " + id + " " + location + " " + sha256);
+                    return "";
+                }
+
+                @Override
+                public String deploy(String location, String sha256) {
+                    calls.add("deploy " + location + " " + sha256);
+                    return "Bundle ID: 9 (sha256 verified)";
+                }
             });
 
     @Test
-    void updateOfABundleIdIsFelixsUpdate() {
+    void updateOfABundleIdIsFelixsUpdateThroughTheVerifiedFetch() {
         assertEquals("", cmd.update("27"));
         assertEquals("", cmd.update("27", "file:/x.jar"));
-        assertEquals(List.of("felix update 27 null", "felix update 27 file:/x.jar"), calls);
+        assertEquals("", cmd.update("27", "https://h/x.jar", "ab12"));
+        assertEquals(List.of("felix update 27 null null", "felix update 27 file:/x.jar null",
+                "felix update 27 https://h/x.jar ab12"), calls);
         assertTrue(cmd.update().startsWith("usage:"));
+    }
+
+    @Test
+    void deployTakesAUrlAndItsPinnedSha256() {
+        assertEquals("Bundle ID: 9 (sha256 verified)", cmd.deploy("https://h/x.jar", "ab12"));
+        assertEquals(List.of("deploy https://h/x.jar ab12"), calls);
+        assertTrue(cmd.deploy("https://h/x.jar").startsWith("usage:"));
     }
 
     @Test

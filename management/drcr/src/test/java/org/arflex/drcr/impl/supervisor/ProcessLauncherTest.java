@@ -7,7 +7,6 @@ import static org.junit.jupiter.api.Assertions.assertTrue;
 import java.io.IOException;
 import java.nio.file.Files;
 import java.nio.file.Path;
-import java.nio.file.attribute.PosixFilePermissions;
 import java.util.List;
 import org.arflex.drcr.impl.abi.ControlBlock;
 import org.junit.jupiter.api.Test;
@@ -26,10 +25,11 @@ class ProcessLauncherTest {
      */
     @Test
     void theReasonOfAFailedStartCarriesTheLastLineTheRtHalfPrinted(@TempDir Path dir) throws Exception {
-        Path exe = dir.resolve("fails");
-        Files.writeString(exe, "#!/bin/sh\necho 'fails: bad program file: /data/program-3.arp:3: joint 6 outside' >&2\nexit 4\n");
-        Files.setPosixFilePermissions(exe, PosixFilePermissions.fromString("rwx------"));
-        ProcessLauncher launcher = new ProcessLauncher(line -> { });
+        byte[] script = "#!/bin/sh\necho 'fails: bad program file: /data/program-3.arp:3: joint 6 outside' >&2\nexit 4\n"
+                .getBytes(java.nio.charset.StandardCharsets.UTF_8);
+        VerifiedExecutables exes = new VerifiedExecutables(dir, line -> { });
+        Path exe = exes.extract(dir.resolve("native"), "fails", () -> new java.io.ByteArrayInputStream(script));
+        ProcessLauncher launcher = new ProcessLauncher(line -> { }, exes);
         for (int i = 0; i < 30; i++) {
             String inst = "fails" + i;
             RtLauncher.Spec spec = new RtLauncher.Spec(rid, inst, exe,
