@@ -556,8 +556,12 @@ class WebConsoleIT {
         browser.findElement(By.id("arflex-debug-window-apply")).click();
         awaitText(By.id("arflex-debug-status"), "window applied by the RT half: 5");
         awaitAtLeast(By.id("arflex-debug-m0-mean"), "data-index", 0);
-        double min = Double.parseDouble(browser.findElement(By.id("arflex-debug-m0-min")).getAttribute("data-value"));
-        double max = Double.parseDouble(browser.findElement(By.id("arflex-debug-m0-max")).getAttribute("data-value"));
+        // both read in one script: the page re-renders between two separate reads
+        @SuppressWarnings("unchecked")
+        List<Object> mm = (List<Object>) browser.executeScript("return [document.getElementById('arflex-debug-m0-min')"
+                + ".getAttribute('data-value'), document.getElementById('arflex-debug-m0-max').getAttribute('data-value')];");
+        double min = Double.parseDouble(String.valueOf(mm.get(0)));
+        double max = Double.parseDouble(String.valueOf(mm.get(1)));
         assertTrue(min <= max, min + " <= " + max);
         new WebDriverWait(browser, WAIT).until(d -> Long.parseLong(d.findElement(By.id("arflex-debug-plot")).getAttribute("data-samples")) > 2);
         shot("16-debug-watching");

@@ -1,0 +1,297 @@
+package org.arflex.it;
+
+import static org.junit.jupiter.api.Assertions.assertTrue;
+
+import java.nio.file.DirectoryStream;
+import java.nio.file.Files;
+import java.nio.file.Path;
+import java.util.ArrayList;
+import java.util.LinkedHashMap;
+import java.util.List;
+import java.util.Locale;
+import java.util.Map;
+import java.util.Random;
+import org.junit.jupiter.api.Test;
+
+/**
+ * The fault benchmark ({@code ./arflex bench faults [--quick]}, issue 15): faults injected from
+ * outside into a running cell whose arm moves (a looping program), each scenario N times, with a
+ * seed that orders the rounds. Per scenario: pass/fail, time to safe (the arm's joint speeds
+ * all under {@link FailSafeIT#STILL}, or every RT half flagged SUPERVISOR_LOST for the JVM
+ * kill), time back to ACTIVE, and leaks. Prints a table, writes target/bench/faults.json, and
+ * ends with {@code faults: P/T scenarios pass, leaks L}. Not a test: run by the script only
+ * (failsafe runs *IT classes).
+ *
+ * <ul>
+ * <li>S1 kill -9 of a provider (force-guard) and of the motion component (trajectory);</li>
+ * <li>S3 SIGSTOP of the guard (stale safety input, then the DRCR's hang handling);</li>
+ * <li>S16 a 400 N push above the guard's limit;</li>
+ * <li>S17 after every reset: no motion for 1000 robot cycles until the fresh command;</li>
+ * <li>G the guard lost for good (killed until FAILED);</li>
+ * <li>S18 kill -9 of the JVM: every RT half safe, then gone with its objects.</li>
+ * </ul>
+ */
+class FaultBench {
+
+    record Run(boolean pass, double safeMs, double backMs, String note) {
+    }
+
+    private final Map<String, List<Run>> runs = new LinkedHashMap<>();
+    private int s17Pass;
+    private int s17Total;
+
+    private void record(String scenario, Run r) {
+        runs.computeIfAbsent(scenario, k -> new ArrayList<>()).add(r);
+        System.out.printf(Locale.ROOT, "faults: %-12s %s safe %.0f ms, back %.0f ms %s%n", scenario, r.pass ? "pass" : "FAIL",
+                r.safeMs, r.backMs, r.note);
+    }
+
+    /** Waits for the arm to stand still after t0; ms from t0, or -1 after the deadline. */
+    private static double timeToStill(Runtime rt, CellRig.Trace<CellRig.JointState> js, long t0) {
+        int mark = js.size();
+        try {
+            rt.waitUntil("the arm still", 20_000, () -> js.size() > mark + 50 && FailSafeIT.stillFor(js, 50));
+        } catch (AssertionError e) {
+            return -1;
+        }
+        // the first of the 50 still samples, in robot time
+        List<CellRig.JointState> s = js.snapshot();
+        CellRig.JointState first = s.get(s.size() - 50);
+        CellRig.JointState atFault = s.get(Math.max(0, mark - 1));
+        return Math.max(0, (first.tNs() - atFault.tNs()) / 1e6);
+    }
+
+    /** S17: after the reset(s), 1000 robot cycles without motion; then the fresh command moves it. */
+    private boolean resetThenCommand(Runtime rt, CellRig.Trace<CellRig.JointState> js) {
+        try {
+            rt.waitUntil("nothing awaits a reset", 30_000, () -> {
+                if (!CellRig.awaitingReset(rt).isEmpty() || "FAILED".equals(rt.state("force-guard"))) {
+                    rt.cmd("arflex:reset --cell");
+                }
+                return CellRig.awaitingReset(rt).isEmpty() && "ACTIVE".equals(rt.state("force-guard"))
+                        && "ACTIVE".equals(rt.state("trajectory"));
+            });
+            int mark = js.size();
+            rt.waitUntil("1000 robot cycles after the reset", 30_000, () -> js.size() > mark + 1000);
+            boolean still = js.snapshot().subList(mark, js.size()).stream().allMatch(j -> j.maxSpeed() <= FailSafeIT.STILL);
+            s17Total++;
+            if (still) {
+                s17Pass++;
+            }
+            CellRig.set(rt, "trajectory", "run", "true");
+            rt.waitUntil("moving after the fresh command", 30_000, () -> FailSafeIT.moving(js));
+            return still;
+        } catch (AssertionError e) {
+            System.out.println("faults: reset/command failed: " + e.getMessage().lines().findFirst().orElse(""));
+            return false;
+        }
+    }
+
+    private static double backToActive(Runtime rt, String name, long oldPid, long t0) {
+        try {
+            rt.waitUntil(name + " back", 30_000, () -> rt.activeWithNewPid(name, oldPid));
+            return (System.nanoTime() - t0) / 1e6;
+        } catch (AssertionError e) {
+            return -1;
+        }
+    }
+
+    private static void signal(long pid, String sig) throws Exception {
+        new ProcessBuilder("kill", "-" + sig, Long.toString(pid)).inheritIO().start().waitFor();
+    }
+
+    @Test
+    void faults() throws Exception {
+        int rounds = Integer.getInteger("arflex.bench.rounds", 3);
+        long seed = Long.getLong("arflex.bench.seed", System.nanoTime());
+        Random rnd = new Random(seed);
+        System.out.println("faults: seed " + seed + ", rounds " + rounds);
+        int leaks = 0;
+        String rid;
+        try (Runtime rt = new Runtime("faults")) {
+            rid = rt.rid;
+            FailSafeIT.movingCell(rt);
+            CellRig.Trace<CellRig.JointState> js = new CellRig.Trace<>();
+            try (CellRig.Port jp = new CellRig.Port(rt.segment("sim-robot", "joint_state"), CellRig.JOINT_STATE_SIZE);
+                    CellRig.Recorder rec = new CellRig.Recorder()) {
+                rec.add(jp, CellRig.JointState::of, CellRig.JointState::seq, js::add);
+                rec.start();
+                rt.waitUntil("the arm moving", 60_000, () -> FailSafeIT.moving(js));
+                List<String> order = new ArrayList<>();
+                for (int i = 0; i < rounds; i++) {
+                    order.addAll(List.of("S1-guard", "S1-motion", "S3-guard", "S16-push"));
+                }
+                java.util.Collections.shuffle(order, rnd);
+                for (String s : order) {
+                    rt.waitUntil("the arm moving", 30_000, () -> FailSafeIT.moving(js));
+                    long t0 = System.nanoTime();
+                    switch (s) {
+                        case "S1-guard", "S1-motion" -> {
+                            String name = s.equals("S1-guard") ? "force-guard" : "trajectory";
+                            long pid = rt.pid(name);
+                            FailSafeIT.kill9(pid);
+                            double safe = timeToStill(rt, js, t0);
+                            double back = backToActive(rt, name, pid, t0);
+                            boolean ok = resetThenCommand(rt, js);
+                            record(s, new Run(safe >= 0 && back >= 0 && ok, safe, back, ""));
+                        }
+                        case "S3-guard" -> {
+                            long pid = rt.pid("force-guard");
+                            signal(pid, "STOP");
+                            double safe = timeToStill(rt, js, t0);
+                            double back = backToActive(rt, "force-guard", pid, t0);
+                            signal(pid, "CONT"); // if the DRCR did not kill it, it goes on
+                            boolean ok = resetThenCommand(rt, js);
+                            record(s, new Run(safe >= 0 && back >= 0 && ok, safe, back, "(hang detection restarts it)"));
+                        }
+                        default -> {
+                            CellRig.set(rt, "sim-robot", "push_duration_ms", "200");
+                            CellRig.set(rt, "sim-robot", "push_force_n", "400");
+                            double safe = timeToStill(rt, js, t0);
+                            CellRig.set(rt, "sim-robot", "push_force_n", "0");
+                            boolean ok = resetThenCommand(rt, js);
+                            record(s, new Run(safe >= 0 && ok, safe, 0, ""));
+                        }
+                    }
+                }
+                // G: the guard lost for good (killed until FAILED), the arm stays stopped.
+                long t0 = System.nanoTime();
+                double safe = -1;
+                for (int k = 0; k < 6 && !"FAILED".equals(rt.state("force-guard")); k++) {
+                    long pid = rt.pid("force-guard");
+                    if (pid == 0) {
+                        break;
+                    }
+                    FailSafeIT.kill9(pid);
+                    if (k == 0) {
+                        safe = timeToStill(rt, js, t0);
+                    }
+                    try {
+                        rt.waitUntil("force-guard back or FAILED", 30_000,
+                                () -> rt.activeWithNewPid("force-guard", pid) || "FAILED".equals(rt.state("force-guard")));
+                    } catch (AssertionError e) {
+                        break;
+                    }
+                }
+                int mark = js.size();
+                rt.waitUntil("2000 robot cycles with the guard lost", 30_000, () -> js.size() > mark + 2000);
+                boolean stayed = js.snapshot().subList(mark, js.size()).stream().allMatch(j -> j.maxSpeed() <= FailSafeIT.STILL);
+                boolean failed = "FAILED".equals(rt.state("force-guard"));
+                boolean ok = resetThenCommand(rt, js);
+                record("G-guard-lost", new Run(safe >= 0 && stayed && failed && ok, safe, 0, failed ? "" : "(guard not FAILED)"));
+                rec.close();
+            }
+        }
+        leaks += leftovers(rid);
+
+        // S18: kill -9 of the JVM, each time a fresh runtime with the moving cell.
+        for (int i = 0; i < Math.max(1, rounds / 2); i++) {
+            String r18;
+            double safeMs = -1;
+            boolean gone = false;
+            try (Runtime rt = new Runtime("faults-jvm")) {
+                r18 = rt.rid;
+                FailSafeIT.movingCell(rt);
+                List<Path> ctls = ctlFiles(r18);
+                long t0 = System.nanoTime();
+                rt.crash();
+                try {
+                    rt.waitUntil("every RT half flagged SUPERVISOR_LOST and safe", 10_000, () -> ctls.stream().allMatch(p -> {
+                        int f = CellPorts.ctlFlags(p);
+                        return (f & 64) != 0 && (f & 4) != 0;
+                    }));
+                    safeMs = (System.nanoTime() - t0) / 1e6;
+                } catch (AssertionError e) {
+                    System.out.println("faults: S18 " + e.getMessage().lines().findFirst().orElse(""));
+                }
+                try {
+                    rt.waitUntil("the orphans gone with their objects", 30_000,
+                            () -> Runtime.rtProcesses(r18).isEmpty() && rt.shmObjects().isEmpty());
+                    gone = true;
+                } catch (AssertionError e) {
+                    System.out.println("faults: S18 " + e.getMessage().lines().findFirst().orElse(""));
+                }
+            }
+            int l = leftovers(r18);
+            leaks += l;
+            record("S18-jvm-kill", new Run(safeMs >= 0 && gone && l == 0, safeMs, 0, ctlNote(l)));
+        }
+        report(seed, leaks);
+    }
+
+    private static String ctlNote(int leaks) {
+        return leaks == 0 ? "" : "(" + leaks + " left)";
+    }
+
+    private static List<Path> ctlFiles(String rid) throws Exception {
+        List<Path> l = new ArrayList<>();
+        try (DirectoryStream<Path> ds = Files.newDirectoryStream(Path.of("/dev/shm"), "arflex." + rid + ".*.ctl")) {
+            ds.forEach(l::add);
+        }
+        return l;
+    }
+
+    /** /dev/shm and /dev/mqueue objects and processes of a runtime id left after it closed. */
+    private static int leftovers(String rid) throws Exception {
+        int n = Runtime.rtProcesses(rid).size();
+        for (String dir : new String[] {"/dev/shm", "/dev/mqueue"}) {
+            if (Files.isDirectory(Path.of(dir))) {
+                try (DirectoryStream<Path> ds = Files.newDirectoryStream(Path.of(dir), "arflex." + rid + ".*")) {
+                    for (Path p : ds) {
+                        System.out.println("faults: leak " + p);
+                        n++;
+                    }
+                }
+            }
+        }
+        return n;
+    }
+
+    private static double pct(List<Double> v, double p) {
+        if (v.isEmpty()) {
+            return Double.NaN;
+        }
+        List<Double> s = new ArrayList<>(v);
+        java.util.Collections.sort(s);
+        return s.get(Math.min(s.size() - 1, (int) Math.ceil(p / 100 * s.size()) - 1));
+    }
+
+    private void report(long seed, int leaks) throws Exception {
+        StringBuilder json = new StringBuilder(String.format(Locale.ROOT, "{\"seed\":%d,\"scenarios\":{", seed));
+        System.out.printf(Locale.ROOT, "%n%-14s %5s %5s  %28s  %20s%n", "scenario", "runs", "pass", "time to safe p50/p99/max ms",
+                "back to ACTIVE p50/max");
+        int pass = 0;
+        int total = 0;
+        boolean firstJ = true;
+        for (var e : runs.entrySet()) {
+            List<Run> rs = e.getValue();
+            List<Double> safe = rs.stream().map(Run::safeMs).filter(x -> x >= 0).toList();
+            List<Double> back = rs.stream().map(Run::backMs).filter(x -> x > 0).toList();
+            long ok = rs.stream().filter(Run::pass).count();
+            boolean all = ok == rs.size();
+            total++;
+            pass += all ? 1 : 0;
+            System.out.printf(Locale.ROOT, "%-14s %5d %5d  %8.0f %8.0f %8.0f    %8.0f %8.0f%n", e.getKey(), rs.size(), ok,
+                    pct(safe, 50), pct(safe, 99), pct(safe, 100), pct(back, 50), pct(back, 100));
+            json.append(firstJ ? "" : ",").append(String.format(Locale.ROOT,
+                    "\"%s\":{\"runs\":%d,\"pass\":%d,\"safe_ms\":{\"p50\":%.1f,\"p99\":%.1f,\"max\":%.1f},"
+                            + "\"back_ms\":{\"p50\":%.1f,\"max\":%.1f}}",
+                    e.getKey(), rs.size(), ok, pct(safe, 50), pct(safe, 99), pct(safe, 100), pct(back, 50), pct(back, 100))
+                    .replace("NaN", "null"));
+            firstJ = false;
+        }
+        total++;
+        boolean s17 = s17Total > 0 && s17Pass == s17Total;
+        pass += s17 ? 1 : 0;
+        System.out.printf(Locale.ROOT, "%-14s %5d %5d  (no motion for 1000 robot cycles after each reset, until the command)%n",
+                "S17-no-resume", s17Total, s17Pass);
+        json.append(String.format(Locale.ROOT, ",\"S17-no-resume\":{\"runs\":%d,\"pass\":%d}},\"leaks\":%d,\"pass\":%d,\"total\":%d}%n",
+                s17Total, s17Pass, leaks, pass, total));
+        Path out = Path.of(System.getProperty("arflex.bench.out", "target/bench/faults.json"));
+        Files.createDirectories(out.toAbsolutePath().getParent());
+        Files.writeString(out, json);
+        System.out.println("JSON: " + out.toAbsolutePath());
+        System.out.println("faults: " + pass + "/" + total + " scenarios pass, leaks " + leaks);
+        assertTrue(true);
+    }
+}
