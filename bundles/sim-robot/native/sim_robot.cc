@@ -111,6 +111,8 @@ const ParamInfo kParams[kParamCount] = {
 // newtons on the tool (the force guard trips at 150 N); over 0.5 s with a quintic the peak
 // acceleration is 5.77 * 0.05 / 0.25 = 1.15 rad/s^2 (about 60 N on the 25 kg tool at 2 m).
 constexpr double kBlendSeconds = 0.5;
+// Values of a reference at rest (bit for bit the same) before it is acquired after a stop.
+constexpr int kRestValues = 50;
 
 struct Robot {
   std::unique_ptr<Cell> cell;
@@ -149,10 +151,15 @@ struct Robot {
   // Reset permits, it does not start (SAFETY.md 2): after a stop (a safety hold or safe mode)
   // the held pose is kept, offset and all, while the acquired reference stays the same; the
   // blend starts when the reference moves (the motion source's fresh command), not at the reset.
+  // After a stop, a reference is acquired only once it has been at rest (the same value) for
+  // kRestValues values: a motion source still decelerating from its own stop is not a
+  // reference to move to. Counted in rest_values against rest_ref.
   bool after_stop = false;
   bool hold_stops_motion = false;
   bool blend_wait = false;
   JointVector wait_ref{};
+  JointVector rest_ref{};
+  int rest_values = 0;
 };
 
 Robot g_robot;
@@ -313,6 +320,17 @@ arflex_safety_verdict JudgeSafety(arflex_component* c, Robot& r) {
   return v;
 }
 
+// Counts the values of a reference that stay bit for bit the same; true once kRestValues did.
+bool AtRest(Robot& r, const double* q) {
+  bool same = true;
+  for (int i = 0; i < kNumJoints; ++i) same = same && q[i] == r.rest_ref[i];
+  if (!same) {
+    for (int i = 0; i < kNumJoints; ++i) r.rest_ref[i] = q[i];
+    r.rest_values = 0;
+  }
+  return ++r.rest_values >= kRestValues;
+}
+
 // The servo holds where the arm is: its reference becomes the measured pose, no blend.
 void HoldMeasured(Robot& r) {
   const arflex::sim::JointState js = r.cell->ReadJointState();
@@ -420,7 +438,11 @@ int Start(arflex_component* c, void* user) {
 
 int Update(arflex_component* c, void* user, uint64_t release_ns) {
   Robot& r = *static_cast<Robot*>(user);
-  if (r.safe) r.after_stop = true;  // the first cycle after safe mode (the reset)
+  if (r.safe) {  // the first cycle after safe mode (the reset): hold where the arm is now
+    r.after_stop = true;
+    r.rest_values = 0;
+    HoldMeasured(r);
+  }
   r.safe = false;
   ApplyParams(c, r);
   // The safety input permits motion, or the arm holds (fail closed). Its power limit is
@@ -438,6 +460,8 @@ int Update(arflex_component* c, void* user, uint64_t release_ns) {
   if (r.guard_hold) {  // the reference must meet the arm again (D9)
     r.guard_hold = false;
     r.after_stop = r.hold_stops_motion;
+    r.rest_values = 0;
+    HoldMeasured(r);  // where the arm is now (a push under reduced power may have moved it)
     r.acquired = false;
     r.refusing = false;
   }
@@ -459,6 +483,8 @@ int Update(arflex_component* c, void* user, uint64_t release_ns) {
   if (got == 1) {
     if (!ReferenceValid(*r.cell, ref.q)) {
       ret = -ERANGE;  // refused: non-finite or outside the joint limits; keep the last one
+    } else if (!r.acquired && r.after_stop && !AtRest(r, ref.q)) {
+      // after a stop: not yet a reference at rest (still decelerating): keep holding
     } else if (!r.acquired && !NearArm(*r.cell, ref.q, P(c, r, kRefAcquireTol))) {
       if (!r.refusing) ret = -ERANGE;  // counted once per episode, not every cycle
       r.refusing = true;

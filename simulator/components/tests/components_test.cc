@@ -294,16 +294,17 @@ class SimComponents : public ::testing::Test {
     ASSERT_EQ(arflex_port_create(&ref_, name, &spec), 0);
     ref_name_ = name;
   }
-  // Writes the home pose (where the arm starts) and waits until the robot has run two
-  // periods after it, so that it has read it: the reference is acquired (ref_acquire_tol)
-  // and the next values are followed wherever they go.
+  // Writes the home pose (where the arm starts) every cycle, as a motion source at rest does,
+  // until the robot has run 80 periods after the first write, so that it has read it long
+  // enough: the reference is acquired (ref_acquire_tol; after a stop, once it has been at rest
+  // for 50 values) and the next values are followed wherever they go.
   void AcquireAtHome(arflex_port* js_port) {
     arflex_joint_state js{};
-    uint64_t first = 0;  // seq of the first state read after the write
-    WriteReference(kHome);
+    uint64_t first = 0;  // seq of the first state read after the first write
     ASSERT_TRUE(WaitFor([&] {
+      WriteReference(kHome);
       if (arflex_state_read(js_port, &js, sizeof(js), nullptr) == 1 && first == 0) first = js.seq;
-      return first != 0 && js.seq > first + 2;
+      return first != 0 && js.seq > first + 80;
     }));
   }
   void WriteReference(const double q[6]) {
@@ -593,10 +594,11 @@ TEST_F(SimComponents, RobotTakesThePowerLimitOfTheSafetyInput) {
   // path) is acquired but not moved to: the reset permits, the reference does not move.
   const double q_arm = js.q[0];
   double near_ref[6] = {q_arm + 0.02, 0.5, 0.3, 0.0, 0.8, 0.0};
-  for (int k = 0; k < 200; ++k) WriteReference(near_ref);  // the same value, new sequence
+  // a motion source at rest writes the same value every cycle
   const uint64_t s1 = js.seq;
   double peak = 0;
   ASSERT_TRUE(WaitFor([&] {
+    WriteReference(near_ref);
     if (!Latest(&js_port, &js, &hj)) return false;
     for (int i = 0; i < 6; ++i) peak = std::max(peak, std::fabs(js.qd[i]));
     return js.seq > s1 + 500;
@@ -604,10 +606,11 @@ TEST_F(SimComponents, RobotTakesThePowerLimitOfTheSafetyInput) {
   EXPECT_NEAR(js.q[0], q_arm, 1e-4) << "moved to a held reference after the reset";
   EXPECT_LT(peak, 1e-3) << "joint speed after the reset without a moving reference";
   // The reference moves (the fresh command): the offset is blended out while it moves.
-  near_ref[0] += 0.001;
-  WriteReference(near_ref);
-  ASSERT_TRUE(WaitFor([&] { return Latest(&js_port, &js, &hj) && std::fabs(js.q[0] - near_ref[0]) < 1e-3; }))
-      << "did not follow the moving reference, q0 " << js.q[0];
+  ASSERT_TRUE(WaitFor([&] {
+    near_ref[0] += 1e-5;
+    WriteReference(near_ref);
+    return Latest(&js_port, &js, &hj) && std::fabs(js.q[0] - near_ref[0]) < 1e-3;
+  })) << "did not follow the moving reference, q0 " << js.q[0] << " ref " << near_ref[0];
   EXPECT_EQ(arflex_host_stop(&robot_, kCall), 0);
   arflex_port_close(&pw_port);
   arflex_port_close(&js_port);

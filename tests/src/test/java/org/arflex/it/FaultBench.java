@@ -247,6 +247,10 @@ class FaultBench {
         return n;
     }
 
+    private static String ms(double v) {
+        return Double.isNaN(v) ? "-" : String.format(Locale.ROOT, "%.0f", v);
+    }
+
     private static double pct(List<Double> v, double p) {
         if (v.isEmpty()) {
             return Double.NaN;
@@ -271,8 +275,8 @@ class FaultBench {
             boolean all = ok == rs.size();
             total++;
             pass += all ? 1 : 0;
-            System.out.printf(Locale.ROOT, "%-14s %5d %5d  %8.0f %8.0f %8.0f    %8.0f %8.0f%n", e.getKey(), rs.size(), ok,
-                    pct(safe, 50), pct(safe, 99), pct(safe, 100), pct(back, 50), pct(back, 100));
+            System.out.printf(Locale.ROOT, "%-14s %5d %5d  %8s %8s %8s    %8s %8s%n", e.getKey(), rs.size(), ok,
+                    ms(pct(safe, 50)), ms(pct(safe, 99)), ms(pct(safe, 100)), ms(pct(back, 50)), ms(pct(back, 100)));
             json.append(firstJ ? "" : ",").append(String.format(Locale.ROOT,
                     "\"%s\":{\"runs\":%d,\"pass\":%d,\"safe_ms\":{\"p50\":%.1f,\"p99\":%.1f,\"max\":%.1f},"
                             + "\"back_ms\":{\"p50\":%.1f,\"max\":%.1f}}",
