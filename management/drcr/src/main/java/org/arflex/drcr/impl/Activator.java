@@ -52,7 +52,7 @@ import org.osgi.util.tracker.BundleTracker;
 public final class Activator implements BundleActivator {
 
     private static final Pattern RID = Pattern.compile("[a-z0-9-]{1,40}");
-    private static final long HEARTBEAT_MS = 20;
+    private static final long HEARTBEAT_MS = org.arflex.drcr.impl.supervisor.HeartbeatMonitor.PERIOD_MS;
     private static final long SAMPLE_MS = 1_000;
 
     private ThreadActor actor;
