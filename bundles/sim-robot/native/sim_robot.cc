@@ -111,8 +111,13 @@ const ParamInfo kParams[kParamCount] = {
 // newtons on the tool (the force guard trips at 150 N); over 0.5 s with a quintic the peak
 // acceleration is 5.77 * 0.05 / 0.25 = 1.15 rad/s^2 (about 60 N on the 25 kg tool at 2 m).
 constexpr double kBlendSeconds = 0.5;
-// Values of a reference at rest (bit for bit the same) before it is acquired after a stop.
+// After a stop: a reference is "at rest" when kRestValues values in a row stay within
+// kRestTol of the first of them (a motion source decelerating from its stop moves far more; a
+// vision correction's noise moves far less), and it "moves" (the fresh command) once it leaves
+// kMoveTol of the value acquired.
 constexpr int kRestValues = 50;
+constexpr double kRestTol = 1e-4;  // rad, any joint
+constexpr double kMoveTol = 5e-4;  // rad, any joint
 
 struct Robot {
   std::unique_ptr<Cell> cell;
@@ -151,9 +156,9 @@ struct Robot {
   // Reset permits, it does not start (SAFETY.md 2): after a stop (a safety hold or safe mode)
   // the held pose is kept, offset and all, while the acquired reference stays the same; the
   // blend starts when the reference moves (the motion source's fresh command), not at the reset.
-  // After a stop, a reference is acquired only once it has been at rest (the same value) for
-  // kRestValues values: a motion source still decelerating from its own stop is not a
-  // reference to move to. Counted in rest_values against rest_ref.
+  // After a stop, a reference is acquired only once it has been at rest for kRestValues
+  // values: a motion source still decelerating from its own stop is not a reference to move
+  // to. Counted in rest_values against rest_ref.
   bool after_stop = false;
   bool hold_stops_motion = false;
   bool blend_wait = false;
@@ -301,14 +306,14 @@ int StepAndPublish(const arflex_component* c, Robot& r, uint64_t release_ns) {
 // input). A guard that had permitted motion and is gone (not merely stopping: no provider,
 // silent, stale, invalid, damaged) latches an operator reset: nothing tells this arm any more
 // that moving is safe.
-arflex_safety_verdict JudgeSafety(arflex_component* c, Robot& r) {
+arflex_safety_verdict JudgeSafety(arflex_component* c, Robot& r, bool clear_hold) {
   r.gate.max_age_ns = static_cast<uint64_t>(P(c, r, kSafetyMaxAgeMs) * 1e6);
   const arflex_safety_verdict v = arflex_safety_gate_check(&r.gate, arflex_sys_now_ns());
   if (arflex_safety_permits(v)) {
     r.cell->SetPowerScale(arflex_safety_gate_scale(&r.gate));
     r.guard_permitted = true;
     r.loss_latched = false;
-    arflex_component_hold(c, ARFLEX_HOLD_NONE, 0, 0);
+    if (clear_hold) arflex_component_hold(c, ARFLEX_HOLD_NONE, 0, 0);
     return v;
   }
   if (v == ARFLEX_SAFETY_STOP) r.cell->SetPowerScale(r.gate.state.power_scale);
@@ -320,10 +325,11 @@ arflex_safety_verdict JudgeSafety(arflex_component* c, Robot& r) {
   return v;
 }
 
-// Counts the values of a reference that stay bit for bit the same; true once kRestValues did.
+// Counts the values of a reference that stay within kRestTol of the first; true once
+// kRestValues did.
 bool AtRest(Robot& r, const double* q) {
-  bool same = true;
-  for (int i = 0; i < kNumJoints; ++i) same = same && q[i] == r.rest_ref[i];
+  bool same = r.rest_values > 0;
+  for (int i = 0; i < kNumJoints; ++i) same = same && std::fabs(q[i] - r.rest_ref[i]) <= kRestTol;
   if (!same) {
     for (int i = 0; i < kNumJoints; ++i) r.rest_ref[i] = q[i];
     r.rest_values = 0;
@@ -448,7 +454,7 @@ int Update(arflex_component* c, void* user, uint64_t release_ns) {
   // The safety input permits motion, or the arm holds (fail closed). Its power limit is
   // applied at once (this period's physics steps); a protective stop applies the reduced
   // power the guard publishes, so the held arm yields to a push.
-  const arflex_safety_verdict verdict = JudgeSafety(c, r);
+  const arflex_safety_verdict verdict = JudgeSafety(c, r, false);
   if (!arflex_safety_permits(verdict)) {
     if (!r.guard_hold) {
       HoldMeasured(r);
@@ -497,13 +503,19 @@ int Update(arflex_component* c, void* user, uint64_t release_ns) {
         for (int i = 0; i < kNumJoints; ++i) r.wait_ref[i] = ref.q[i];
       } else if (r.blend_wait) {
         for (int i = 0; i < kNumJoints; ++i)
-          if (ref.q[i] != r.wait_ref[i]) r.blend_wait = false;  // the reference moves
+          if (std::fabs(ref.q[i] - r.wait_ref[i]) > kMoveTol) r.blend_wait = false;  // it moves
       }
       r.acquired = true;
       r.refusing = false;
       for (int i = 0; i < kNumJoints; ++i) r.q_ref[i] = ref.q[i];
     }
   }
+  // The arm holds on its own account while no reference is acquired after a stop, or one is
+  // refused as too far from it: say so (a reference that meets the arm is expected).
+  if (!r.acquired && (r.refusing || r.after_stop))
+    arflex_component_hold(c, ARFLEX_HOLD_REFERENCE, 0, arflex_input_index(c, r.joint_ref));
+  else
+    arflex_component_hold(c, ARFLEX_HOLD_NONE, 0, 0);
   JointVector servo = r.q_ref;
   if (r.blend_t < kBlendSeconds) {
     const double u = r.blend_t / kBlendSeconds;
@@ -526,7 +538,7 @@ int Safe(arflex_component* c, void* user, arflex_safe_mode /*mode*/, bool first)
     r.acquired = false;  // after the reset the reference must meet the arm again (D9)
     r.refusing = false;
   }
-  JudgeSafety(c, r);
+  JudgeSafety(c, r, true);
   r.safe = true;
   return StepAndPublish(c, r, arflex_sys_now_ns());
 }

@@ -530,8 +530,10 @@ TEST_F(SimComponents, RobotTakesThePowerLimitOfTheSafetyInput) {
       << "never permitted: nothing to reset";
   // A fresh NORMAL guard permits: the reference is acquired and followed, full power.
   ASSERT_EQ(arflex_host_bind(&robot_, "safety", guard_.name(), kCall), 0);
-  ASSERT_TRUE(WaitFor([&] { return HoldCause() == ARFLEX_HOLD_NONE; }));
+  ASSERT_TRUE(WaitFor([&] { return HoldCause() != ARFLEX_HOLD_SAFETY_INPUT; }));
+  EXPECT_EQ(HoldCause(), static_cast<uint32_t>(ARFLEX_HOLD_REFERENCE)) << "the far target is refused, and it says so";
   AcquireAtHome(&js_port);
+  ASSERT_TRUE(WaitFor([&] { return HoldCause() == ARFLEX_HOLD_NONE; }));
   EXPECT_TRUE(power_is(1.0)) << "got " << pw.value;
   guard_.Set(ARFLEX_SAFETY_STATE_MODE_LIMITED, 0.25);
   EXPECT_TRUE(power_is(0.25)) << "got " << pw.value;
@@ -555,7 +557,8 @@ TEST_F(SimComponents, RobotTakesThePowerLimitOfTheSafetyInput) {
   EXPECT_EQ(HoldDetail(), static_cast<uint32_t>(ARFLEX_SAFETY_STOP));
   guard_.Set(ARFLEX_SAFETY_STATE_MODE_NORMAL, 1.0);
   EXPECT_TRUE(power_is(1.0)) << "got " << pw.value;
-  ASSERT_TRUE(WaitFor([&] { return HoldCause() == ARFLEX_HOLD_NONE; }));
+  // the guard permits; the arm, stopped, waits for a reference at rest that meets it
+  ASSERT_TRUE(WaitFor([&] { return HoldCause() == ARFLEX_HOLD_REFERENCE; }));
   // Moving, the guard dies (stops writing; its segment still reads NORMAL, power 1): stale
   // within 1.5 x 20 ms, the arm stops where it is and a reset is latched.
   const double far[6] = {0.6, 0.5, 0.3, 0.0, 0.8, 0.0};

@@ -30,7 +30,7 @@ final class Holding {
         } else if (cause == ControlBlock.HOLD_AWAIT_COMMAND && !awaitingReset) {
             why = "stopped: waits for a fresh command (set run true, or a program) after the reset";
         } else if (cause == ControlBlock.HOLD_REFERENCE) {
-            why = "holds: its reference does not meet the arm";
+            why = "holds: waits for a reference that meets the arm (after a stop: one at rest)";
         }
         if (awaitingReset) {
             String r = (flags & ControlBlock.FLAG_SAFE_ACTIVE) != 0 ? "safe mode, awaiting operator reset"
