@@ -118,6 +118,7 @@ enum arflex_warn_kind {
 	ARFLEX_WARN_PARAM = 8,       /**< a parameter request was rejected */
 	ARFLEX_WARN_INPUT = 9,       /**< an input read failed (retries exhausted, bad header) */
 	ARFLEX_WARN_SAFE = 10,       /**< safe mode entered (heartbeat lost or reset required) */
+	ARFLEX_WARN_FORGED = 11,     /**< a mailbox request with a wrong token was ignored */
 };
 
 /** Causes of ctl->hold (bits 0..7). Detail (bits 8..15): for SAFETY_INPUT the enum

@@ -56,6 +56,7 @@ struct arflex_host {
 	int exit_status;    /**< wait status once reaped */
 	bool reaped;
 	uint32_t seq;
+	uint64_t token;     /**< the child's mailbox token (0 without the supervisor pipe) */
 	int sup_fd;         /**< write end of the child's stdin (supervisor pipe) */
 	bool sup_open;
 	int out_fd;         /**< read end of the child's stdout/stderr (output pipe) */
@@ -66,7 +67,9 @@ struct arflex_host {
 enum arflex_host_spawn_flag {
 	/** The child's stdin is a pipe whose write end the host holds until the child was
 	 *  reaped (or arflex_host_drop_supervisor); ARFLEX_CFG_SUPERVISOR_PIPE is set in the
-	 *  control block, so the RT half takes EOF as the death of its supervisor. */
+	 *  control block, so the RT half takes EOF as the death of its supervisor. A fresh random
+	 *  mailbox token is written first into the pipe (ABI.md 5, 6.2) and put into every
+	 *  request; without this flag the token is 0 (tests and benchmarks only). */
 	ARFLEX_HOST_SUPERVISOR_PIPE = 1u << 0,
 	/** The child's stdout and stderr go to a pipe the host reads (arflex_host_output_fd). */
 	ARFLEX_HOST_OUTPUT_PIPE = 1u << 1,

@@ -11,6 +11,13 @@
  * priority than the RT thread, never the RT thread itself). The manager should have one
  * request outstanding at a time and discard replies whose seq is not the one it waits for
  * (a late reply to a request that timed out).
+ *
+ * Only the manager may command (ABI.md 5, DECISIONS.md D13): with ARFLEX_CFG_SUPERVISOR_PIPE
+ * the manager writes a random 64-bit token as the first 8 bytes (little endian) into the
+ * supervisor pipe (the child's stdin) and puts it into msg.token of every request. The RT half
+ * reads it before it serves anything and ignores (no reply, no action) every request whose
+ * token differs; replies echo the token and the manager discards replies with another one. The
+ * token is never in shared memory. Without the pipe the token is 0 (tests and benchmarks only).
  */
 #ifndef ARFLEX_MAILBOX_H
 #define ARFLEX_MAILBOX_H
@@ -102,7 +109,7 @@ struct arflex_msg {
 	uint16_t flags;          /**< ARFLEX_MSG_REPLY on replies */
 	int32_t status;          /**< reply: 0 or -errno; request: 0 */
 	uint32_t payload_len;    /**< bytes of payload in use */
-	uint64_t reserved;
+	uint64_t token;          /**< the instance's secret (see above); echoed in the reply */
 	union {
 		uint8_t raw[ARFLEX_MSG_PAYLOAD];
 		struct arflex_msg_param param;
@@ -113,6 +120,7 @@ struct arflex_msg {
 };
 
 ARFLEX_STATIC_ASSERT(sizeof(struct arflex_msg) == ARFLEX_MSG_SIZE, "msg size");
+ARFLEX_STATIC_ASSERT(offsetof(struct arflex_msg, token) == 24, "msg token");
 ARFLEX_STATIC_ASSERT(offsetof(struct arflex_msg, u) == 32, "msg payload");
 ARFLEX_STATIC_ASSERT(sizeof(struct arflex_msg_param) == 56, "msg param");
 ARFLEX_STATIC_ASSERT(sizeof(struct arflex_msg_bind) == 160, "msg bind");
@@ -158,8 +166,8 @@ ARFLEX_API int arflex_mailbox_send(struct arflex_mailbox *mb, const struct arfle
 ARFLEX_API int arflex_mailbox_recv(struct arflex_mailbox *mb, struct arflex_msg *m,
 				   uint64_t timeout_ns);
 
-/** Manager side: sends @req and waits for the reply with the same seq, discarding stale
- *  replies, until @timeout_ns has passed. On success the reply is in @rsp and its status is
+/** Manager side: sends @req and waits for the reply with the same seq and token, discarding
+ *  stale replies and replies with another token, until @timeout_ns has passed. On success the reply is in @rsp and its status is
  *  returned (0 or -errno from the RT side); -ETIMEDOUT or another -errno on transport
  *  failure. */
 ARFLEX_API int arflex_mailbox_call(struct arflex_mailbox *mb, const struct arflex_msg *req,

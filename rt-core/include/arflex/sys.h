@@ -95,6 +95,9 @@ ARFLEX_API int arflex_sys_fstat(int fd, struct stat *st);
 ARFLEX_API int arflex_sys_write_all(int fd, const void *buf, size_t len);
 /** read(); retries EINTR. Returns the byte count (0 at EOF) or -errno. */
 ARFLEX_API long arflex_sys_read(int fd, void *buf, size_t len);
+/** Fills @buf with @len random bytes from getrandom() (blocks until the pool is ready).
+ *  Returns 0 or -errno. */
+ARFLEX_API int arflex_sys_random(void *buf, size_t len);
 /** pipe2(O_CLOEXEC): @fds[0] the read end, @fds[1] the write end. Returns 0 or -errno. */
 ARFLEX_API int arflex_sys_pipe(int fds[2]);
 /** Sets O_NONBLOCK on @fd when it is a pipe or FIFO (never on a TTY or a file). Returns 1 if

@@ -651,6 +651,30 @@ static bool serve(struct arflex_component *c, struct arflex_msg *m)
 	return quit;
 }
 
+#define FORGED_LOG_NS 1000000000u /* one log line per burst of forged requests */
+
+/* A request with another token than the manager's is not from the manager (ABI.md 5,
+ * DECISIONS.md D13): counted, logged at most once a second, never answered or acted on.
+ * Returns true when @m is such a request. */
+static bool forged(struct arflex_component *c, const struct arflex_msg *m)
+{
+	uint64_t now;
+
+	if (m->token == c->token)
+		return false;
+	__atomic_add_fetch(&c->ctl->warnings[ARFLEX_WARN_FORGED], 1, __ATOMIC_RELAXED);
+	c->forged_unlogged++;
+	now = arflex_sys_now_ns();
+	if (c->forged_log_ns && now - c->forged_log_ns < FORGED_LOG_NS)
+		return true;
+	arflex_comp_log(c, "ignored %llu mailbox request(s) with a wrong token (last: %s seq %u): "
+			"not from my manager", (unsigned long long)c->forged_unlogged,
+			arflex_cmd_name(m->cmd), m->seq);
+	c->forged_unlogged = 0;
+	c->forged_log_ns = now;
+	return true;
+}
+
 static void serve_loop(struct arflex_component *c)
 {
 	struct arflex_msg m;
@@ -670,7 +694,7 @@ static void serve_loop(struct arflex_component *c)
 			continue;
 		if (r == -EPROTO) {
 			/* malformed: answer if it looks like ours at all, so callers do not hang */
-			if (m.magic == ARFLEX_MSG_MAGIC) {
+			if (m.magic == ARFLEX_MSG_MAGIC && !forged(c, &m)) {
 				m.flags = ARFLEX_MSG_REPLY;
 				m.status = -EPROTO;
 				memset(&m.u, 0, sizeof(m.u));
@@ -683,7 +707,7 @@ static void serve_loop(struct arflex_component *c)
 			wait_short();
 			continue;
 		}
-		if (m.flags & ARFLEX_MSG_REPLY)
+		if ((m.flags & ARFLEX_MSG_REPLY) || forged(c, &m))
 			continue;
 		if (serve(c, &m))
 			break;
@@ -850,6 +874,13 @@ int arflex_component_main(int argc, char **argv, const struct arflex_component_o
 		goto out_failed;
 	}
 	if (c->ctl->config.cfg_flags & ARFLEX_CFG_SUPERVISOR_PIPE) {
+		r = arflex_comp_read_token(c);
+		if (r) {
+			arflex_comp_log(c, "no mailbox token from the manager on the supervisor pipe "
+					"(fd 0): %s", strerror(-r));
+			code = ARFLEX_EXIT_ATTACH;
+			goto out_mailbox;
+		}
 		r = arflex_comp_watch_start(c);
 		if (r) {
 			arflex_comp_log(c, "cannot start the supervisor-pipe watcher: %s", strerror(-r));

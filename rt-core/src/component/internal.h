@@ -54,6 +54,9 @@ struct arflex_component {
 	bool orphaned;                /* mailbox thread: left the loop as an orphan */
 	pthread_t watcher;
 	bool watching;                /* main thread: the watcher runs */
+	uint64_t token;               /* the manager's mailbox token (0 without the pipe) */
+	uint64_t forged_log_ns;       /* mailbox thread: when a forged request was last logged */
+	uint64_t forged_unlogged;     /* mailbox thread: forged requests since that log line */
 	struct arflex_port outputs[ARFLEX_MAX_OUTPUTS];
 	char output_names[ARFLEX_MAX_OUTPUTS][ARFLEX_NAME_SIZE];
 	unsigned noutputs;
@@ -68,6 +71,7 @@ void arflex_comp_log(const struct arflex_component *c, const char *fmt, ...)
 
 /* supervisor.c (ABI.md 6.2, DECISIONS.md D10) */
 #define ARFLEX_ORPHAN_POLL_NS 10000000u /* mailbox wakes every 10 ms once the supervisor is lost */
+int arflex_comp_read_token(struct arflex_component *c);
 int arflex_comp_watch_start(struct arflex_component *c);
 void arflex_comp_watch_stop(struct arflex_component *c);
 bool arflex_comp_orphan_done(struct arflex_component *c);

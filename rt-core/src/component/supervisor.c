@@ -4,9 +4,12 @@
  * instance's own objects, since no manager is left to do it. */
 #include "internal.h"
 
+#include <errno.h>
+#include <poll.h>
 #include <signal.h>
 #include <stdio.h>
 
+#define TOKEN_WAIT_NS 5000000000u /* the manager writes the token right at the spawn */
 #define ORPHAN_SAFE_WAIT_NS 1000000000u /* after the hold: wait this long at most for the
 					 * RT thread's first safe cycle of the orphan */
 
@@ -40,6 +43,55 @@ bool arflex_comp_orphan_done(struct arflex_component *c)
 	return true;
 }
 
+/* Waits until fd 0 is readable or @deadline (monotonic ns) passed. Returns 0 or -errno. */
+static int wait_readable(uint64_t deadline)
+{
+	for (;;) {
+		struct pollfd p = { .fd = 0, .events = POLLIN };
+		uint64_t now = arflex_sys_now_ns();
+		int r;
+
+		if (now >= deadline)
+			return -ETIMEDOUT;
+		r = poll(&p, 1, (int)((deadline - now) / 1000000u) + 1);
+		if (r > 0)
+			return 0;
+		if (r < 0 && errno != EINTR)
+			return -errno;
+	}
+}
+
+/* The manager's mailbox token (ABI.md 5, 6.2; DECISIONS.md D13): the first 8 bytes on the
+ * supervisor pipe, little endian, read on the main thread before the watcher starts and
+ * before any request is served. Returns 0 or -errno (-ETIMEDOUT, -EPIPE: EOF, -EPROTO: 0). */
+int arflex_comp_read_token(struct arflex_component *c)
+{
+	uint64_t deadline = arflex_sys_now_ns() + TOKEN_WAIT_NS, t = 0;
+	uint8_t le[8];
+	size_t got = 0;
+
+	while (got < sizeof(le)) {
+		int r = wait_readable(deadline);
+		long n;
+
+		if (r)
+			return r;
+		n = arflex_sys_read(0, le + got, sizeof(le) - got);
+		if (n < 0 && n != -EAGAIN)
+			return (int)n;
+		if (n == 0)
+			return -EPIPE;
+		if (n > 0)
+			got += (size_t)n;
+	}
+	for (unsigned i = 0; i < sizeof(le); i++)
+		t |= (uint64_t)le[i] << (8 * i);
+	if (!t)
+		return -EPROTO; /* 0 is the token of hosts without the pipe: never over it */
+	c->token = t;
+	return 0;
+}
+
 /* The supervisor-pipe watcher (ARFLEX_CFG_SUPERVISOR_PIPE): blocks in read() on fd 0; EOF or
  * an error means the supervisor is gone. Not the RT thread; it only sets two words. */
 static void *watch_supervisor(void *arg)
@@ -49,7 +101,7 @@ static void *watch_supervisor(void *arg)
 	long n;
 
 	do {
-		n = arflex_sys_read(0, buf, sizeof(buf)); /* data is ignored */
+		n = arflex_sys_read(0, buf, sizeof(buf)); /* data after the token is ignored */
 	} while (n > 0);
 	STORE(&c->lost_ns, arflex_sys_now_ns());
 	__atomic_or_fetch(&c->ctl->flags, ARFLEX_FLAG_SUPERVISOR_LOST, __ATOMIC_RELEASE);

@@ -205,6 +205,27 @@ void arflex_host_destroy(struct arflex_host *h)
 	}
 }
 
+/* A fresh token for the next child, written as the first 8 bytes (little endian) into its
+ * supervisor pipe while we still hold both ends (ABI.md 6.2). */
+static int send_token(struct arflex_host *h, int fd)
+{
+	uint8_t le[8];
+	uint64_t t;
+	int r;
+
+	do {
+		r = arflex_sys_random(&t, sizeof(t));
+	} while (!r && !t); /* 0 is the token of hosts without the pipe */
+	if (r)
+		return r;
+	for (unsigned i = 0; i < 8; i++)
+		le[i] = (uint8_t)(t >> (8 * i));
+	r = arflex_sys_write_all(fd, le, sizeof(le));
+	if (!r)
+		h->token = t;
+	return r;
+}
+
 int arflex_host_spawn(struct arflex_host *h, const char *exe, char *const extra[],
 		      char *const envp[])
 {
@@ -235,11 +256,15 @@ int arflex_host_spawn_ex(struct arflex_host *h, const char *exe, char *const ext
 	/* a respawn: the pipes of the previous child (reaped) go */
 	arflex_host_drop_supervisor(h);
 	arflex_host_close_output(h);
+	h->token = 0;
 	if (flags & ARFLEX_HOST_SUPERVISOR_PIPE) {
 		r = arflex_sys_pipe(sup);
 		if (r)
 			return r;
 		fds[0] = sup[0];
+		r = send_token(h, sup[1]);
+		if (r)
+			goto out_sup;
 	}
 	if (flags & ARFLEX_HOST_OUTPUT_PIPE) {
 		r = arflex_sys_pipe(out);
@@ -334,6 +359,7 @@ int arflex_host_call(struct arflex_host *h, uint16_t cmd, const struct arflex_ms
 	m.flags = 0;
 	m.status = 0;
 	m.seq = ++h->seq;
+	m.token = h->token;
 	return arflex_mailbox_call(&h->mb, &m, rsp ? rsp : &r, timeout_ns);
 }
 

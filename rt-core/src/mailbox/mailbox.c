@@ -155,9 +155,10 @@ int arflex_mailbox_call(struct arflex_mailbox *mb, const struct arflex_msg *req,
 			continue; /* malformed: dropped */
 		if (r)
 			return r;
-		if (rsp->seq == req->seq && rsp->cmd == req->cmd && (rsp->flags & ARFLEX_MSG_REPLY))
+		if (rsp->seq == req->seq && rsp->cmd == req->cmd && rsp->token == req->token &&
+		    (rsp->flags & ARFLEX_MSG_REPLY))
 			return rsp->status;
-		/* stale reply of an earlier, timed-out request: discard */
+		/* stale reply of an earlier, timed-out request, or not from our RT half: discard */
 	}
 }
 

@@ -25,6 +25,7 @@ static const char *const warn_names[ARFLEX_WARN_KINDS] = {
 	[ARFLEX_WARN_PARAM] = "parameter request rejected",
 	[ARFLEX_WARN_INPUT] = "input read failed",
 	[ARFLEX_WARN_SAFE] = "safe mode entered (runtime heartbeat lost or operator reset required)",
+	[ARFLEX_WARN_FORGED] = "mailbox request with a wrong token ignored",
 };
 
 const char *arflex_warn_name(unsigned kind)
