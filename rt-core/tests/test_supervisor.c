@@ -8,6 +8,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <fcntl.h>
+#include <mqueue.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -137,11 +139,90 @@ static void closed_output_pipe_does_not_kill(void **state)
 	th_assert_clean(rid);
 }
 
+/* A process-local forger: any process of the same user can open the command queue. */
+static void forge(uint16_t cmd, uint64_t token)
+{
+	char name[ARFLEX_OBJ_NAME_SIZE];
+	struct arflex_msg m;
+	mqd_t q;
+
+	assert_int_equal(arflex_ctl_obj_name(name, sizeof(name), rid, "probe", "cmd"), 0);
+	q = mq_open(name, O_WRONLY);
+	assert_true(q != (mqd_t)-1);
+	arflex_msg_init(&m, cmd, 77);
+	m.token = token;
+	assert_int_equal(mq_send(q, (const char *)&m, sizeof(m), 0), 0);
+	mq_close(q);
+}
+
+static long replies_waiting(void)
+{
+	char name[ARFLEX_OBJ_NAME_SIZE];
+	struct mq_attr a;
+	mqd_t q;
+
+	assert_int_equal(arflex_ctl_obj_name(name, sizeof(name), rid, "probe", "rsp"), 0);
+	q = mq_open(name, O_RDONLY);
+	assert_true(q != (mqd_t)-1);
+	assert_int_equal(mq_getattr(q, &a), 0);
+	mq_close(q);
+	return a.mq_curmsgs;
+}
+
+/* Issue 16 finding 6 (ABI.md 5, D13): requests without the manager's token (0 or a guessed
+ * one) are neither answered nor acted on, only counted; the manager's own still work. */
+static void forged_requests_are_ignored(void **state)
+{
+	const uint16_t cmds[] = { ARFLEX_CMD_SHUTDOWN, ARFLEX_CMD_STOP, ARFLEX_CMD_RESET };
+	struct arflex_host h_forged;
+	struct probe_out o;
+	uint64_t real;
+
+	(void)state;
+	setup_ids("forged");
+	assert_int_equal(probe_host(&h_forged, "probe", 0, 0, true), 0);
+	assert_int_equal(arflex_host_spawn_ex(&h_forged, ARFLEX_PROBE_EXE, NULL, envp,
+					      ARFLEX_HOST_SUPERVISOR_PIPE), 0);
+	assert_int_equal(arflex_host_wait_state(&h_forged, ARFLEX_STATE_READY, 10 * SEC), 0);
+	assert_true(h_forged.token != 0);
+	assert_int_equal(arflex_host_start(&h_forged, T_CALL), 0);
+	assert_true(wait_out(&h_forged, updates_above, 5, false));
+
+	real = h_forged.token;
+	for (unsigned i = 0; i < sizeof(cmds) / sizeof(cmds[0]); i++) {
+		forge(cmds[i], 0);
+		forge(cmds[i], real ^ 1);
+	}
+	/* served in order: the forged six came before this PING */
+	assert_int_equal(arflex_host_call(&h_forged, ARFLEX_CMD_PING, NULL, NULL, T_CALL), 0);
+	assert_int_equal(replies_waiting(), 0);
+	assert_int_equal(h_forged.ctl->warnings[ARFLEX_WARN_FORGED], 6);
+	assert_int_equal(arflex_ctl_state(h_forged.ctl), ARFLEX_STATE_RUNNING);
+	assert_int_equal(arflex_host_wait_exit(&h_forged, 0), -ETIMEDOUT);
+	assert_true(read_out(&h_forged, &o));
+	assert_true(wait_out(&h_forged, updates_above, o.updates + 5, false));
+	/* a manager with the wrong token is a forger too: no reply */
+	h_forged.token = real + 1;
+	assert_int_equal(arflex_host_call(&h_forged, ARFLEX_CMD_STOP, NULL, NULL, SEC / 4),
+			 -ETIMEDOUT);
+	h_forged.token = real;
+	assert_int_equal(arflex_ctl_state(h_forged.ctl), ARFLEX_STATE_RUNNING);
+	assert_int_equal(h_forged.ctl->warnings[ARFLEX_WARN_FORGED], 7);
+	/* the real manager's commands work */
+	assert_int_equal(arflex_host_stop(&h_forged, T_CALL), 0);
+	assert_int_equal(arflex_ctl_state(h_forged.ctl), ARFLEX_STATE_READY);
+	shutdown_ok(&h_forged);
+	arflex_host_destroy(&h_forged);
+	unlink(logpath);
+	th_assert_clean(rid);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(supervisor_lost_holds_then_leaves_nothing),
 		cmocka_unit_test(closed_output_pipe_does_not_kill),
+		cmocka_unit_test(forged_requests_are_ignored),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);
