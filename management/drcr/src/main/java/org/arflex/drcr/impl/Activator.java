@@ -1,5 +1,6 @@
 package org.arflex.drcr.impl;
 
+import java.security.SecureRandom;
 import java.time.LocalTime;
 import java.util.ArrayList;
 import java.util.Hashtable;
@@ -39,7 +40,7 @@ import org.osgi.util.tracker.BundleTracker;
  * registers the services and Gogo commands, starts the heartbeat thread and the extender. Stop
  * undoes all of it and leaves no process or shared object behind.
  *
- * <p>Framework properties: {@code arflex.runtime.id} (default {@code rt<pid>}),
+ * <p>Framework properties: {@code arflex.runtime.id} (default {@code rt<pid>-<10 random hex>}),
  * {@code arflex.cpus} (default all), {@code arflex.cpus.reserved} (CPUs admission gives only
  * to components naming them in {@code timing/@cpus}; default none), {@code arflex.cpu.cap}
  * (utilisation cap per CPU, default 1.0), {@code arflex.memory} (default 1g), {@code arflex.network} (default 125m B/s),
@@ -52,6 +53,7 @@ import org.osgi.util.tracker.BundleTracker;
 public final class Activator implements BundleActivator {
 
     private static final Pattern RID = Pattern.compile("[a-z0-9-]{1,40}");
+    private static final SecureRandom RANDOM = new SecureRandom();
     private static final long HEARTBEAT_MS = org.arflex.drcr.impl.supervisor.HeartbeatMonitor.PERIOD_MS;
     private static final long SAMPLE_MS = 1_000;
 
@@ -86,8 +88,18 @@ public final class Activator implements BundleActivator {
         }
     }
 
+    /**
+     * The default runtime id, {@code rt<pid>-<10 random hex>}: the pid lets the Sweeper tell a
+     * dead runtime's objects, the random part makes the object names unpredictable
+     * (DECISIONS.md D13).
+     */
+    static String defaultRuntimeId(long pid) {
+        long r = RANDOM.nextLong() & 0xFF_FFFF_FFFFL;
+        return String.format("rt%d-%010x", pid, r);
+    }
+
     private void doStart(BundleContext ctx) throws Exception {
-        rid = prop(ctx, "arflex.runtime.id", "rt" + ProcessHandle.current().pid());
+        rid = prop(ctx, "arflex.runtime.id", defaultRuntimeId(ProcessHandle.current().pid()));
         if (!RID.matcher(rid).matches()) {
             throw new IllegalArgumentException("arflex.runtime.id '" + rid + "' must match [a-z0-9-]{1,40}");
         }

@@ -22,13 +22,14 @@ import org.arflex.drcr.impl.abi.ShmSegment;
 /**
  * Removes what a dead runtime left behind: {@code /dev/shm/arflex.<rid>.*} and the queues of
  * the same instances, for our own runtime id (a previous run that crashed) and for
- * {@code rt<pid>} ids whose JVM is gone. Orphaned RT halves (pid in a stale control block,
+ * default ids ({@code rt<pid>-<10 hex>}, formerly {@code rt<pid>}) whose JVM is gone. Orphaned RT halves (pid in a stale control block,
  * still running with {@code --runtime <rid>} on their command line) are killed.
  */
 final class Sweeper {
 
     private static final Pattern NAME = Pattern.compile("arflex\\.([a-z0-9-]{1,40})\\.([a-z0-9-]{1,40})\\.(.+)");
-    private static final Pattern DEFAULT_RID = Pattern.compile("rt(\\d+)");
+    /** Default runtime ids, {@code rt<pid>-<10 hex>} and the older {@code rt<pid>}. */
+    private static final Pattern DEFAULT_RID = Pattern.compile("rt(\\d+)(-[0-9a-f]{10})?");
 
     private Sweeper() {
     }

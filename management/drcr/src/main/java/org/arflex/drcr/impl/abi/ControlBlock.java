@@ -52,6 +52,8 @@ public final class ControlBlock implements AutoCloseable {
     public static final int OFF_CFG_ORPHAN_HOLD = 120;
     public static final int OFF_WARNINGS = 128;
     public static final int WARN_KINDS = 16;
+    /** enum arflex_warn_kind ARFLEX_WARN_FORGED: mailbox requests with a wrong token ignored. */
+    public static final int WARN_FORGED = 11;
     // stats (struct arflex_stats at 256)
     public static final int OFF_STATS = 256;
     public static final int OFF_STATS_SEQ = 256;

@@ -12,6 +12,10 @@ import java.util.Optional;
  * message one 512-byte struct arflex_msg. One request is outstanding at a time (calls are
  * serialised); a reply whose seq is not the awaited one is a late reply to a request that timed
  * out and is discarded.
+ *
+ * <p>Every request carries the instance's token (ABI.md 5, DECISIONS.md D13), which the RT half
+ * got as the first 8 bytes on its supervisor pipe; it ignores requests with another token, and
+ * a reply with another token is not from it and is discarded here.
  */
 public final class Mailbox implements AutoCloseable {
 
@@ -26,6 +30,7 @@ public final class Mailbox implements AutoCloseable {
     public static final int OFF_FLAGS = 14;
     public static final int OFF_STATUS = 16;
     public static final int OFF_PAYLOAD_LEN = 20;
+    public static final int OFF_TOKEN = 24;
     public static final int OFF_PAYLOAD = 32;
     public static final int FLAG_REPLY = 1;
     // struct arflex_msg_param, relative to the payload
@@ -72,18 +77,23 @@ public final class Mailbox implements AutoCloseable {
 
     private final MessageQueue cmd;
     private final MessageQueue rsp;
+    private final long token;
     private int seq;
 
-    private Mailbox(MessageQueue cmd, MessageQueue rsp) {
+    Mailbox(MessageQueue cmd, MessageQueue rsp, long token) {
         this.cmd = cmd;
         this.rsp = rsp;
+        this.token = token;
     }
 
-    /** Creates both queues exclusively (0600); nothing is left behind on failure. */
-    public static Mailbox create(String cmdName, String rspName) throws IOException {
+    /**
+     * Creates both queues exclusively (0600); nothing is left behind on failure. {@code token}
+     * goes into every request and must come back in every reply.
+     */
+    public static Mailbox create(String cmdName, String rspName, long token) throws IOException {
         MessageQueue c = MessageQueue.create(cmdName, MQ_MAXMSG, MSG_SIZE);
         try {
-            return new Mailbox(c, MessageQueue.create(rspName, MQ_MAXMSG, MSG_SIZE));
+            return new Mailbox(c, MessageQueue.create(rspName, MQ_MAXMSG, MSG_SIZE), token);
         } catch (IOException e) {
             c.close();
             throw e;
@@ -153,6 +163,7 @@ public final class Mailbox implements AutoCloseable {
         int s = ++seq;
         ByteBuffer req = message(c, s);
         fill.accept(req);
+        req.putLong(OFF_TOKEN, token);
         long deadline = System.nanoTime() + timeoutMs * 1_000_000L;
         cmd.send(req.array(), timeoutMs);
         while (true) {
@@ -168,6 +179,9 @@ public final class Mailbox implements AutoCloseable {
             if (got.get().length < OFF_PAYLOAD || r.getInt(OFF_MAGIC) != MSG_MAGIC
                     || r.getShort(OFF_ABI_MAJOR) != ControlBlock.ABI_MAJOR) {
                 continue; // not a message of ours: discarded
+            }
+            if (r.getLong(OFF_TOKEN) != token) {
+                continue; // not from our RT half
             }
             if (r.getInt(OFF_SEQ) != s || (r.getShort(OFF_FLAGS) & FLAG_REPLY) == 0) {
                 continue; // a late reply to an earlier request

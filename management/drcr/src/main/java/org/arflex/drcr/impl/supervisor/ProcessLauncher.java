@@ -4,7 +4,10 @@ import java.io.BufferedReader;
 import java.io.IOException;
 import java.io.InputStreamReader;
 import java.io.OutputStream;
+import java.nio.ByteBuffer;
+import java.nio.ByteOrder;
 import java.nio.charset.StandardCharsets;
+import java.security.SecureRandom;
 import java.util.ArrayDeque;
 import java.util.Deque;
 import java.util.concurrent.CompletableFuture;
@@ -33,6 +36,7 @@ public final class ProcessLauncher implements RtLauncher {
     private static final int TAIL_LINES = 8;
     /** How long an RT half that reported FAILED may take to exit by itself before it is killed. */
     private static final long FAILED_EXIT_GRACE_MS = 500;
+    private static final SecureRandom RANDOM = new SecureRandom();
 
     private final Consumer<String> log;
     private final VerifiedExecutables executables;
@@ -80,6 +84,25 @@ public final class ProcessLauncher implements RtLauncher {
         };
     }
 
+    /** A fresh, nonzero mailbox token (0 is the token of hosts without a supervisor pipe). */
+    static long newToken() {
+        long t;
+        do {
+            t = RANDOM.nextLong();
+        } while (t == 0);
+        return t;
+    }
+
+    /** The token as the first 8 bytes, little endian, on the supervisor pipe (ABI.md 6.2). */
+    static void sendToken(OutputStream pipe, long token) {
+        try {
+            pipe.write(ByteBuffer.allocate(8).order(ByteOrder.LITTLE_ENDIAN).putLong(0, token).array());
+            pipe.flush();
+        } catch (IOException e) {
+            // the half is gone already, or it exits for want of the token: the wait reports it
+        }
+    }
+
     @Override
     public RtHalf launch(Spec spec) throws IOException {
         String rid = spec.runtimeId();
@@ -88,9 +111,10 @@ public final class ProcessLauncher implements RtLauncher {
         String exe = executables.verify(spec.executable()).toString();
         ControlBlock ctl = ControlBlock.create(objectName(rid, inst, "ctl"), spec.config().withSupervisorPipe(),
                 spec.params(), spec.resetRequired());
+        long token = newToken();
         Mailbox mb;
         try {
-            mb = Mailbox.create(objectName(rid, inst, "cmd"), objectName(rid, inst, "rsp"));
+            mb = Mailbox.create(objectName(rid, inst, "cmd"), objectName(rid, inst, "rsp"), token);
         } catch (IOException e) {
             ctl.close();
             throw e;
@@ -106,8 +130,10 @@ public final class ProcessLauncher implements RtLauncher {
             ctl.close();
             throw new IOException("cannot spawn " + spec.executable() + ": " + e.getMessage(), e);
         }
-        // p.getOutputStream() is the supervisor pipe: held open until cleanup()
+        // p.getOutputStream() is the supervisor pipe: held open until cleanup(); its first 8
+        // bytes are the token (a half that died at once is reported by the wait below)
         ProcessRtHalf half = new ProcessRtHalf(inst, p, ctl, mb, p.getOutputStream());
+        sendToken(p.getOutputStream(), token);
         half.pumpOutput(log);
         // Wait for READY (or a failure) with a deadline; the RT half attaches, configures and
         // declares its ports in between.

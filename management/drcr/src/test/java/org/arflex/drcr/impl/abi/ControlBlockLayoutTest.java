@@ -41,6 +41,7 @@ class ControlBlockLayoutTest {
         expect.put("offsetof(struct arflex_ctl, config.orphan_hold_ns)", (long) ControlBlock.OFF_CFG_ORPHAN_HOLD);
         expect.put("offsetof(struct arflex_ctl, warnings)", (long) ControlBlock.OFF_WARNINGS);
         expect.put("ARFLEX_WARN_KINDS", (long) ControlBlock.WARN_KINDS);
+        expect.put("ARFLEX_WARN_FORGED", (long) ControlBlock.WARN_FORGED);
         expect.put("offsetof(struct arflex_ctl, stats.seq)", (long) ControlBlock.OFF_STATS_SEQ);
         expect.put("offsetof(struct arflex_ctl, stats.cycles)", (long) ControlBlock.OFF_STATS_CYCLES);
         expect.put("offsetof(struct arflex_ctl, stats.overruns)", (long) ControlBlock.OFF_STATS_OVERRUNS);

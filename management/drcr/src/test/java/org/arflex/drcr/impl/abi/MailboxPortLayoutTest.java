@@ -23,6 +23,7 @@ class MailboxPortLayoutTest {
         e.put("offsetof(struct arflex_msg, flags)", (long) Mailbox.OFF_FLAGS);
         e.put("offsetof(struct arflex_msg, status)", (long) Mailbox.OFF_STATUS);
         e.put("offsetof(struct arflex_msg, payload_len)", (long) Mailbox.OFF_PAYLOAD_LEN);
+        e.put("offsetof(struct arflex_msg, token)", (long) Mailbox.OFF_TOKEN);
         e.put("offsetof(struct arflex_msg, u)", (long) Mailbox.OFF_PAYLOAD);
         e.put("ARFLEX_MSG_REPLY", (long) Mailbox.FLAG_REPLY);
         e.put("offsetof(struct arflex_msg_param, index)", (long) Mailbox.PARAM_INDEX);
