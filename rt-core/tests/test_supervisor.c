@@ -217,12 +217,42 @@ static void forged_requests_are_ignored(void **state)
 	th_assert_clean(rid);
 }
 
+/* A half told to expect the supervisor pipe but given no token on it (EOF at once) does not
+ * serve anyone: it exits with the attach failure code. */
+static void no_token_no_service(void **state)
+{
+	char *argv[] = { (char *)ARFLEX_PROBE_EXE, (char *)"--runtime", rid, (char *)"--instance",
+			 (char *)"probe", NULL };
+	struct arflex_host h;
+	int sup[2], fds[3], status;
+	pid_t pid;
+
+	(void)state;
+	setup_ids("notoken");
+	assert_int_equal(probe_host(&h, "probe", 0, 0, true), 0);
+	h.ctl->config.cfg_flags |= ARFLEX_CFG_SUPERVISOR_PIPE;
+	assert_int_equal(arflex_sys_pipe(sup), 0);
+	fds[0] = sup[0];
+	fds[1] = fds[2] = -1;
+	assert_int_equal(arflex_sys_spawn_io(&pid, ARFLEX_PROBE_EXE, argv, envp, fds), 0);
+	arflex_sys_close(sup[0]);
+	arflex_sys_close(sup[1]);
+	assert_int_equal(waitpid(pid, &status, 0), pid);
+	assert_true(WIFEXITED(status));
+	assert_int_equal(WEXITSTATUS(status), ARFLEX_EXIT_ATTACH);
+	assert_int_equal(arflex_ctl_state(h.ctl), ARFLEX_STATE_FAILED);
+	arflex_host_destroy(&h);
+	unlink(logpath);
+	th_assert_clean(rid);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(supervisor_lost_holds_then_leaves_nothing),
 		cmocka_unit_test(closed_output_pipe_does_not_kill),
 		cmocka_unit_test(forged_requests_are_ignored),
+		cmocka_unit_test(no_token_no_service),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);
