@@ -54,6 +54,7 @@ struct arflex_component {
 	bool orphaned;                /* mailbox thread: left the loop as an orphan */
 	pthread_t watcher;
 	bool watching;                /* main thread: the watcher runs */
+	int watch_wake[2];            /* main -> watcher: a byte (or EOF) ends the watch */
 	uint64_t token;               /* the manager's mailbox token (0 without the pipe) */
 	uint64_t forged_log_ns;       /* mailbox thread: when a forged request was last logged */
 	uint64_t forged_unlogged;     /* mailbox thread: forged requests since that log line */

@@ -94,15 +94,30 @@ int arflex_comp_read_token(struct arflex_component *c)
 
 /* The supervisor-pipe watcher (ARFLEX_CFG_SUPERVISOR_PIPE): blocks in read() on fd 0; EOF or
  * an error means the supervisor is gone. Not the RT thread; it only sets two words. */
+/* Blocks in poll() on fd 0 and on the wake pipe: EOF or an error on fd 0 means the supervisor
+ * is gone; the wake pipe ends the watch without that (an orderly exit). No cancellation: a
+ * thread cancelled in read() is not something every runtime (ASan's among them) unwinds. */
 static void *watch_supervisor(void *arg)
 {
 	struct arflex_component *c = arg;
+	struct pollfd fds[2] = { { .fd = 0, .events = POLLIN }, { .fd = c->watch_wake[0], .events = POLLIN } };
 	char buf[64];
-	long n;
 
-	do {
-		n = arflex_sys_read(0, buf, sizeof(buf)); /* data after the token is ignored */
-	} while (n > 0);
+	for (;;) {
+		if (poll(fds, 2, -1) < 0) {
+			if (errno == EINTR)
+				continue;
+			break; /* cannot watch: take it as lost, the safe side */
+		}
+		if (fds[1].revents)
+			return NULL; /* orderly exit */
+		if (fds[0].revents) {
+			long n = arflex_sys_read(0, buf, sizeof(buf)); /* data after the token: ignored */
+
+			if (n <= 0 && n != -EINTR && n != -EAGAIN)
+				break;
+		}
+	}
 	STORE(&c->lost_ns, arflex_sys_now_ns());
 	__atomic_or_fetch(&c->ctl->flags, ARFLEX_FLAG_SUPERVISOR_LOST, __ATOMIC_RELEASE);
 	return NULL;
@@ -113,6 +128,9 @@ int arflex_comp_watch_start(struct arflex_component *c)
 	sigset_t all, old;
 	int r;
 
+	r = arflex_sys_pipe(c->watch_wake);
+	if (r)
+		return r;
 	sigemptyset(&all);
 	sigaddset(&all, SIGTERM);
 	sigaddset(&all, SIGINT);
@@ -120,17 +138,22 @@ int arflex_comp_watch_start(struct arflex_component *c)
 	r = arflex_sys_thread_create(&c->watcher, NULL, watch_supervisor, c);
 	pthread_sigmask(SIG_SETMASK, &old, NULL);
 	c->watching = !r;
+	if (r) {
+		arflex_sys_close(c->watch_wake[0]);
+		arflex_sys_close(c->watch_wake[1]);
+	}
 	return r;
 }
 
-/* Before the control block is unmapped: the watcher must not write to it any more. It is
- * blocked in read() (a cancellation point) or about to return. */
+/* Before the control block is unmapped: the watcher must not write to it any more. Closing
+ * the wake pipe's write end wakes it (EOF on the wake pipe); then it is joined. */
 void arflex_comp_watch_stop(struct arflex_component *c)
 {
 	if (!c->watching)
 		return;
-	pthread_cancel(c->watcher);
+	arflex_sys_close(c->watch_wake[1]);
 	arflex_sys_thread_join(c->watcher, NULL);
+	arflex_sys_close(c->watch_wake[0]);
 	c->watching = false;
 }
 
