@@ -96,6 +96,18 @@ class FaultBench {
         }
     }
 
+    /**
+     * Waits until {@code name} has at least two restarts left in its window (3 in 10 s for the
+     * cell's components), so that a fault injected now restarts it instead of exhausting its
+     * budget because of the scenario before (FAILED is right then, but it is another scenario).
+     */
+    private static void awaitRestartBudget(Runtime rt, String name) {
+        rt.waitUntil(name + " with restarts left", 30_000, () -> {
+            Object left = rt.instance(name).get("restartsLeft");
+            return left instanceof Number n && n.intValue() >= 2;
+        });
+    }
+
     private static void signal(long pid, String sig) throws Exception {
         new ProcessBuilder("kill", "-" + sig, Long.toString(pid)).inheritIO().start().waitFor();
     }
@@ -123,6 +135,9 @@ class FaultBench {
                 }
                 java.util.Collections.shuffle(order, rnd);
                 for (String s : order) {
+                    if (!s.startsWith("S16")) { // before the clock starts
+                        awaitRestartBudget(rt, s.equals("S1-motion") ? "trajectory" : "force-guard");
+                    }
                     rt.waitUntil("the arm moving", 30_000, () -> FailSafeIT.moving(js));
                     long t0 = System.nanoTime();
                     switch (s) {
@@ -148,7 +163,13 @@ class FaultBench {
                             CellRig.set(rt, "sim-robot", "push_duration_ms", "200");
                             CellRig.set(rt, "sim-robot", "push_force_n", "400");
                             double safe = timeToStill(rt, js, t0);
+                            // the operator resets once the contact is over: the push (200 ms of
+                            // simulated time) has ended and the arm is at rest again
+                            rt.waitUntil("the push over", 30_000, () -> System.nanoTime() - t0 > 400_000_000L);
                             CellRig.set(rt, "sim-robot", "push_force_n", "0");
+                            int settled = js.size();
+                            rt.waitUntil("the arm at rest after the push", 30_000,
+                                    () -> js.size() > settled + 50 && FailSafeIT.stillFor(js, 200));
                             boolean ok = resetThenCommand(rt, js);
                             record(s, new Run(safe >= 0 && ok, safe, 0, ""));
                         }
