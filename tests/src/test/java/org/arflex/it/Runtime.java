@@ -72,6 +72,20 @@ final class Runtime implements AutoCloseable {
 
     /** @param waitForDrcr false: do not wait for the DRCR (a test that expects it to refuse to start) */
     Runtime(String name, String fixedRid, boolean waitForDrcr) throws IOException, InterruptedException {
+        this(name, fixedRid, waitForDrcr, trustedFolders());
+    }
+
+    /**
+     * @param trusted the code gate's trusted folders ({@code arflex.code.trusted}); the tests of
+     *        the gate pass the runtime's defaults only ({@code bundle,cell,tools})
+     */
+    Runtime(String name, String fixedRid, boolean waitForDrcr, String trusted) throws IOException, InterruptedException {
+        this(name, fixedRid, waitForDrcr, trusted, null);
+    }
+
+    /** @param umask the file mode creation mask to start the JVM with (octal), null: this JVM's */
+    Runtime(String name, String fixedRid, boolean waitForDrcr, String trusted, String umask)
+            throws IOException, InterruptedException {
         Path assembly = Path.of(System.getProperty("arflex.it.runtime"));
         if (!Files.isRegularFile(assembly.resolve("bin/felix.jar"))) {
             fail("runtime assembly not found at " + assembly + " (build management/runtime first)");
@@ -91,10 +105,14 @@ final class Runtime implements AutoCloseable {
         // machine); a benchmark that measures the cell as the main job runs it sets
         // arflex.it.mlock=true.
         boolean mlock = Boolean.getBoolean("arflex.it.mlock");
-        ProcessBuilder pb = new ProcessBuilder(Path.of(System.getProperty("java.home"), "bin", "java").toString(),
+        List<String> command = new ArrayList<>();
+        if (umask != null) {
+            command.addAll(List.of("sh", "-c", "umask " + umask + " && exec \"$@\"", "sh"));
+        }
+        command.addAll(List.of(Path.of(System.getProperty("java.home"), "bin", "java").toString(),
                 "-Darflex.runtime.id=" + rid, "-Darflex.nomlock=" + !mlock, "-Dorg.osgi.service.http.port=0",
-                "-Darflex.code.trusted=" + trustedFolders(),
-                "-jar", "bin/felix.jar").directory(dir.toFile());
+                "-Darflex.code.trusted=" + trusted, "-jar", "bin/felix.jar"));
+        ProcessBuilder pb = new ProcessBuilder(command).directory(dir.toFile());
         process = pb.start();
         stdin = new OutputStreamWriter(process.getOutputStream(), StandardCharsets.UTF_8);
         pump(new BufferedReader(new InputStreamReader(process.getInputStream(), StandardCharsets.UTF_8)), true);
@@ -354,6 +372,20 @@ final class Runtime implements AutoCloseable {
         crashed = true;
         process.destroyForcibly();
         process.waitFor(30, TimeUnit.SECONDS);
+    }
+
+    /** How many lines the log has now (a mark for {@link #logSince}). */
+    int logMark() {
+        synchronized (log) {
+            return log.size();
+        }
+    }
+
+    /** The log lines after {@code mark}. */
+    List<String> logSince(int mark) {
+        synchronized (log) {
+            return new ArrayList<>(log.subList(Math.min(mark, log.size()), log.size()));
+        }
     }
 
     /** Whether the log contains a line with {@code text}. */

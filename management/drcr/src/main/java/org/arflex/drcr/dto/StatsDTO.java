@@ -25,6 +25,11 @@ public class StatsDTO {
     public long updateErrors;
     /** Since 0.5.0: cycles run through the safe hook (heartbeat lost, reset required). */
     public long safeCycles;
+    /**
+     * Since 0.7.0: mailbox requests the RT half ignored because they did not carry its token
+     * (written into its command queue by another process of this machine: an attack or a bug).
+     */
+    public long forgedRequests;
 
     // Since 0.2.0: percentiles and the wake-up latency histogram of the control block (all
     // read under the same seqlock as the counters above). Percentiles are upper bin edges

@@ -155,6 +155,7 @@ public final class Snapshots {
         d.rtState = ControlBlock.stateName(half.rtState());
         long hb = half.rtHeartbeatNs();
         d.heartbeatAgeMs = hb == 0 ? -1 : Math.max(0, (nowNs - hb) / 1_000_000L);
+        d.forgedRequests = half.forgedRequests();
         if (s != null) {
             d.cycles = s.cycles();
             d.overruns = s.overruns();

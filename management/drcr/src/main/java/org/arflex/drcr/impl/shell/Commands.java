@@ -237,7 +237,7 @@ public final class Commands {
             return name + ": rt " + s.rtState + ", cycles " + s.cycles + ", overruns " + s.overruns + ", wcet overruns "
                     + s.wcetOverruns + ", latency max " + s.maxLatencyNs + " ns, exec max " + s.maxExecNs + " ns, exec mean "
                     + s.meanExecNs + " ns, update errors " + s.updateErrors + ", safe cycles " + s.safeCycles
-                    + ", heartbeat age " + s.heartbeatAgeMs + " ms"
+                    + ", heartbeat age " + s.heartbeatAgeMs + " ms, forged requests ignored " + s.forgedRequests
                     + (s.latencyHistBins == null ? "" : "\n" + name + ": latency p50 " + s.latencyP50Ns + " ns, p99 "
                     + s.latencyP99Ns + " ns, p99.9 " + s.latencyP999Ns + " ns (" + s.latencyCount + " samples, "
                     + s.latencyHistOverflow + " >= " + s.histBinNs * 2000 / 1000 + " us); exec p50 " + s.execP50Ns

@@ -10,6 +10,7 @@ import java.nio.charset.StandardCharsets;
 import java.security.SecureRandom;
 import java.util.ArrayDeque;
 import java.util.Deque;
+import java.util.List;
 import java.util.concurrent.CompletableFuture;
 import java.util.concurrent.TimeUnit;
 import java.util.concurrent.locks.LockSupport;
@@ -55,7 +56,8 @@ public final class ProcessLauncher implements RtLauncher {
     @Override
     public Output createOutput(String segmentName, int method, String typeName, int major, int minor, int elemSize,
                                int depth, int overflow) throws IOException {
-        PortSegment seg = PortSegment.create(segmentName, method, typeName, major, minor, elemSize, depth, overflow);
+        PortSegment seg = Squatters.createExclusive(segmentName, List.of(segmentName), List.of(),
+                () -> PortSegment.create(segmentName, method, typeName, major, minor, elemSize, depth, overflow), log);
         return new Output() {
             private boolean closed;
 
@@ -109,12 +111,15 @@ public final class ProcessLauncher implements RtLauncher {
         String inst = spec.instance();
         // every spawn, restarts included, runs the bytes recorded when the bundle was started
         String exe = executables.verify(spec.executable()).toString();
-        ControlBlock ctl = ControlBlock.create(objectName(rid, inst, "ctl"), spec.config().withSupervisorPipe(),
-                spec.params(), spec.resetRequired());
+        String ctlName = objectName(rid, inst, "ctl");
+        ControlBlock ctl = Squatters.createExclusive(inst, List.of(ctlName), List.of(), () -> ControlBlock.create(ctlName,
+                spec.config().withSupervisorPipe(), spec.params(), spec.resetRequired()), log);
         long token = newToken();
         Mailbox mb;
         try {
-            mb = Mailbox.create(objectName(rid, inst, "cmd"), objectName(rid, inst, "rsp"), token);
+            String cmd = objectName(rid, inst, "cmd");
+            String rsp = objectName(rid, inst, "rsp");
+            mb = Squatters.createExclusive(inst, List.of(), List.of(cmd, rsp), () -> Mailbox.create(cmd, rsp, token), log);
         } catch (IOException e) {
             ctl.close();
             throw e;
@@ -366,6 +371,14 @@ public final class ProcessLauncher implements RtLauncher {
                 return 0;
             }
             return ctl.hold();
+        }
+
+        @Override
+        public synchronized long forgedRequests() {
+            if (cleaned) {
+                return 0;
+            }
+            return ctl.warnings(ControlBlock.WARN_FORGED);
         }
 
         @Override

@@ -63,6 +63,14 @@ public interface RtHalf {
         return 0;
     }
 
+    /**
+     * Mailbox requests the RT half ignored because their token was not its own (ABI.md 6.2:
+     * someone else on this machine wrote into its command queue); 0 when gone.
+     */
+    default long forgedRequests() {
+        return 0;
+    }
+
     /** The RT thread's heartbeat, CLOCK_MONOTONIC ns (0 before its first cycle). */
     long rtHeartbeatNs();
 
