@@ -98,7 +98,8 @@ final class JarSignatures {
         try {
             return check(Files.readAllBytes(jar), trusted);
         } catch (IOException e) {
-            return Verdict.refused("cannot read " + jar + ": " + e.getMessage());
+            return Verdict.refused("cannot read " + jar + ": "
+                    + (e instanceof java.nio.file.NoSuchFileException ? "no such file" : e.getMessage()));
         }
     }
 
