@@ -47,7 +47,10 @@ import org.osgi.util.tracker.BundleTracker;
  * {@code arflex.ready.timeout.ms} (default 5000), {@code arflex.nomlock} (true: RT halves skip
  * mlockall, for tests with many instances), {@code arflex.code.trusted} (the folders whose jars
  * may run RT halves without a pinned SHA-256, comma separated; default
- * {@code bundle,cell,tools} of the working directory: docs/DECISIONS.md D12).
+ * {@code bundle,cell,tools} of the working directory: docs/DECISIONS.md D12),
+ * {@code arflex.code.truststore} (the folder of certificates whose keys may sign component
+ * bundles; default {@code trust} of the working directory, {@code none}: no signature is
+ * trusted; D14).
  */
 @Header(name = Constants.BUNDLE_ACTIVATOR, value = "${@class}")
 public final class Activator implements BundleActivator {
@@ -130,7 +133,11 @@ public final class Activator implements BundleActivator {
             return c;
         }, 10_000);
         ContractReader reader = new ContractReader(types);
-        CodeGate gate = new CodeGate(trustedFolders(prop(ctx, "arflex.code.trusted", "bundle,cell,tools")), log);
+        String store = prop(ctx, "arflex.code.truststore", "trust");
+        CodeGate gate = new CodeGate(trustedFolders(prop(ctx, "arflex.code.trusted", "bundle,cell,tools")),
+                store.equals("none") ? null : java.nio.file.Path.of(store).toAbsolutePath().normalize(), log);
+        log.accept("arflex: code gate: trusted folders " + gate.trusted() + ", trust store for signed code "
+                + (gate.trustStore() == null ? "none" : gate.trustStore()));
         services = new Services(cell, rm[0], reader, ctx, gate, log);
         VerifiedInstaller installer = new VerifiedInstaller(ctx, gate, log);
         cell.onChange(services::sync);

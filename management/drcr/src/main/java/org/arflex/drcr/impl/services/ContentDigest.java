@@ -31,6 +31,11 @@ final class ContentDigest {
 
     /** The digest of a jar held in memory. */
     static String ofJar(byte[] jar) throws IOException {
+        return of(entries(jar));
+    }
+
+    /** The file entries of a jar held in memory, by name (what its digest covers). */
+    static Map<String, byte[]> entries(byte[] jar) throws IOException {
         Map<String, byte[]> entries = new TreeMap<>();
         try (ZipInputStream in = new ZipInputStream(new ByteArrayInputStream(jar))) {
             ZipEntry e;
@@ -43,7 +48,7 @@ final class ContentDigest {
         if (entries.isEmpty()) {
             throw new IOException("not a jar (no entries)");
         }
-        return of(entries);
+        return entries;
     }
 
     /** The digest of a jar file. */
@@ -53,9 +58,14 @@ final class ContentDigest {
 
     /** The digest of an installed bundle's current revision, from its entries. */
     static String ofBundle(Bundle b) throws IOException {
+        return of(entries(b));
+    }
+
+    /** The file entries of an installed bundle's current revision, by name (what its digest covers). */
+    static Map<String, byte[]> entries(Bundle b) throws IOException {
         Map<String, byte[]> entries = new TreeMap<>();
         collect(b, "/", entries);
-        return of(entries);
+        return entries;
     }
 
     private static void collect(Bundle b, String dir, Map<String, byte[]> into) throws IOException {

@@ -11,11 +11,13 @@ import org.osgi.framework.Constants;
 
 /**
  * Installs and updates bundles from the shell through the verified path: {@code deploy <url>
- * <sha256>} and {@code update <bundle-id> [<url> [<sha256>]]}. Every fetch goes through
+ * [<sha256>]} and {@code update <bundle-id> [<url> [<sha256>]]}. Every fetch goes through
  * {@link Fetch} (https/file only, timeouts, no redirects). A jar whose SHA-256 matches the pin
- * is recorded in the {@link CodeGate}; one without a pin is installed as Felix would, and the
- * gate then decides whether its RT halves may run (only when it is the file in a trusted
- * folder it came from).
+ * is recorded in the {@link CodeGate}. {@code deploy} without a pin installs only a jar signed
+ * entirely by a key of the trust store (docs/DECISIONS.md D14), and refuses any other with the
+ * reason; the gate checks the installed bundle's signature again before its RT halves run.
+ * {@code update} without a pin installs as Felix would, and the gate then decides whether its
+ * RT halves may run (a trusted signature, or the file in a trusted folder it came from).
  */
 public final class VerifiedInstaller {
 
@@ -52,12 +54,27 @@ public final class VerifiedInstaller {
         return jar;
     }
 
-    /** {@code deploy <url> <sha256>}: install (or update the bundle of that location) and start. */
+    /**
+     * {@code deploy <url> [<sha256>]}: install (or update the bundle of that location) and start.
+     * Without a pin the jar must be signed by a key of the trust store.
+     */
     public String deploy(String location, String sha256) {
-        if (sha256 == null || !sha256.matches("[0-9a-fA-F]{64}")) {
-            throw new IllegalArgumentException("deploy needs the jar's SHA-256 (64 hex digits) after its URL");
+        if (sha256 != null && !sha256.matches("[0-9a-fA-F]{64}")) {
+            throw new IllegalArgumentException("deploy needs the jar's SHA-256 (64 hex digits) after its URL, "
+                    + "or none for a jar signed by a key of the trust store");
         }
         byte[] jar = fetch(location, sha256);
+        String how = "sha256 verified";
+        if (sha256 == null) {
+            JarSignatures.Verdict v = gate.signature(jar);
+            if (!v.accepted()) {
+                throw new IllegalStateException("not installed: " + location
+                        + " has no pinned SHA-256 and is not signed by a trusted key: " + v.reason()
+                        + "; give its SHA-256 (deploy <url> <sha256>) or sign it with a key of the trust store "
+                        + gate.trustStore());
+            }
+            how = v.describe();
+        }
         try {
             Bundle b = context.getBundle(location);
             if (b == null) {
@@ -66,8 +83,8 @@ public final class VerifiedInstaller {
                 b.update(new ByteArrayInputStream(jar));
             }
             b.start();
-            log.accept("arflex: deployed bundle " + b.getBundleId() + " from " + location + " (sha256 verified)");
-            return "Bundle ID: " + b.getBundleId() + " (sha256 verified)";
+            log.accept("arflex: deployed bundle " + b.getBundleId() + " from " + location + " (" + how + ")");
+            return "Bundle ID: " + b.getBundleId() + " (" + how + ")";
         } catch (BundleException e) {
             throw new IllegalStateException("install of " + location + " failed: " + e.getMessage());
         }
@@ -96,7 +113,7 @@ public final class VerifiedInstaller {
             throw new IllegalStateException("update of bundle " + id + " failed: " + e.getMessage());
         }
         log.accept("arflex: bundle " + id + " updated from " + from + " ("
-                + (sha256 != null ? "sha256 verified" : "no pinned sha256: the code gate decides whether it runs") + ")");
+                + (sha256 != null ? "sha256 verified" : "no pinned sha256: the code gate decides whether it runs, by its signature or its folder") + ")");
         return "";
     }
 }

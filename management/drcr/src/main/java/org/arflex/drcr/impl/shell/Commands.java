@@ -45,7 +45,10 @@ public final class Commands {
          */
         String update(long id, String location, String sha256);
 
-        /** Installs (or updates) and starts the bundle at {@code location}, checked against {@code sha256}. */
+        /**
+         * Installs (or updates) and starts the bundle at {@code location}, checked against
+         * {@code sha256}, or (null) by its signature.
+         */
         String deploy(String location, String sha256);
     }
 
@@ -188,10 +191,14 @@ public final class Commands {
         });
     }
 
-    /** {@code deploy <https-or-file-url> <sha256>}: the verified install of a bundle, then its start. */
+    /**
+     * {@code deploy <https-or-file-url> [<sha256>]}: the verified install of a bundle, then its
+     * start; without a SHA-256 only a jar signed by a key of the runtime's trust store.
+     */
     public String deploy(String... args) {
-        return guard(() -> args.length == 2 ? bundles.deploy(args[0], args[1])
-                : "usage: deploy <https-or-file-url> <sha256>");
+        return guard(() -> args.length == 1 || args.length == 2
+                ? bundles.deploy(args[0], args.length == 2 ? args[1] : null)
+                : "usage: deploy <https-or-file-url> [<sha256>] (without a SHA-256: a jar signed by a trusted key)");
     }
 
     /** {@code resources} prints capacities; {@code resources set cpus 0,1 memory 512m network 10m} changes them. */

@@ -233,10 +233,12 @@ class CommandsTest {
     }
 
     @Test
-    void deployTakesAUrlAndItsPinnedSha256() {
+    void deployTakesAUrlAndItsPinnedSha256OrNoneForASignedJar() {
         assertEquals("Bundle ID: 9 (sha256 verified)", cmd.deploy("https://h/x.jar", "ab12"));
-        assertEquals(List.of("deploy https://h/x.jar ab12"), calls);
-        assertTrue(cmd.deploy("https://h/x.jar").startsWith("usage:"));
+        cmd.deploy("https://h/signed.jar");
+        assertEquals(List.of("deploy https://h/x.jar ab12", "deploy https://h/signed.jar null"), calls);
+        assertTrue(cmd.deploy().startsWith("usage: deploy <https-or-file-url> [<sha256>]"));
+        assertTrue(cmd.deploy("a", "b", "c").startsWith("usage:"));
     }
 
     @Test
