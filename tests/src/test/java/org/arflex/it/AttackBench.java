@@ -2,16 +2,11 @@ package org.arflex.it;
 
 import static org.junit.jupiter.api.Assertions.assertTrue;
 
-import java.io.IOException;
-import java.nio.charset.StandardCharsets;
 import java.nio.file.Files;
 import java.nio.file.Path;
-import java.nio.file.attribute.PosixFilePermission;
 import java.util.ArrayList;
 import java.util.List;
 import java.util.Locale;
-import java.util.Set;
-import java.util.stream.Stream;
 import org.junit.jupiter.api.Test;
 
 /**
@@ -57,7 +52,7 @@ class AttackBench {
             mb.trySquat(counter);
             print(mb.attempts);
         }
-        print(List.of(umask000(work)));
+        print(List.of(CodeDoors.umask000(work)));
 
         long ok = all.stream().filter(CodeDoors.Attempt::succeeded).count();
         StringBuilder json = new StringBuilder("{\"part\":\"runtime\",\"attempts\":[");
@@ -73,69 +68,6 @@ class AttackBench {
         System.out.println("JSON: " + out.toAbsolutePath());
         System.out.printf(Locale.ROOT, "attack-part: runtime %d/%d attempts succeeded%n", ok, all.size());
         assertTrue(all.size() > 0);
-    }
-
-    /**
-     * Finding 5: started under umask 000, is anything on the way to a native executable writable
-     * by others, and does an executable replaced on disk run at the next restart?
-     */
-    private static CodeDoors.Attempt umask000(Path work) throws Exception {
-        String door = "umask 000: writable cache, replaced RT executable";
-        try (Runtime rt = new Runtime("attack-umask", null, true, "bundle,cell,tools", "000")) {
-            Path jar = Files.copy(Path.of(System.getProperty("arflex.it.counter")),
-                    Files.createDirectories(rt.dir.resolve("tools")).resolve("counter.jar"));
-            long id = rt.installAndStart(jar);
-            rt.awaitState("ACTIVE", CellIT.T, CodeDoors.COMPONENT);
-            long pid = rt.pid(CodeDoors.COMPONENT);
-            Path exe = Path.of("/proc/" + pid + "/exe").toRealPath();
-            List<String> writable = new ArrayList<>();
-            for (Path p = exe; p != null && p.startsWith(rt.dir); p = p.getParent()) {
-                if (othersMayWrite(p)) {
-                    writable.add(p.toString());
-                }
-            }
-            try (Stream<Path> s = Files.walk(rt.dir.resolve("felix-cache"))) {
-                s.filter(AttackBench::othersMayWriteQuietly).limit(5).forEach(p -> writable.add(p.toString()));
-            }
-            // The attacker (here with the rights to do so) replaces the executable, then the half dies.
-            Path marker = work.resolve("attack-umask-pwned");
-            Files.deleteIfExists(marker);
-            // (a running executable cannot be written: it is replaced by a rename, as an attacker would)
-            Path fake = exe.resolveSibling(exe.getFileName() + ".new");
-            Files.writeString(fake, "#!/bin/sh\ntouch '" + marker + "'\nexec sleep 30\n", StandardCharsets.UTF_8);
-            Files.setPosixFilePermissions(fake, Set.of(PosixFilePermission.OWNER_READ, PosixFilePermission.OWNER_WRITE,
-                    PosixFilePermission.OWNER_EXECUTE));
-            Files.move(fake, exe, java.nio.file.StandardCopyOption.REPLACE_EXISTING, java.nio.file.StandardCopyOption.ATOMIC_MOVE);
-            FailSafeIT.kill9(pid);
-            boolean back;
-            try {
-                rt.waitUntil("the counter restarted", CellIT.T, () -> rt.activeWithNewPid(CodeDoors.COMPONENT, pid));
-                back = true;
-            } catch (AssertionError e) {
-                back = false;
-            }
-            boolean ran = Files.exists(marker);
-            rt.cmd("uninstall " + id);
-            rt.waitUntil(CodeDoors.COMPONENT + " gone", CellIT.T, () -> rt.instance(CodeDoors.COMPONENT) == null);
-            Files.deleteIfExists(marker);
-            return new CodeDoors.Attempt(door, ran || !writable.isEmpty(),
-                    (writable.isEmpty() ? "nothing writable by others" : "writable by others: " + writable)
-                            + (ran ? "; the replaced executable RAN" : "; the replaced executable did not run")
-                            + (back ? ", the counter came back verified" : ", the counter did not come back"));
-        }
-    }
-
-    private static boolean othersMayWrite(Path p) throws IOException {
-        Set<PosixFilePermission> s = Files.getPosixFilePermissions(p, java.nio.file.LinkOption.NOFOLLOW_LINKS);
-        return s.contains(PosixFilePermission.GROUP_WRITE) || s.contains(PosixFilePermission.OTHERS_WRITE);
-    }
-
-    private static boolean othersMayWriteQuietly(Path p) {
-        try {
-            return !Files.isSymbolicLink(p) && othersMayWrite(p);
-        } catch (IOException e) {
-            return false;
-        }
     }
 
     static String esc(String s) {

@@ -10,9 +10,11 @@ import java.net.Socket;
 import java.nio.charset.StandardCharsets;
 import java.nio.file.Files;
 import java.nio.file.Path;
+import java.nio.file.attribute.PosixFilePermission;
 import java.util.ArrayList;
 import java.util.List;
 import java.util.Map;
+import java.util.Set;
 import java.util.concurrent.ConcurrentHashMap;
 import java.util.jar.Attributes;
 import java.util.jar.JarEntry;
@@ -21,6 +23,7 @@ import java.util.jar.JarOutputStream;
 import java.util.jar.Manifest;
 import java.util.regex.Matcher;
 import java.util.regex.Pattern;
+import java.util.stream.Stream;
 
 /**
  * Every door through which code can reach a running runtime, tried as an attacker on the same
@@ -159,6 +162,69 @@ final class CodeDoors implements AutoCloseable {
             for (Socket s : held) {
                 s.close();
             }
+        }
+    }
+
+    /**
+     * Finding 5: started under umask 000, is anything on the way to a native executable writable
+     * by others, and does an executable replaced on disk run at the next restart?
+     */
+    static Attempt umask000(Path work) throws Exception {
+        String door = "umask 000: writable cache, replaced RT executable";
+        try (Runtime rt = new Runtime("attack-umask", null, true, "bundle,cell,tools", "000")) {
+            Path jar = Files.copy(Path.of(System.getProperty("arflex.it.counter")),
+                    Files.createDirectories(rt.dir.resolve("tools")).resolve("counter.jar"));
+            long id = rt.installAndStart(jar);
+            rt.awaitState("ACTIVE", CellIT.T, COMPONENT);
+            long pid = rt.pid(COMPONENT);
+            Path exe = Path.of("/proc/" + pid + "/exe").toRealPath();
+            List<String> writable = new ArrayList<>();
+            for (Path p = exe; p != null && p.startsWith(rt.dir); p = p.getParent()) {
+                if (othersMayWrite(p)) {
+                    writable.add(p.toString());
+                }
+            }
+            try (Stream<Path> s = Files.walk(rt.dir.resolve("felix-cache"))) {
+                s.filter(CodeDoors::othersMayWriteQuietly).limit(5).forEach(p -> writable.add(p.toString()));
+            }
+            // The attacker (here with the rights to do so) replaces the executable, then the half dies.
+            Path marker = work.resolve("attack-umask-pwned");
+            Files.deleteIfExists(marker);
+            // (a running executable cannot be written: it is replaced by a rename, as an attacker would)
+            Path fake = exe.resolveSibling(exe.getFileName() + ".new");
+            Files.writeString(fake, "#!/bin/sh\ntouch '" + marker + "'\nexec sleep 30\n", StandardCharsets.UTF_8);
+            Files.setPosixFilePermissions(fake, Set.of(PosixFilePermission.OWNER_READ, PosixFilePermission.OWNER_WRITE,
+                    PosixFilePermission.OWNER_EXECUTE));
+            Files.move(fake, exe, java.nio.file.StandardCopyOption.REPLACE_EXISTING, java.nio.file.StandardCopyOption.ATOMIC_MOVE);
+            FailSafeIT.kill9(pid);
+            boolean back;
+            try {
+                rt.waitUntil("the counter restarted", CellIT.T, () -> rt.activeWithNewPid(COMPONENT, pid));
+                back = true;
+            } catch (AssertionError e) {
+                back = false;
+            }
+            boolean ran = Files.exists(marker);
+            rt.cmd("uninstall " + id);
+            rt.waitUntil(COMPONENT + " gone", CellIT.T, () -> rt.instance(COMPONENT) == null);
+            Files.deleteIfExists(marker);
+            return new Attempt(door, ran || !writable.isEmpty(),
+                    (writable.isEmpty() ? "nothing writable by others" : "writable by others: " + writable)
+                            + (ran ? "; the replaced executable RAN" : "; the replaced executable did not run")
+                            + (back ? ", the counter came back verified" : ", the counter did not come back"));
+        }
+    }
+
+    private static boolean othersMayWrite(Path p) throws IOException {
+        Set<PosixFilePermission> s = Files.getPosixFilePermissions(p, java.nio.file.LinkOption.NOFOLLOW_LINKS);
+        return s.contains(PosixFilePermission.GROUP_WRITE) || s.contains(PosixFilePermission.OTHERS_WRITE);
+    }
+
+    private static boolean othersMayWriteQuietly(Path p) {
+        try {
+            return !Files.isSymbolicLink(p) && othersMayWrite(p);
+        } catch (IOException e) {
+            return false;
         }
     }
 

@@ -117,9 +117,10 @@ public final class Activator implements BundleActivator {
         }
         long memory = Commands.parseSize(prop(ctx, "arflex.memory", "1g"));
         long network = Commands.parseSize(prop(ctx, "arflex.network", "125000000"));
+        java.nio.file.Path storage = java.nio.file.Path.of(prop(ctx, Constants.FRAMEWORK_STORAGE, "felix-cache"));
+        StoragePermissions.secure(storage, Posix.LIBC::umask, log);
         actor = new ThreadActor(log);
-        VerifiedExecutables executables = new VerifiedExecutables(
-                java.nio.file.Path.of(prop(ctx, Constants.FRAMEWORK_STORAGE, "felix-cache")), log);
+        VerifiedExecutables executables = new VerifiedExecutables(storage, log);
         Cell.Config cfg = new Cell.Config(rid, Long.parseLong(prop(ctx, "arflex.ready.timeout.ms", "5000")), 3_000,
                 Boolean.parseBoolean(prop(ctx, "arflex.nomlock", "false")), types, Posix::monotonicNs,
                 Boolean.parseBoolean(prop(ctx, "arflex.evaluation", "false")));

@@ -39,6 +39,9 @@ public interface Posix extends Library {
 
     int shm_unlink(String name) throws LastErrorException;
 
+    /** Sets the process's file mode creation mask; returns the previous one (never fails). */
+    int umask(int mask);
+
     int ftruncate(int fd, long length) throws LastErrorException;
 
     Pointer mmap(Pointer addr, long length, int prot, int flags, int fd, long offset) throws LastErrorException;
