@@ -31,6 +31,8 @@ final class ContractValidator {
     static final Pattern TYPE_VERSION = Pattern.compile("(0|[1-9][0-9]{0,4})\\.(0|[1-9][0-9]{0,4})");
     static final Pattern UNIT = Pattern.compile("[\\p{L}\\p{N}/^*.%·_°-]{0,16}");
     static final Pattern SHA256 = Pattern.compile("[0-9a-fA-F]{64}");
+    /** The port type of a safety input (§6.8). */
+    static final String SAFETY_TYPE = "arflex.SafetyState";
     static final Pattern CPUS = Pattern.compile("[0-9]{1,4}(-[0-9]{1,4})?(,[0-9]{1,4}(-[0-9]{1,4})?)*");
 
     static final int MAX_ATTRIBUTE_VALUE = 256;
@@ -148,6 +150,12 @@ final class ContractValidator {
                     ports.add(ps);
                 }
             }
+        }
+        boolean guarded = x.ports != null && x.ports.list.stream()
+                .anyMatch(q -> !q.out && q.safety != null && !"false".equals(q.safety));
+        if (moves && !guarded) {
+            p.at(x.implementation, "6.8", "implementation/@movesHardware", "a component that moves hardware declares the "
+                    + "safety input that permits its motion: <in ... type=\"" + SAFETY_TYPE + "\" safety=\"true\">");
         }
 
         // §7 properties
@@ -302,10 +310,16 @@ final class ContractValidator {
         int depth = 1;
         PortSpec.Overflow overflow = PortSpec.Overflow.DROP_OLDEST;
         boolean optional = false;
+        boolean safety = false;
         Optional<Binding> binding = Optional.empty();
         if (x.out) {
             if (x.optional != null) {
                 p.at(x, "6.4", f + "/@optional", "only an in port may be optional");
+                ok = false;
+            }
+            if (x.safety != null) {
+                p.at(x, "6.8", f + "/@safety", "only an in port is a safety input; a guard's output is an ordinary "
+                        + SAFETY_TYPE + " output");
                 ok = false;
             }
             if (!x.binds.isEmpty()) {
@@ -357,6 +371,18 @@ final class ContractValidator {
                 ok = false;
             }
             optional = bool(p, x, x.optional, false, "6.5", f + "/@optional");
+            safety = bool(p, x, x.safety, false, "6.8", f + "/@safety");
+            if (safety && x.type != null && !SAFETY_TYPE.equals(x.type)) {
+                p.at(x, "6.8", f + "/@safety", "a safety input carries " + SAFETY_TYPE + ", not " + x.type);
+                ok = false;
+            }
+            if (safety && x.optional != null && !optional) {
+                p.at(x, "6.8", f + "/@optional", "a safety input is never required to start: the component starts "
+                        + "without a guard and holds in a protective stop; leave optional out");
+                ok = false;
+            }
+            // A safety input does not keep its component from starting: it holds without one.
+            optional |= safety;
             if (x.binds.size() > 1) {
                 p.at(x.binds.get(1), "6.5", f + "/bind", "an input has at most one <bind>");
                 ok = false;
@@ -369,7 +395,7 @@ final class ContractValidator {
             return null;
         }
         return new PortSpec(x.name, x.out ? PortSpec.Direction.OUT : PortSpec.Direction.IN, x.type, tv, method, depth,
-                overflow, binding, optional);
+                overflow, binding, optional, safety);
     }
 
     private Optional<Binding> bind(Problems p, ContractXml.Bind b, String portField) {

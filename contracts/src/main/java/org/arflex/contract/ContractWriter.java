@@ -147,7 +147,11 @@ public final class ContractWriter {
         w.writeAttribute("typeVersion", p.typeVersion().toString());
         w.writeAttribute("method", p.method().name().toLowerCase(Locale.ROOT));
         if (in) {
-            w.writeAttribute("optional", Boolean.toString(p.optional()));
+            if (p.safety()) {
+                w.writeAttribute("safety", "true");
+            } else {
+                w.writeAttribute("optional", Boolean.toString(p.optional()));
+            }
         } else {
             if (p.method() != PortSpec.Method.STATE) {
                 w.writeAttribute("depth", Integer.toString(p.depth()));

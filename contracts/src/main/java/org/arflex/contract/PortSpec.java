@@ -14,6 +14,9 @@ import java.util.Optional;
  * @param overflow    what a full stream does; ignored for state and frame ports
  * @param binding     for inputs: how a provider is chosen; empty for outputs
  * @param optional    for inputs: the component may be Active without a provider
+ * @param safety      for inputs: a safety input (SPEC §6.8): it permits motion; the component
+ *                    starts without a provider and holds in a protective stop while it has
+ *                    none, and losing its provider is planned as {@code HOLD}, not a rewiring
  */
 public record PortSpec(
         String name,
@@ -24,7 +27,14 @@ public record PortSpec(
         int depth,
         Overflow overflow,
         Optional<Binding> binding,
-        boolean optional) {
+        boolean optional,
+        boolean safety) {
+
+    /** A port that is not a safety input. */
+    public PortSpec(String name, Direction direction, String type, TypeVersion typeVersion, Method method, int depth,
+                    Overflow overflow, Optional<Binding> binding, boolean optional) {
+        this(name, direction, type, typeVersion, method, depth, overflow, binding, optional, false);
+    }
 
     /** Port direction. */
     public enum Direction { IN, OUT }

@@ -118,7 +118,8 @@ class SupervisionIT {
     void aRestartedMovingComponentDrivesNothingUntilTheOperatorResets() throws Exception {
         java.nio.file.Path moving = Jars.withContract(CellIT.COUNTER,
                 java.nio.file.Files.createTempDirectory("arflex-it").resolve("moving.jar"),
-                xml -> xml.replace("movesHardware=\"false\"", "movesHardware=\"true\""));
+                xml -> xml.replace("movesHardware=\"false\"", "movesHardware=\"true\"").replace("<ports>",
+                        "<ports><in name=\"safety\" type=\"arflex.SafetyState\" typeVersion=\"1.0\" method=\"state\" safety=\"true\"/>"));
         try (Runtime rt = new Runtime("moving")) {
             rt.installAndStart(moving);
             rt.awaitState("ACTIVE", CellIT.T, "sample-counter");

@@ -806,7 +806,8 @@ class WebConsoleIT {
         // The counter as a component that moves hardware: after a crash the DRCR restarts it held
         // (no motion) until an operator resets it.
         Path moving = withContract(sample("counter"), variant("counter-moving.jar"),
-                xml -> xml.replace("movesHardware=\"false\"", "movesHardware=\"true\""));
+                xml -> xml.replace("movesHardware=\"false\"", "movesHardware=\"true\"").replace("<ports>",
+                        "<ports><in name=\"safety\" type=\"arflex.SafetyState\" typeVersion=\"1.0\" method=\"state\" safety=\"true\"/>"));
         uploadAndConfirm(moving, "updated");
         RuntimeUnderTest.awaitCondition("the moving counter Active", WAIT, () -> "ACTIVE".equals(instanceState("sample-counter"))
                 && componentJson("sample-counter").contains("\"movesHardware\":true"));

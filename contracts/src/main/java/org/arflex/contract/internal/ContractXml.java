@@ -72,6 +72,7 @@ public final class ContractXml extends Located {
         @JacksonXmlProperty(isAttribute = true) public String typeVersion;
         @JacksonXmlProperty(isAttribute = true) public String method;
         @JacksonXmlProperty(isAttribute = true) public String optional;
+        @JacksonXmlProperty(isAttribute = true) public String safety;
         @JacksonXmlProperty(isAttribute = true) public String depth;
         @JacksonXmlProperty(isAttribute = true) public String overflow;
         public final List<Bind> binds = new ArrayList<>();

@@ -38,7 +38,14 @@ public final class Plan {
          * they are bound and unbound while it runs (no restart, so a moving component keeps
          * moving and needs no operator reset).
          */
-        REBIND
+        REBIND,
+        /**
+         * As {@link #REBIND}, when a safety input (contracts/SPEC.md §6.8) loses its provider:
+         * the inputs are rewired while it runs, and it holds in a protective stop (its RT half
+         * judges the input) until a guard is bound again and the operator resets it. Never
+         * planned as a plain REBIND, so the plan and the log say that the arm stops.
+         */
+        HOLD
     }
 
     /**
@@ -118,7 +125,7 @@ public final class Plan {
         return title;
     }
 
-    /** Every action, sorted by op (START, STOP, RESTART, REBIND) then component name. */
+    /** Every action, sorted by op (START, STOP, RESTART, REBIND, HOLD) then component name. */
     public List<Action> actions() {
         return actions;
     }
@@ -141,6 +148,16 @@ public final class Plan {
     /** The REBIND actions, by name. */
     public List<Action> rebinds() {
         return only(Op.REBIND);
+    }
+
+    /** The HOLD actions, by name. */
+    public List<Action> holds() {
+        return only(Op.HOLD);
+    }
+
+    /** The REBIND and HOLD actions (rewired while running), by name. */
+    public List<Action> rewires() {
+        return actions.stream().filter(a -> a.op() == Op.REBIND || a.op() == Op.HOLD).toList();
     }
 
     private List<Action> only(Op op) {

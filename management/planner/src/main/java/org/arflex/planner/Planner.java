@@ -47,6 +47,9 @@ import org.arflex.contract.PortSpec;
  */
 public final class Planner {
 
+    /** How the reason of a HOLD starts: a safety input lost its provider. */
+    private static final String SAFETY_LOST = "safety input ";
+
     private final Resolver resolver = new Resolver();
     private final TreeSet<String> active = new TreeSet<>();
     private final TreeMap<String, String> blocked = new TreeMap<>();
@@ -375,7 +378,8 @@ public final class Planner {
                 List<String> why = new ArrayList<>();
                 boolean rewireOnly = restartReasons(n, replaced, oldEff.get(n), newEff.get(n), oldContracts, adm, why);
                 if (!why.isEmpty() && rewireOnly) {
-                    actions.add(new Plan.Action(Plan.Op.REBIND, n, String.join("; ", why)));
+                    boolean holds = why.stream().anyMatch(w -> w.startsWith(SAFETY_LOST));
+                    actions.add(new Plan.Action(holds ? Plan.Op.HOLD : Plan.Op.REBIND, n, String.join("; ", why)));
                 } else if (!why.isEmpty()) {
                     actions.add(new Plan.Action(Plan.Op.RESTART, n, String.join("; ", why)));
                     stopping.add(n);
@@ -478,6 +482,9 @@ public final class Planner {
                 why.add("input '" + p + "' now from " + a.source() + " (was " + b.source() + ")");
             } else if (a != null) {
                 why.add("input '" + p + "' now from " + a.source());
+            } else if (resolver.contract(n).flatMap(c -> c.port(p)).map(PortSpec::safety).orElse(false)) {
+                why.add(SAFETY_LOST + "'" + p + "' lost " + b.source() + ": protective stop until a guard is bound and "
+                        + "the operator resets");
             } else {
                 why.add("input '" + p + "' lost " + b.source());
             }

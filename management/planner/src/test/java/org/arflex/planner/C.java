@@ -84,6 +84,13 @@ final class C {
         return in(port, type, "1.0", PortSpec.Method.STATE, Optional.of(Binding.filter(filter)), false);
     }
 
+    /** A safety input (contracts/SPEC.md §6.8): optional to start, its loss a HOLD. */
+    C inSafety(String port) {
+        ports.add(new PortSpec(port, PortSpec.Direction.IN, "arflex.SafetyState", TypeVersion.parse("1.0"),
+                PortSpec.Method.STATE, 1, PortSpec.Overflow.DROP_OLDEST, Optional.empty(), true, true));
+        return this;
+    }
+
     C inOptional(String port, String type) {
         return in(port, type, "1.0", PortSpec.Method.STATE, Optional.empty(), true);
     }

@@ -276,6 +276,28 @@ class PlannerTest {
         assertTrue(plan.toText().contains("REBIND   display"), plan.toText());
     }
 
+    /** Issue 15: losing a guard is never a silent rewiring of the arm. */
+    @Test
+    void losingTheProviderOfASafetyInputIsAHoldNotARebind() {
+        Planner p = new Planner(CAPS);
+        p.apply(Change.install(C.of("arm").inSafety("safety").build()));
+        assertEquals(Set.of("arm"), p.active(), "the arm starts without a guard (and holds)");
+        Plan arrive = p.apply(Change.install(C.of("guard").out("safety", "arflex.SafetyState").build()));
+        assertEquals(new Plan.Action(Plan.Op.REBIND, "arm", "input 'safety' now from guard.safety"),
+                arrive.action("arm").get());
+        Plan lose = p.plan(Change.uninstall("guard"));
+        assertEquals(new Plan.Action(Plan.Op.HOLD, "arm", "safety input 'safety' lost guard.safety: protective stop "
+                + "until a guard is bound and the operator resets"), lose.action("arm").get());
+        assertEquals(List.of(lose.action("arm").get()), lose.holds());
+        assertEquals(List.of(), lose.rebinds());
+        assertEquals(lose.holds(), lose.rewires());
+        assertTrue(lose.toText().contains("HOLD     arm"), lose.toText());
+        // the same when the guard fails (blocked) instead of being uninstalled
+        Plan block = p.plan(Change.block("guard", "Failed: 3 restarts in 10 s"));
+        assertEquals(Plan.Op.HOLD, block.action("arm").get().op());
+        assertEquals(List.of(), block.stopOrder().stream().filter("arm"::equals).toList(), "the arm is not stopped");
+    }
+
     @Test
     void inconsistentChangesAreRefusedNamingTheComponent() {
         Planner p = cell();

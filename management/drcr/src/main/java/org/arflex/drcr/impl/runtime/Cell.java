@@ -351,7 +351,7 @@ public final class Cell {
         // Live rewiring: inputs whose provider changes or goes are unbound before any stop, so
         // no consumer reads a provider while it goes away; new bindings come after the starts,
         // when every provider's segment exists.
-        for (Plan.Action a : plan.rebinds()) {
+        for (Plan.Action a : plan.rewires()) {
             rebind(instances.get(a.component()), plan.wiringOf(a.component()), false, a.reason());
         }
         // The plan's stops in three sweeps, so that their waits overlap: every half to stop is
@@ -394,7 +394,7 @@ public final class Cell {
                 startHalf(inst, plan.cpuAssignment().getOrDefault(name, -1), plan.wiringOf(name));
             }
         }
-        for (Plan.Action a : plan.rebinds()) {
+        for (Plan.Action a : plan.rewires()) {
             rebind(instances.get(a.component()), plan.wiringOf(a.component()), true, a.reason());
         }
         // Everything the plan leaves inactive shows the planner's reason.

@@ -1,8 +1,11 @@
 package org.arflex.drcr.impl.runtime;
 
 import java.util.List;
+import org.arflex.contract.Binding;
+import org.arflex.contract.Filter;
 import org.arflex.contract.PortSpec;
 import org.arflex.drcr.impl.abi.ControlBlock;
+import org.arflex.drcr.impl.lifecycle.State;
 
 /**
  * Says in words why an instance holds the arm (or its outputs): from its control block's flags
@@ -59,10 +62,36 @@ final class Holding {
         if (provider != null) {
             String name = provider;
             String state = cell.instances().stream().filter(x -> x.name.equals(name)).findFirst()
-                    .map(x -> " " + x.life.state()).orElse("");
+                    .map(x -> " " + x.life.state() + (x.life.state() == State.ACTIVE || x.life.reason() == null ? ""
+                            : ": " + x.life.reason())).orElse("");
             p = " (provider " + provider + state + ")";
+        } else {
+            PortSpec spec = i.contract.port(port).orElse(null);
+            List<String> guards = cell.instances().stream().filter(x -> x != i && spec != null && guards(spec, x))
+                    .map(x -> x.name + " " + x.life.state() + (x.life.reason() == null ? "" : ": " + x.life.reason()))
+                    .toList();
+            p = guards.isEmpty() ? " (no guard installed)" : " (guard " + String.join("; ", guards) + ")";
         }
         return "safety input '" + port + "' " + v + p;
+    }
+
+    /** Whether {@code x} could provide the safety input {@code in} (its type, and its binding rule). */
+    private static boolean guards(PortSpec in, Instance x) {
+        if (x.contract.outputs().stream().noneMatch(o -> SAFETY_TYPE.equals(o.type()))) {
+            return false;
+        }
+        Binding b = in.binding().orElse(null);
+        if (b == null) {
+            return true;
+        }
+        if (b.component().isPresent()) {
+            return b.component().get().equals(x.name);
+        }
+        try {
+            return b.filter().map(f -> Filter.parse(f).matches(x.contract.attributes())).orElse(true);
+        } catch (RuntimeException e) {
+            return false;
+        }
     }
 
     /**

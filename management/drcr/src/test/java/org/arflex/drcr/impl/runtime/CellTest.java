@@ -48,6 +48,9 @@ class CellTest {
                 + "<fault " + fault + " safe=\"hold\" heartbeatTimeout=\"100ms\"/></component>";
     }
 
+    /** The safety input every motion component declares (contracts/SPEC.md §6.8). */
+    static final String SAFETY_IN = "<in name=\"safety\" type=\"arflex.SafetyState\" typeVersion=\"1.0\" method=\"state\""
+            + " safety=\"true\"/>";
     static final String PERMANENT = "restart=\"permanent\" intensity=\"2\" window=\"10s\" backoff=\"100ms\"";
     static final String PROVIDER_PORTS = "<out name=\"y\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\"/>";
     static final String CONSUMER_PORTS = "<in name=\"x\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\">"
@@ -284,7 +287,7 @@ class CellTest {
 
     @Test
     void movingHardwareNeedsResetAfterRestart() throws Exception {
-        install(contract("prov", PROVIDER_PORTS, PERMANENT, true, 5, "50us"));
+        install(contract("prov", PROVIDER_PORTS + SAFETY_IN, PERMANENT, true, 5, "50us"));
         assertFalse(launcher.specs.get(0).resetRequired(), "the first start needs no reset");
         launcher.running.get("prov").crash(137, "killed by signal 9");
         actor.runAll();
@@ -482,7 +485,7 @@ class CellTest {
 
     @Test
     void theDtoShowsAResetLatchedByTheRtHalfItselfAndItsSafeMode() throws Exception {
-        install(contract("prov", PROVIDER_PORTS, PERMANENT, true, 5, "50us"));
+        install(contract("prov", PROVIDER_PORTS + SAFETY_IN, PERMANENT, true, 5, "50us"));
         FakeLauncher.FakeHalf h = launcher.running.get("prov");
         InstanceDTO d = Snapshots.instance(cell, "prov").orElseThrow();
         assertFalse(d.awaitingReset);
@@ -502,7 +505,7 @@ class CellTest {
                 PERMANENT, false, 5, "50us"));
         install(contract("arm", "<in name=\"ref\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\" optional=\"true\">"
                 + "<bind component=\"prov\" port=\"y\"/></in>"
-                + "<in name=\"safety\" type=\"arflex.SafetyState\" typeVersion=\"1.0\" method=\"state\" optional=\"true\">"
+                + "<in name=\"safety\" type=\"arflex.SafetyState\" typeVersion=\"1.0\" method=\"state\" safety=\"true\">"
                 + "<bind component=\"guard\" port=\"safety\"/></in>", PERMANENT, true, 4, "50us"));
         assertEquals(State.ACTIVE, state("arm"));
         FakeLauncher.FakeHalf h = launcher.running.get("arm");
@@ -529,6 +532,40 @@ class CellTest {
         h.flags = 0;
         h.hold = 0;
         assertEquals(null, Snapshots.instance(cell, "arm").orElseThrow().holding);
+    }
+
+    /** Issue 15 finding 1: the guard fails for good; the arm holds, rewired, and says which guard is gone. */
+    @Test
+    void aGuardThatFailsIsAHoldNamingTheGuard() throws Exception {
+        install(contract("guard", "<out name=\"safety\" type=\"arflex.SafetyState\" typeVersion=\"1.0\" method=\"state\"/>",
+                PERMANENT, false, 5, "50us"));
+        install(contract("arm", "<in name=\"safety\" type=\"arflex.SafetyState\" typeVersion=\"1.0\" method=\"state\""
+                + " safety=\"true\"><bind component=\"guard\" port=\"safety\"/></in>", PERMANENT, true, 4, "50us"));
+        FakeLauncher.FakeHalf arm = launcher.running.get("arm");
+        assertTrue(launcher.events.stream().anyMatch(e -> e.startsWith("arm BIND safety")), launcher.events.toString());
+        for (int k = 0; k < 3; k++) {
+            launcher.running.get("guard").crash(137, "killed by signal 9");
+            actor.runAll();
+            actor.advance(500);
+        }
+        assertEquals(State.FAILED, state("guard"));
+        assertEquals(State.ACTIVE, state("arm"), "the arm is not stopped: it holds");
+        assertEquals(arm, launcher.running.get("arm"), "and not restarted");
+        assertTrue(launcher.events.contains("arm UNBIND safety"), "unbound from the dead guard: " + launcher.events);
+        assertTrue(log.toString().contains("arm rewired while running (safety input 'safety' lost guard.safety: "
+                + "protective stop until a guard is bound and the operator resets)"), log.toString());
+        // its RT half reports the verdict NO_PROVIDER for input 0; the DTO names the guard and why
+        arm.hold = ControlBlock.HOLD_SAFETY_INPUT | 3 << 8;
+        String holding = Snapshots.instance(cell, "arm").orElseThrow().holding;
+        assertTrue(holding.startsWith("protective stop: safety input 'safety' without a provider (provider guard FAILED: "
+                + "restart intensity exceeded"), holding);
+        actor.call(() -> {
+            cell.uninstall("guard", "bundle stopped");
+            return null;
+        }, 0);
+        actor.runAll();
+        assertEquals("protective stop: safety input 'safety' without a provider (no guard installed)",
+                Snapshots.instance(cell, "arm").orElseThrow().holding);
     }
 
     @Test
