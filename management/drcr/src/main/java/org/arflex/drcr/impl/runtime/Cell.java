@@ -574,7 +574,8 @@ public final class Cell {
         inst.life.to(State.ACTIVE, inst.awaitingReset ? "restarted: waits for an operator reset before motion" : null);
         RtHalf h = half;
         half.exit().thenAccept(ex -> actor.submit(() -> onExit(inst, h, ex)));
-        monitor.watch(inst.name, half, c.fault().heartbeatTimeoutMs(), cfg.monotonicNs().getAsLong());
+        monitor.watch(inst.name, half, c.fault().heartbeatTimeoutMs(), cfg.monotonicNs().getAsLong(),
+                OutputRepair.probe(inst.name, inst.outputs));
         long t1 = cfg.monotonicNs().getAsLong();
         log.accept("arflex: " + inst.name + " ACTIVE (pid " + half.pid() + ", cpu " + cpu + ", inputs " + inst.bound
                 + "; spawn to READY " + (tLaunched - t0) / 1000 + " us, bind+start " + (t1 - tLaunched) / 1000 + " us)");
@@ -653,6 +654,7 @@ public final class Cell {
         String what = inst.hangReason != null ? inst.hangReason : exit.description();
         inst.hangReason = null;
         log.accept("arflex: " + inst.name + " (pid " + half.pid() + ") " + what);
+        OutputRepair.dropDamaged(inst.name, inst.outputs, log);
         failed(inst, exit.abnormal(), "RT half " + what);
         changed();
     }

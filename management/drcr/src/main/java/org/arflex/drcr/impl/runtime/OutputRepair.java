@@ -8,7 +8,8 @@ import java.util.function.Consumer;
 import org.arflex.drcr.impl.supervisor.RtLauncher;
 
 /**
- * On an operator reset of a FAILED component: finds its damaged output segments (truncated,
+ * On an operator reset of a FAILED component, and when its RT half ends (a crash, or the kill
+ * that follows damage seen while it ran, {@link #probe}): finds its damaged output segments (truncated,
  * header overwritten; {@link RtLauncher.Output#damage}) and removes them (unlink), so that the
  * restart the reset plans creates them anew (Cell.ensureOutputs) instead of failing the
  * producer again on the same damaged segment. Consumers are rebound to the new segment by the
@@ -24,6 +25,24 @@ final class OutputRepair {
      *
      * @return one text per removed segment, for the operator's reply; empty when all are intact
      */
+    /**
+     * A probe for the heartbeat monitor: the first damaged segment of {@code outputs} (a copy
+     * taken when the half starts; the outputs stay the same while it runs), or null.
+     */
+    static java.util.function.Supplier<String> probe(String instance, Map<String, RtLauncher.Output> outputs) {
+        List<Map.Entry<String, RtLauncher.Output>> outs = List.copyOf(outputs.entrySet());
+        return () -> {
+            for (Map.Entry<String, RtLauncher.Output> e : outs) {
+                String why = e.getValue().damage();
+                if (why != null) {
+                    return "output " + instance + "." + e.getKey() + " damaged while running (" + why
+                            + "): restarting it with a new segment";
+                }
+            }
+            return null;
+        };
+    }
+
     static List<String> dropDamaged(String instance, Map<String, RtLauncher.Output> outputs, Consumer<String> log) {
         List<String> done = new ArrayList<>();
         for (Iterator<Map.Entry<String, RtLauncher.Output>> it = outputs.entrySet().iterator(); it.hasNext();) {

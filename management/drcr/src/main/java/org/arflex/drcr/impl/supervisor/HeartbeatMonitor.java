@@ -3,6 +3,7 @@ package org.arflex.drcr.impl.supervisor;
 import java.util.Map;
 import java.util.concurrent.ConcurrentHashMap;
 import java.util.function.BiConsumer;
+import java.util.function.Supplier;
 
 /**
  * Writes the runtime heartbeat into every watched control block and reports an RT half whose
@@ -16,6 +17,11 @@ import java.util.function.BiConsumer;
  * is silent at once (two or more), that is the machine, not a component: none is reported
  * before its silence reaches {@link #ALL_SILENT_FACTOR} times its timeout. A single half that
  * stops while the others go on is still reported when its silence passes its timeout.
+ *
+ * <p>Each check also asks a half's {@code damage} probe (its output segments' headers, issue 15
+ * finding 5): a segment overwritten or truncated while it runs is reported as that half's fault
+ * within one period, so that its restart recreates the segment (consumers hold meanwhile: they
+ * judge the header too).
  */
 public final class HeartbeatMonitor {
 
@@ -28,13 +34,15 @@ public final class HeartbeatMonitor {
         final String name;
         final RtHalf half;
         final long timeoutNs;
+        final Supplier<String> damage;
         long lastHb;
         long silenceNs;
 
-        Watch(String name, RtHalf half, long timeoutNs) {
+        Watch(String name, RtHalf half, long timeoutNs, Supplier<String> damage) {
             this.name = name;
             this.half = half;
             this.timeoutNs = timeoutNs;
+            this.damage = damage;
         }
     }
 
@@ -45,7 +53,8 @@ public final class HeartbeatMonitor {
     private long lastCheckNs;
 
     /**
-     * @param onHang called (on the checking thread) with the half and the reason, once per half
+     * @param onHang called (on the checking thread) with the half and the reason (a hang or a
+     *               damaged output), once per half
      */
     public HeartbeatMonitor(BiConsumer<RtHalf, String> onHang) {
         this(onHang, PERIOD_MS);
@@ -58,7 +67,12 @@ public final class HeartbeatMonitor {
 
     /** Starts watching a running half; {@code nowNs} is when it was started. */
     public void watch(String name, RtHalf half, long timeoutMs, long nowNs) {
-        watched.put(half, new Watch(name, half, timeoutMs * 1_000_000L));
+        watch(name, half, timeoutMs, nowNs, () -> null);
+    }
+
+    /** As {@link #watch(String, RtHalf, long, long)}, with a probe saying which output is damaged (or null). */
+    public void watch(String name, RtHalf half, long timeoutMs, long nowNs, Supplier<String> damage) {
+        watched.put(half, new Watch(name, half, timeoutMs * 1_000_000L, damage));
     }
 
     /** Stops watching (before an orderly stop, or after an exit). */
@@ -90,6 +104,11 @@ public final class HeartbeatMonitor {
         }
         boolean machine = silent >= 2 && silent == watched.size();
         for (Watch w : watched.values()) {
+            String d = w.damage.get();
+            if (d != null && reported.putIfAbsent(w.half, Boolean.TRUE) == null) {
+                onHang.accept(w.half, d);
+                continue;
+            }
             long limit = machine ? ALL_SILENT_FACTOR * w.timeoutNs : w.timeoutNs;
             if (w.timeoutNs > 0 && w.silenceNs > limit && reported.putIfAbsent(w.half, Boolean.TRUE) == null) {
                 onHang.accept(w.half, "hung: no RT heartbeat for " + w.silenceNs / 1_000_000L + " ms of supervision (timeout "

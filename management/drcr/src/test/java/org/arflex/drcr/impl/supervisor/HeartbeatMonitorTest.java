@@ -84,4 +84,19 @@ class HeartbeatMonitorTest {
         assertEquals(2, hung.size(), hung.toString());
         assertTrue(hung.get(0).contains("every half silent"), hung.toString());
     }
+
+    /** Issue 15 finding 5: an output damaged while its producer runs is that producer's fault, once. */
+    @Test
+    void aDamagedOutputIsReportedOnceWithinOnePeriod() {
+        RtHalf a = half("a");
+        String[] damage = {null};
+        m.watch("a", a, 100, now, () -> damage[0]);
+        run(100, a);
+        assertEquals(List.of(), hung);
+        damage[0] = "output a.y damaged while running (magic 0x0)";
+        run(20, a);
+        assertEquals(List.of("a: output a.y damaged while running (magic 0x0)"), hung);
+        run(200, a);
+        assertEquals(1, hung.size(), "reported once: " + hung);
+    }
 }
