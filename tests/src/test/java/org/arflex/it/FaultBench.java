@@ -25,15 +25,45 @@ import org.junit.jupiter.api.Test;
  * <ul>
  * <li>S1 kill -9 of a provider (force-guard) and of the motion component (trajectory);</li>
  * <li>S3 SIGSTOP of the guard (stale safety input, then the DRCR's hang handling);</li>
+ * <li>S5 the motion component (trajectory) killed each time it is back, until FAILED;</li>
+ * <li>S15 the guard's output segment header overwritten while it runs (the robot holds on the
+ * damaged header; the DRCR restarts the guard with a new segment);</li>
  * <li>S16 a 400 N push above the guard's limit;</li>
  * <li>S17 after every reset: no motion for 1000 robot cycles until the fresh command;</li>
  * <li>G the guard lost for good (killed until FAILED);</li>
- * <li>S18 kill -9 of the JVM: every RT half safe, then gone with its objects.</li>
+ * <li>S18 kill -9 of the JVM ({@code --jvm-kills N} times): every RT half safe, then gone with its
+ * objects.</li>
  * </ul>
  */
 class FaultBench {
 
-    record Run(boolean pass, double safeMs, double backMs, String note) {
+    /** One run; detectMs is from the fault to the DRCR's log line about it (-1: not measured). */
+    record Run(boolean pass, double safeMs, double backMs, String note, double detectMs) {
+        Run(boolean pass, double safeMs, double backMs, String note) {
+            this(pass, safeMs, backMs, note, -1);
+        }
+    }
+
+    /**
+     * Milliseconds from {@code at} to the first DRCR log line after {@code mark} that contains
+     * {@code text} (the log's time of day, same clock); -1 when none comes within 10 s.
+     */
+    private static double detection(Runtime rt, int mark, java.time.LocalTime at, String text) {
+        String[] line = {null};
+        try {
+            rt.waitUntil("the DRCR's line '" + text + "'", 10_000, () -> {
+                line[0] = rt.logSince(mark).stream().filter(l -> l.contains(text)).findFirst().orElse(null);
+                return line[0] != null;
+            });
+        } catch (AssertionError e) {
+            return -1;
+        }
+        String[] w = line[0].replace("err| ", "").split(" ", 2);
+        try {
+            return java.time.Duration.between(at, java.time.LocalTime.parse(w[0])).toNanos() / 1e6;
+        } catch (java.time.format.DateTimeParseException e) {
+            return -1;
+        }
     }
 
     private final Map<String, List<Run>> runs = new LinkedHashMap<>();
@@ -65,7 +95,8 @@ class FaultBench {
     private boolean resetThenCommand(Runtime rt, CellRig.Trace<CellRig.JointState> js) {
         try {
             rt.waitUntil("nothing awaits a reset", 30_000, () -> {
-                if (!CellRig.awaitingReset(rt).isEmpty() || "FAILED".equals(rt.state("force-guard"))) {
+                if (!CellRig.awaitingReset(rt).isEmpty() || "FAILED".equals(rt.state("force-guard"))
+                        || "FAILED".equals(rt.state("trajectory"))) {
                     rt.cmd("arflex:reset --cell");
                 }
                 return CellRig.awaitingReset(rt).isEmpty() && "ACTIVE".equals(rt.state("force-guard"))
@@ -131,12 +162,13 @@ class FaultBench {
                 rt.waitUntil("the arm moving", 60_000, () -> FailSafeIT.moving(js));
                 List<String> order = new ArrayList<>();
                 for (int i = 0; i < rounds; i++) {
-                    order.addAll(List.of("S1-guard", "S1-motion", "S3-guard", "S16-push"));
+                    order.addAll(List.of("S1-guard", "S1-motion", "S3-guard", "S16-push", "S15-header"));
                 }
                 java.util.Collections.shuffle(order, rnd);
                 for (String s : order) {
                     if (!s.startsWith("S16")) { // before the clock starts
                         awaitRestartBudget(rt, s.equals("S1-motion") ? "trajectory" : "force-guard");
+                        awaitRestartBudget(rt, "trajectory");
                     }
                     rt.waitUntil("the arm moving", 30_000, () -> FailSafeIT.moving(js));
                     long t0 = System.nanoTime();
@@ -144,11 +176,30 @@ class FaultBench {
                         case "S1-guard", "S1-motion" -> {
                             String name = s.equals("S1-guard") ? "force-guard" : "trajectory";
                             long pid = rt.pid(name);
+                            int mark = rt.logMark();
+                            java.time.LocalTime at = java.time.LocalTime.now();
                             FailSafeIT.kill9(pid);
                             double safe = timeToStill(rt, js, t0);
+                            double detect = detection(rt, mark, at, name + " (pid " + pid + ") ");
                             double back = backToActive(rt, name, pid, t0);
                             boolean ok = resetThenCommand(rt, js);
-                            record(s, new Run(safe >= 0 && back >= 0 && ok, safe, back, ""));
+                            record(s, new Run(safe >= 0 && back >= 0 && ok, safe, back, "", detect));
+                        }
+                        case "S15-header" -> {
+                            // bytes written into the guard's output segment: its header's magic
+                            long pid = rt.pid("force-guard");
+                            int mark = rt.logMark();
+                            java.time.LocalTime at = java.time.LocalTime.now();
+                            try (java.nio.channels.FileChannel ch = java.nio.channels.FileChannel.open(
+                                    rt.segment("force-guard", "safety"), java.nio.file.StandardOpenOption.WRITE)) {
+                                ch.write(java.nio.ByteBuffer.allocate(8), 0);
+                            }
+                            double safe = timeToStill(rt, js, t0);
+                            double detect = detection(rt, mark, at, "output force-guard.safety damaged while running");
+                            double back = backToActive(rt, "force-guard", pid, t0);
+                            boolean ok = resetThenCommand(rt, js);
+                            record(s, new Run(safe >= 0 && back >= 0 && ok, safe, back, "(guard restarted, new segment)",
+                                    detect));
                         }
                         case "S3-guard" -> {
                             long pid = rt.pid("force-guard");
@@ -200,13 +251,42 @@ class FaultBench {
                 boolean failed = "FAILED".equals(rt.state("force-guard"));
                 boolean ok = resetThenCommand(rt, js);
                 record("G-guard-lost", new Run(safe >= 0 && stayed && failed && ok, safe, 0, failed ? "" : "(guard not FAILED)"));
+
+                // S5: the motion component in a crash loop (killed each time it is back) until FAILED.
+                awaitRestartBudget(rt, "trajectory");
+                rt.waitUntil("the arm moving", 30_000, () -> FailSafeIT.moving(js));
+                long t5 = System.nanoTime();
+                double safe5 = -1;
+                for (int k = 0; k < 6 && !"FAILED".equals(rt.state("trajectory")); k++) {
+                    long pid = rt.pid("trajectory");
+                    if (pid == 0) {
+                        break;
+                    }
+                    FailSafeIT.kill9(pid);
+                    if (k == 0) {
+                        safe5 = timeToStill(rt, js, t5);
+                    }
+                    try {
+                        rt.waitUntil("trajectory back or FAILED", 30_000,
+                                () -> rt.activeWithNewPid("trajectory", pid) || "FAILED".equals(rt.state("trajectory")));
+                    } catch (AssertionError e) {
+                        break;
+                    }
+                }
+                int mark5 = js.size();
+                rt.waitUntil("2000 robot cycles in the crash loop's end", 30_000, () -> js.size() > mark5 + 2000);
+                boolean still5 = js.snapshot().subList(mark5, js.size()).stream().allMatch(j -> j.maxSpeed() <= FailSafeIT.STILL);
+                boolean failed5 = "FAILED".equals(rt.state("trajectory"));
+                boolean ok5 = resetThenCommand(rt, js);
+                record("S5-crash-loop", new Run(safe5 >= 0 && still5 && failed5 && ok5, safe5, 0,
+                        failed5 ? "(trajectory FAILED, arm still)" : "(trajectory not FAILED)"));
                 rec.close();
             }
         }
         leaks += leftovers(rid);
 
         // S18: kill -9 of the JVM, each time a fresh runtime with the moving cell.
-        for (int i = 0; i < Math.max(1, rounds / 2); i++) {
+        for (int i = 0; i < Integer.getInteger("arflex.bench.jvmkills", Math.max(1, rounds / 2)); i++) {
             String r18;
             double safeMs = -1;
             boolean gone = false;
@@ -272,6 +352,10 @@ class FaultBench {
         return Double.isNaN(v) ? "-" : String.format(Locale.ROOT, "%.0f", v);
     }
 
+    private static String ms1(double v) {
+        return Double.isNaN(v) ? "-" : String.format(Locale.ROOT, "%.1f", v);
+    }
+
     private static double pct(List<Double> v, double p) {
         if (v.isEmpty()) {
             return Double.NaN;
@@ -283,8 +367,8 @@ class FaultBench {
 
     private void report(long seed, int leaks) throws Exception {
         StringBuilder json = new StringBuilder(String.format(Locale.ROOT, "{\"seed\":%d,\"scenarios\":{", seed));
-        System.out.printf(Locale.ROOT, "%n%-14s %5s %5s  %28s  %20s%n", "scenario", "runs", "pass", "time to safe p50/p99/max ms",
-                "back to ACTIVE p50/max");
+        System.out.printf(Locale.ROOT, "%n%-14s %5s %5s  %28s  %20s  %26s%n", "scenario", "runs", "pass",
+                "time to safe p50/p99/max ms", "back to ACTIVE p50/max", "detection p50/p99/max ms");
         int pass = 0;
         int total = 0;
         boolean firstJ = true;
@@ -292,16 +376,19 @@ class FaultBench {
             List<Run> rs = e.getValue();
             List<Double> safe = rs.stream().map(Run::safeMs).filter(x -> x >= 0).toList();
             List<Double> back = rs.stream().map(Run::backMs).filter(x -> x > 0).toList();
+            List<Double> det = rs.stream().map(Run::detectMs).filter(x -> x >= 0).toList();
             long ok = rs.stream().filter(Run::pass).count();
             boolean all = ok == rs.size();
             total++;
             pass += all ? 1 : 0;
-            System.out.printf(Locale.ROOT, "%-14s %5d %5d  %8s %8s %8s    %8s %8s%n", e.getKey(), rs.size(), ok,
-                    ms(pct(safe, 50)), ms(pct(safe, 99)), ms(pct(safe, 100)), ms(pct(back, 50)), ms(pct(back, 100)));
+            System.out.printf(Locale.ROOT, "%-14s %5d %5d  %8s %8s %8s    %8s %8s      %6s %6s %6s%n", e.getKey(), rs.size(),
+                    ok, ms(pct(safe, 50)), ms(pct(safe, 99)), ms(pct(safe, 100)), ms(pct(back, 50)), ms(pct(back, 100)),
+                    ms1(pct(det, 50)), ms1(pct(det, 99)), ms1(pct(det, 100)));
             json.append(firstJ ? "" : ",").append(String.format(Locale.ROOT,
                     "\"%s\":{\"runs\":%d,\"pass\":%d,\"safe_ms\":{\"p50\":%.1f,\"p99\":%.1f,\"max\":%.1f},"
-                            + "\"back_ms\":{\"p50\":%.1f,\"max\":%.1f}}",
-                    e.getKey(), rs.size(), ok, pct(safe, 50), pct(safe, 99), pct(safe, 100), pct(back, 50), pct(back, 100))
+                            + "\"back_ms\":{\"p50\":%.1f,\"max\":%.1f},\"detect_ms\":{\"p50\":%.2f,\"p99\":%.2f,\"max\":%.2f}}",
+                    e.getKey(), rs.size(), ok, pct(safe, 50), pct(safe, 99), pct(safe, 100), pct(back, 50), pct(back, 100),
+                    pct(det, 50), pct(det, 99), pct(det, 100))
                     .replace("NaN", "null"));
             firstJ = false;
         }
