@@ -379,6 +379,17 @@ class WebConsoleBrowserIT {
         own.put("configuration", checkPage("configuration", "/system/console/configMgr", "#configTable tbody tr, #plugin_table tbody tr"));
         own.put("components", checkPage("components", "/system/console/components", "#plugin_table tbody tr"));
         own.put("system information", checkPage("system information", "/system/console/vmstat", "#shutdownform"));
+        // Its Stop and Restart buttons keep their confirmation (the handlers allowed by hash).
+        // The test answers "no" and holds any submit, so the framework is not stopped either way.
+        browser.js("window.__asked = []; window.confirm = m => { window.__asked.push(m); return false; };"
+                + "window.__submitted = 0; document.getElementById('shutdownform').addEventListener('submit',"
+                + " e => { window.__submitted++; e.preventDefault(); }, true);");
+        for (String button : browser.findAll("#shutdownform input[type='submit']")) {
+            browser.click(button);
+        }
+        assertEquals(2L, browser.js("return window.__asked.length;"), "both buttons ask first");
+        assertEquals(0L, browser.js("return window.__submitted;"), "answered no: nothing submitted");
+        own.put("system information, buttons", ownViolations());
         for (String page : List.of("arflex-cell", "arflex-deploy", "arflex-contract", "arflex-graph", "arflex-debug",
                 "arflex-audit")) {
             own.put(page, checkPage(page, "/system/console/" + page, "#arflex-app h2"));
