@@ -184,5 +184,6 @@ commands() {
 # where the user may raise priorities (root or CAP_SYS_NICE), else at the default.
 NICE=()
 if nice -n -10 true 2>/dev/null && [ "$(nice -n -10 nice)" = "-10" ]; then NICE=(nice -n -10); fi
+# arflex.home: where the console keeps its audit log (console-audit.log, mode 0600).
 commands | "${NICE[@]}" java -Dfelix.system.properties="file:$CREDS" -Darflex.console.bundles="$console_bundles" \
-  -Darflex.evaluation="${ARFLEX_EVALUATION:-true}" -jar bin/felix.jar 2>&1 | tee "$LOG"
+  -Darflex.home="$ARFLEX_HOME" -Darflex.evaluation="${ARFLEX_EVALUATION:-true}" -jar bin/felix.jar 2>&1 | tee "$LOG"

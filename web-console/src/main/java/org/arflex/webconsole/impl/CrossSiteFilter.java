@@ -36,6 +36,7 @@ public class CrossSiteFilter implements Filter {
         if (request instanceof HttpServletRequest req && response instanceof HttpServletResponse resp) {
             String why = refusal(req);
             if (why != null) {
+                req.setAttribute(AuditFilter.REASON, why);
                 resp.sendError(HttpServletResponse.SC_FORBIDDEN, why);
                 return;
             }

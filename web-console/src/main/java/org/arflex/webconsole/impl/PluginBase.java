@@ -88,10 +88,12 @@ abstract class PluginBase extends AbstractServlet {
         String r = route(req);
         String why = Csrf.refusal(req);
         if (why != null) {
+            req.setAttribute(AuditFilter.REASON, why);
             send(resp, 403, Map.of("error", why));
             return;
         }
         if (!r.startsWith("/api/")) {
+            req.setAttribute(AuditFilter.REASON, "no endpoint " + r);
             send(resp, 404, Map.of("error", "no endpoint " + r));
             return;
         }
@@ -106,9 +108,12 @@ abstract class PluginBase extends AbstractServlet {
         try {
             send(resp, 200, a.run());
         } catch (HttpError e) {
+            req.setAttribute(AuditFilter.REASON, e.getMessage());
             send(resp, e.status, Map.of("error", e.getMessage()));
         } catch (RuntimeException e) {
-            send(resp, 500, Map.of("error", e.getClass().getSimpleName() + ": " + e.getMessage()));
+            String why = e.getClass().getSimpleName() + ": " + e.getMessage();
+            req.setAttribute(AuditFilter.REASON, why);
+            send(resp, 500, Map.of("error", why));
         }
     }
 
@@ -139,8 +144,13 @@ abstract class PluginBase extends AbstractServlet {
             case "port" -> b.portValue(name, req.getParameter("port"));
             case "ports" -> b.watchablePorts();
             case "debug" -> b.debugStatus();
-            default -> throw new HttpError(404, "no endpoint /api/" + what);
+            default -> pageGet(what, req);
         };
+    }
+
+    /** A read endpoint of one page only; none by default. */
+    Object pageGet(String what, HttpServletRequest req) throws HttpError, IOException {
+        throw new HttpError(404, "no endpoint /api/" + what);
     }
 
     /** The state-changing endpoints (CSRF already checked). */
