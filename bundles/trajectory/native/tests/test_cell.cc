@@ -903,11 +903,26 @@ void CaseTeachReplay() {
 // ---- tools ----------------------------------------------------------------------------------
 
 // One tool provider after the other behind the same consumer code: the same port type, the
-// consumer's reader opens either; each follows the command from the same command segment.
+// consumer's reader opens either; each follows the command from the same command segment,
+// with its safety input bound to a guard the script plays (NORMAL, written while waiting:
+// a tool holds without a fresh guard; bundles/tool-gripper/native/tests/test_tools.c).
 void CaseTools() {
   static struct arflex_host script, grip, spin, traj;
-  int r = Make(&script, "script", kMs, {{"command", kSampleT}}, {}, nullptr);
+  int r = Make(&script, "script", kMs, {{"command", kSampleT}, {"safety", kST}}, {}, nullptr);
   CHECK(r == 0, "script: %d", r);
+  struct arflex_safety_state guard;
+  memset(&guard, 0, sizeof(guard));
+  guard.mode = ARFLEX_SAFETY_STATE_MODE_NORMAL;
+  guard.power_scale = 1;
+  uint64_t guard_at = 0;
+  auto speak = [&] {  // a fresh guard value every 5 ms at most
+    if (Now() - guard_at < 5 * kMs) return;
+    guard_at = Now();
+    guard.t_ns = (int64_t)guard_at;
+    ++guard.seq;
+    arflex_state_write(arflex_host_output(&script, "safety"), &guard, sizeof(guard));
+  };
+  speak();
   // The consumer the cell has: trajectory's tool input, bound to each tool in turn (the
   // DRCR's rebinding); its tool_id output tells which tool lin motions are planned for.
   r = Make(&traj, "trajectory", kMs, {{"joint_ref", kRefT}, {"tool_id", kSampleT}}, TrajectoryParams(),
@@ -925,9 +940,14 @@ void CaseTools() {
   const uint32_t ids[2] = {1, 2};
   for (int i = 0; i < 2; ++i) {
     r = Make(tools[i], exes[i] + 5, kMs, {{"tool", kToolT}},
-             {PD("command", 0, 0, 1, true), PD("rate", 2, 0.01, 100, true)}, exes[i]);
+             {PD("command", 0, 0, 1, true), PD("rate", 2, 0.01, 100, true),
+              PD("safety_max_age_ms", 1000, 2, 1000, true)},
+             exes[i]);
     CHECK(r == 0, "%s: %d", exes[i], r);
     CHECK(arflex_host_bind(tools[i], "command", arflex_host_output_name(&script, "command"), kCall) == 0, "bind");
+    speak();
+    CHECK(arflex_host_bind(tools[i], "safety", arflex_host_output_name(&script, "safety"), kCall) == 0,
+          "bind safety");
     CHECK(arflex_host_start(tools[i], kCall) == 0, "start");
     Reader rd;  // the consumer: expects arflex.ToolState 1.0 from whoever provides `tool`
     CHECK(rd.Open(tools[i], "tool", &kToolT) == 0, "%s: consumer cannot open its tool port", exes[i]);
@@ -936,6 +956,7 @@ void CaseTools() {
     bool ready = false;
     const uint64_t dl = Now() + kWait;
     while (!ready && Now() < dl) {
+      speak();
       if (rd.Read(&s, &seq) != 1) {
         sched_yield();
         continue;
