@@ -8,7 +8,7 @@
  * Safety input `safety` (arflex.SafetyState, role=safety: the force guard) permits actuation
  * (docs/safety.md, D11), judged every cycle by rt-core/safety (arflex_safety_gate): while it
  * is unbound, has not spoken, is older than safety_max_age_ms, invalid, damaged or in a
- * protective stop, the spindle runs down to 0 (at its rate, at least kStopRate) and the
+ * protective stop, the spindle runs down to 0 (at its rate, at least STOP_RATE) and the
  * gripper keeps its grip (it never opens by itself: dropping a part is not safe); commands
  * are refused. A guard that had permitted actuation and is lost (not merely stopping) latches
  * an operator reset. After any stop (protective stop, lost guard, safe mode, a restart) the
