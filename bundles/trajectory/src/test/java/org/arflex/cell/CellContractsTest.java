@@ -55,6 +55,18 @@ class CellContractsTest {
         assertEquals(out.method(), in.method());
         assertTrue(in.optional());
         assertTrue(load("trajectory").movesHardware());
+        // The tools move hardware too: the same safety input, a declared one (SPEC 6.8).
+        Map<String, String> guard = load("force-guard").attributes();
+        for (String tool : List.of("tool-gripper", "tool-spindle")) {
+            PortSpec s = load(tool).port("safety").orElseThrow();
+            assertEquals(PortSpec.Direction.IN, s.direction());
+            assertEquals(out.type(), s.type(), tool);
+            assertEquals(out.typeVersion(), s.typeVersion(), tool);
+            assertEquals(out.method(), s.method(), tool);
+            assertTrue(s.safety(), tool + ".safety must be a declared safety input");
+            assertTrue(load(tool).movesHardware(), tool);
+            assertTrue(filterOf(tool, "safety").matches(guard), tool + ".safety must bind the force guard");
+        }
     }
 
     @Test
