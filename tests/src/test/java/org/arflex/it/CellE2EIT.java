@@ -303,7 +303,7 @@ class CellE2EIT {
         for (String b : List.of("tcp-correction.reference <- trajectory.joint_ref",
                 "sim-robot.joint_ref <- tcp-correction.corrected", "tcp-correction.tcp_pose <- vision.tcp_pose",
                 "vision.cam0 <- sim-camera-0.frames", "vision.cam3 <- sim-camera-3.frames",
-                "trajectory.safety <- force-guard.safety")) {
+                "trajectory.safety <- force-guard.safety", "tool-gripper.safety <- force-guard.safety")) {
             assertTrue(bindings.contains(b), "binding '" + b + "' missing:\n" + bindings);
         }
         @SuppressWarnings("unchecked")

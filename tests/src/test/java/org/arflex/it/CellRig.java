@@ -170,7 +170,12 @@ final class CellRig {
             }
             // a reset permits motion, it does not start it: the operator's fresh command
             for (String n : awaitingCommand(rt)) {
-                rt.cmd("arflex:set " + n + " run true");
+                if (n.startsWith("tool-")) {
+                    // a tool's fresh command is a write of its command (the level it had)
+                    rt.cmd("arflex:set " + n + " command " + rt.cmd("arflex:get " + n + " command").strip());
+                } else {
+                    rt.cmd("arflex:set " + n + " run true");
+                }
             }
         }
     }

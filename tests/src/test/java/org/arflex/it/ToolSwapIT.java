@@ -17,11 +17,16 @@ import org.junit.jupiter.api.Test;
  * {@code (role=tool)}: lin motions move the mounted tool's centre point) and is rewired live:
  * trajectory and sim-robot keep their processes, their cycle counters advance at every step,
  * the trajectory reports the new tool id on its {@code tool_id} port, and the joint reference
- * never jumps (every observed step within the joint speed limits for the cycles between).
+ * never jumps (every observed step within the joint speed limits for the cycles between). Each
+ * tool's safety input is bound to the arm's force guard, and the spindle, with the guard
+ * permitting, spins up to the speed it is commanded.
  */
 class ToolSwapIT {
 
     static final long T = CellRig.T;
+    /** arflex.ToolState: size, and offset of its actuation level (command). */
+    static final int TOOL_STATE_SIZE = 120;
+    static final int TOOL_LEVEL = 112;
 
     @Test
     void gripperSwappedForSpindleWhileTheArmMoves() throws Exception {
@@ -37,6 +42,9 @@ class ToolSwapIT {
             rt.waitUntil("the arm follows the trajectory", T, () -> CellRig.armFollows(rt, "trajectory"));
             rt.waitUntil("trajectory.tool bound to the gripper", T,
                     () -> rt.cmd("arflex:bindings").contains("trajectory.tool <- tool-gripper.tool"));
+            // A tool moves hardware: its safety input is the arm's guard (it holds without one).
+            rt.waitUntil("tool-gripper.safety bound to the guard", T,
+                    () -> rt.cmd("arflex:bindings").contains("tool-gripper.safety <- force-guard.safety"));
 
             String[] watched = {"trajectory", "sim-robot"};
             long[] pids = {rt.pid("trajectory"), rt.pid("sim-robot")};
@@ -106,6 +114,17 @@ class ToolSwapIT {
                         () -> rt.cmd("arflex:bindings").contains("trajectory.tool <- tool-spindle.tool"));
                 rt.waitUntil("trajectory plans for the spindle (tool_id 2)", T, () -> toolIdIs(toolId, 2));
                 step.check("spindle installed");
+                // The guard permits: the spindle (installed, not restarted: no reset to take)
+                // spins up to its command.
+                rt.waitUntil("tool-spindle.safety bound to the guard", T,
+                        () -> rt.cmd("arflex:bindings").contains("tool-spindle.safety <- force-guard.safety"));
+                CellRig.set(rt, "tool-spindle", "command", "0.5");
+                try (CellRig.Port tool = new CellRig.Port(rt.segment("tool-spindle", "tool"), TOOL_STATE_SIZE)) {
+                    rt.waitUntil("the spindle at speed 0.5", T, () -> {
+                        java.nio.ByteBuffer v = tool.read();
+                        return v != null && v.getDouble(TOOL_LEVEL) == 0.5;
+                    });
+                }
                 long seen = refs.get();
                 rt.waitUntil("the arm keeps moving", T, () -> refs.get() > seen + 500);
                 step.check("spindle in use");
