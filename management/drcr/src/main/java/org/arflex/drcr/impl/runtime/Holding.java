@@ -31,7 +31,7 @@ final class Holding {
         if (cause == ControlBlock.HOLD_SAFETY_INPUT) {
             why = "protective stop: " + safetyInput(cell, i, (hold >> 8) & 0xff, (hold >> 16) & 0xff);
         } else if (cause == ControlBlock.HOLD_AWAIT_COMMAND && !awaitingReset) {
-            why = "stopped: waits for a fresh command (set run true, or a program) after the reset";
+            why = "stopped: waits for a fresh command (" + freshCommand(i) + ") after the reset";
         } else if (cause == ControlBlock.HOLD_REFERENCE) {
             why = "holds: waits for a reference that meets the arm (after a stop: one at rest)";
         }
@@ -44,6 +44,13 @@ final class Holding {
             why = "safe mode: runtime heartbeat lost";
         }
         return why;
+    }
+
+    /** What a fresh command is for this component: by the parameters its contract declares. */
+    static String freshCommand(Instance i) {
+        boolean run = i.contract.properties().stream().anyMatch(p -> p.name().equals("run"));
+        boolean command = i.contract.properties().stream().anyMatch(p -> p.name().equals("command"));
+        return run ? "set run true, or a program" : command ? "write its command again" : "a new command";
     }
 
     private static String safetyInput(Cell cell, Instance i, int verdict, int index) {
