@@ -163,7 +163,10 @@ public final class SecureXml {
             // RuntimeException: Woodstox reports an error found while reading text lazily (a
             // text node past the limit) as an unchecked WstxLazyException, and a limit may throw
             // IllegalArgumentException; all of them are problems of this document (issue 16).
-            problems.add(XmlFailure.problem(e, source, r == null ? null : locationOf(r)));
+            // no reader yet: creating it failed in the XML declaration or the encoding detection
+            // (an unsupported or inconsistent encoding), which Woodstox reports without a
+            // location; both are at the document's start (issue 16, fuzzing)
+            problems.add(XmlFailure.problem(e, source, r == null ? DOCUMENT_START : locationOf(r)));
         } finally {
             if (r != null) {
                 try {
@@ -194,6 +197,34 @@ public final class SecureXml {
         return "malformed XML: " + m.replace('\n', ' ').trim();
     }
 
+    /** Line 1, column 1: where the XML declaration and the encoding detection are. */
+    private static final Location DOCUMENT_START = new Location() {
+        @Override
+        public int getLineNumber() {
+            return 1;
+        }
+
+        @Override
+        public int getColumnNumber() {
+            return 1;
+        }
+
+        @Override
+        public int getCharacterOffset() {
+            return 0;
+        }
+
+        @Override
+        public String getPublicId() {
+            return null;
+        }
+
+        @Override
+        public String getSystemId() {
+            return null;
+        }
+    };
+
     private static Location locationOf(XMLStreamReader r) {
         try {
             return r.getLocation();
@@ -205,7 +236,7 @@ public final class SecureXml {
     private static void add(List<Problem> problems, String source, Location loc, String section, String field,
             String message) {
         int line = loc == null ? 0 : Math.max(loc.getLineNumber(), 0);
-        int col = loc == null ? 0 : Math.max(loc.getColumnNumber(), 0);
+        int col = line <= 0 ? 0 : Math.max(loc.getColumnNumber(), 1);
         problems.add(new Problem(source, line, col, section, field, message));
     }
 }
