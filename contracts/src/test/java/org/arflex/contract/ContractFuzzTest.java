@@ -12,8 +12,10 @@ import java.util.Arrays;
 import java.util.Base64;
 import java.util.HexFormat;
 import java.util.List;
+import java.util.Locale;
 import java.util.Map;
 import java.util.concurrent.TimeUnit;
+import org.junit.jupiter.api.AfterAll;
 
 /**
  * Fuzz target for everything in this module that reads untrusted XML (issue 16): the contract
@@ -54,6 +56,11 @@ class ContractFuzzTest {
     private static volatile byte[] current;
     private static volatile Thread runner;
 
+    /** Inputs run by this JVM, and when the first and the last of them started (System.nanoTime). */
+    private static long inputs;
+    private static long firstNs;
+    private static long lastNs;
+
     static {
         Thread w = new Thread(ContractFuzzTest::watch, "ContractFuzzTest-watchdog");
         w.setDaemon(true);
@@ -69,12 +76,27 @@ class ContractFuzzTest {
         runner = Thread.currentThread();
         current = data;
         startedAt = System.nanoTime();
+        lastNs = startedAt;
+        if (inputs++ == 0) {
+            firstNs = startedAt;
+        }
         try {
             contract(data);
             portType(data);
         } finally {
             startedAt = 0;
         }
+    }
+
+    /**
+     * One line on the console however the output is redirected (libFuzzer runs quiet in the
+     * suite): how many inputs ran, how fast.
+     */
+    @AfterAll
+    static void summary() {
+        double s = (lastNs - firstNs) / 1e9;
+        stderr(String.format(Locale.ROOT, "ContractFuzzTest: %d inputs in %.1f s (%.0f a second)%n", inputs, s,
+                s > 0 ? inputs / s : 0.0));
     }
 
     /** Contracts: {@code parse} on the raw bytes, {@code validate} and {@code parseAll} on them as text. */
@@ -185,16 +207,23 @@ class ContractFuzzTest {
                         b.append("    at ").append(e).append('\n');
                     }
                 }
-                // straight to file descriptor 2: Surefire's System.err would not be flushed before halt
-                try {
-                    FileOutputStream err = new FileOutputStream(FileDescriptor.err);
-                    err.write(b.toString().getBytes(StandardCharsets.UTF_8));
-                    err.flush();
-                } catch (IOException e) {
-                    // nothing better to do: halting is what matters
-                }
+                stderr(b.toString());
                 Runtime.getRuntime().halt(70);
             }
+        }
+    }
+
+    /**
+     * Straight to file descriptor 2, to the console: Surefire sends System.err to a file here,
+     * and would not flush it before a halt.
+     */
+    private static void stderr(String text) {
+        try {
+            FileOutputStream err = new FileOutputStream(FileDescriptor.err);
+            err.write(text.getBytes(StandardCharsets.UTF_8));
+            err.flush();
+        } catch (IOException e) {
+            // nothing better to do
         }
     }
 
