@@ -189,7 +189,7 @@ public final class ContractParser {
 
                 @Override
                 public void error(SAXParseException e) {
-                    problems.add(new Problem(source, e.getLineNumber(), e.getColumnNumber(), "14", "(schema)",
+                    problems.add(new Problem(source, Math.max(e.getLineNumber(), 1), Math.max(e.getColumnNumber(), 1), "14", "(schema)",
                             "rejected by arflex-contract-1.xsd: " + e.getMessage()));
                 }
 
@@ -200,8 +200,12 @@ public final class ContractParser {
             });
             v.validate(new StreamSource(new ByteArrayInputStream(data), source));
         } catch (SAXException | IOException e) {
+            // the JDK's parser failed before it could say where (a SAXParseException went to the
+            // handler above): that is while it sets up decoding, at the document's start. The
+            // prescan refuses what it knows to fail here (SecureXml.encodingProblem); this is
+            // the last line (issue 16: every problem has a line and a column)
             if (problems.isEmpty()) {
-                problems.add(new Problem(source, 0, 0, "14", "(schema)", "schema check failed: " + e.getMessage()));
+                problems.add(new Problem(source, 1, 1, "14", "(schema)", "schema check failed: " + e.getMessage()));
             }
         }
     }

@@ -5,6 +5,7 @@ import static org.junit.jupiter.api.Assertions.assertFalse;
 import static org.junit.jupiter.api.Assertions.assertThrows;
 import static org.junit.jupiter.api.Assertions.assertTrue;
 
+import java.io.ByteArrayInputStream;
 import java.io.IOException;
 import java.io.InputStream;
 import java.nio.charset.StandardCharsets;
@@ -73,6 +74,33 @@ class ContractParserTest {
         assertFalse(PARSER.validate("", "empty.xml").isEmpty());
         assertFalse(PARSER.validate("<<<", "junk.xml").isEmpty());
         assertFalse(PARSER.validate(null, "null.xml").isEmpty());
+    }
+
+    /**
+     * Failures before the first token (no input, an unsupported or undetectable encoding) are
+     * reported by Woodstox without a location or at column 0; they are at the document's start,
+     * 1:1 (issue 16, found by ContractFuzzTest; corpus files finding-*-no-location).
+     */
+    @Test
+    void failuresBeforeTheFirstTokenAreLocatedAtTheStart() throws Exception {
+        Map<String, byte[]> docs = new LinkedHashMap<>();
+        docs.put("empty", new byte[0]);
+        docs.put("utf-9", "<?xml version=\"1.0\" encoding=\"UTF-9\"?>\n<component xmlns=\"urn:arflex:contract:1\"/>"
+                .getBytes(StandardCharsets.US_ASCII));
+        docs.put("ucs-4 3412", new byte[] {0, '<', 0, 0, 0, 0, 0, 0});
+        for (Map.Entry<String, byte[]> d : docs.entrySet()) {
+            ContractException e = assertThrows(ContractException.class,
+                    () -> PARSER.parse(new ByteArrayInputStream(d.getValue()), "start.xml"), d.getKey());
+            Problem p = e.problems().get(0);
+            assertEquals("2.1", p.section(), d.getKey());
+            assertEquals(1, p.line(), d.getKey() + ": " + p);
+            assertEquals(1, p.column(), d.getKey() + ": " + p);
+        }
+        ContractException e = assertThrows(ContractException.class, () -> PortTypes.parse(new ByteArrayInputStream(
+                "<?xml version=\"1.0\" encoding=\"UTF-%\"?><portType xmlns=\"urn:arflex:porttype:1\"/>"
+                        .getBytes(StandardCharsets.US_ASCII)), "t.xml"));
+        assertEquals("t.xml:1:1: [§2.1] (document): malformed XML: Unsupported encoding: UTF-%",
+                e.problems().get(0).toString());
     }
 
     @Test

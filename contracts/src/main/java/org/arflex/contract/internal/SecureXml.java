@@ -7,6 +7,8 @@ import com.ctc.wstx.stax.WstxOutputFactory;
 import java.io.ByteArrayInputStream;
 import java.io.IOException;
 import java.io.InputStream;
+import java.nio.charset.Charset;
+import java.nio.charset.StandardCharsets;
 import java.util.List;
 import javax.xml.stream.Location;
 import javax.xml.stream.XMLInputFactory;
@@ -100,6 +102,11 @@ public final class SecureXml {
         XMLStreamReader r = null;
         try {
             r = factory.createXMLStreamReader(new ByteArrayInputStream(data));
+            String encodingProblem = encodingProblem(r.getCharacterEncodingScheme(), data);
+            if (encodingProblem != null) {
+                add(problems, source, DOCUMENT_START, "2.1", "(document)", encodingProblem);
+                return false;
+            }
             boolean seenRoot = false;
             while (r.hasNext()) {
                 int ev = r.next();
@@ -163,7 +170,10 @@ public final class SecureXml {
             // RuntimeException: Woodstox reports an error found while reading text lazily (a
             // text node past the limit) as an unchecked WstxLazyException, and a limit may throw
             // IllegalArgumentException; all of them are problems of this document (issue 16).
-            problems.add(XmlFailure.problem(e, source, r == null ? null : locationOf(r)));
+            // no reader yet: creating it failed in the XML declaration or the encoding detection
+            // (an unsupported or inconsistent encoding), which Woodstox reports without a
+            // location; both are at the document's start (issue 16, fuzzing)
+            problems.add(XmlFailure.problem(e, source, r == null ? DOCUMENT_START : locationOf(r)));
         } finally {
             if (r != null) {
                 try {
@@ -174,6 +184,46 @@ public final class SecureXml {
             }
         }
         return problems.size() == before;
+    }
+
+    /**
+     * What is wrong with the encoding the XML declaration names ({@code declared}, null when
+     * there is none), or null. Woodstox matches encoding names loosely ("UT-F-8" and "utf_8"
+     * read as UTF-8) and lets a declaration override a UTF-8 byte order mark; the JDK's parser
+     * behind the XSD check does neither, so such a document was accepted by the validator and
+     * then refused by the schema check with no location (issue 16, found by fuzzing). XML 1.0
+     * §4.3.3 makes both a fatal error; §2.1 refuses them here, before anything reads the text.
+     */
+    static String encodingProblem(String declared, byte[] data) {
+        if (declared == null) {
+            return null;
+        }
+        Charset named;
+        try {
+            named = Charset.forName(declared);
+        } catch (IllegalArgumentException e) {
+            // IllegalCharsetNameException and UnsupportedCharsetException are both IllegalArgumentExceptions
+            return "malformed XML: the XML declaration names encoding '" + declared + "', which is not supported";
+        }
+        Charset bom = byteOrderMark(data);
+        if (bom != null && !bom.equals(named) && !(bom.name().startsWith("UTF-16") && named.name().startsWith("UTF-16"))) {
+            return "malformed XML: the byte order mark says " + bom.name() + " but the XML declaration names encoding '"
+                    + declared + "'";
+        }
+        return null;
+    }
+
+    private static Charset byteOrderMark(byte[] d) {
+        if (d.length >= 3 && (d[0] & 0xFF) == 0xEF && (d[1] & 0xFF) == 0xBB && (d[2] & 0xFF) == 0xBF) {
+            return StandardCharsets.UTF_8;
+        }
+        if (d.length >= 2 && (d[0] & 0xFF) == 0xFE && (d[1] & 0xFF) == 0xFF) {
+            return StandardCharsets.UTF_16BE;
+        }
+        if (d.length >= 2 && (d[0] & 0xFF) == 0xFF && (d[1] & 0xFF) == 0xFE) {
+            return StandardCharsets.UTF_16LE;
+        }
+        return null;
     }
 
     /** The parser's message without Woodstox's location prefix (the Problem carries it). */
@@ -194,6 +244,34 @@ public final class SecureXml {
         return "malformed XML: " + m.replace('\n', ' ').trim();
     }
 
+    /** Line 1, column 1: where the XML declaration and the encoding detection are. */
+    private static final Location DOCUMENT_START = new Location() {
+        @Override
+        public int getLineNumber() {
+            return 1;
+        }
+
+        @Override
+        public int getColumnNumber() {
+            return 1;
+        }
+
+        @Override
+        public int getCharacterOffset() {
+            return 0;
+        }
+
+        @Override
+        public String getPublicId() {
+            return null;
+        }
+
+        @Override
+        public String getSystemId() {
+            return null;
+        }
+    };
+
     private static Location locationOf(XMLStreamReader r) {
         try {
             return r.getLocation();
@@ -205,7 +283,7 @@ public final class SecureXml {
     private static void add(List<Problem> problems, String source, Location loc, String section, String field,
             String message) {
         int line = loc == null ? 0 : Math.max(loc.getLineNumber(), 0);
-        int col = loc == null ? 0 : Math.max(loc.getColumnNumber(), 0);
+        int col = line <= 0 ? 0 : Math.max(loc.getColumnNumber(), 1);
         problems.add(new Problem(source, line, col, section, field, message));
     }
 }

@@ -56,6 +56,11 @@ public final class XmlFailure {
             line = fallback.getLineNumber();
             column = Math.max(fallback.getColumnNumber(), 0);
         }
+        if (line > 0) {
+            // Woodstox counts columns from 0 at the start of a line (an empty document fails at
+            // 1:0); a Problem's columns are 1-based
+            column = Math.max(column, 1);
+        }
         String text = message instanceof JsonProcessingException j && j.getOriginalMessage() != null
                 ? SecureXml.describe(j.getOriginalMessage())
                 : SecureXml.describe(message.getMessage() == null ? message.getClass().getSimpleName()
