@@ -463,6 +463,11 @@ final class CellRig {
             return values.get(i);
         }
 
+        /** A copy of the values from index {@code mark} on (one consistent view). */
+        synchronized List<V> since(int mark) {
+            return new ArrayList<>(values.subList(Math.min(mark, values.size()), values.size()));
+        }
+
         /** A copy of everything so far. */
         synchronized List<V> snapshot() {
             return new ArrayList<>(values);

@@ -126,7 +126,7 @@ class FailSafeIT {
                 int held = js.size();
                 rt.waitUntil("2000 robot cycles with the guard FAILED", T, () -> js.size() > held + 2000);
                 double[] q0 = js.get(held).q();
-                for (CellRig.JointState j : js.snapshot().subList(held, js.size())) {
+                for (CellRig.JointState j : js.since(held)) {
                     assertTrue(CellRig.maxDiff(j.q(), q0) < 1e-3, "the arm moved without its guard: " + j);
                 }
                 String h = holding(rt, "sim-robot");
@@ -149,7 +149,7 @@ class FailSafeIT {
                         () -> CellRig.awaitingCommand(rt).contains("trajectory"));
                 int afterReset = js.size();
                 rt.waitUntil("1000 robot cycles after the reset", T, () -> js.size() > afterReset + 1000);
-                for (CellRig.JointState j : js.snapshot().subList(afterReset, js.size())) {
+                for (CellRig.JointState j : js.since(afterReset)) {
                     assertTrue(j.maxSpeed() <= STILL, "the arm moved after the reset without a command: " + j);
                 }
                 CellRig.set(rt, "trajectory", "run", "true");
@@ -184,7 +184,7 @@ class FailSafeIT {
                 assertTrue(listLine(rt, "trajectory").contains("waits for a fresh command"), rt.cmd("arflex:list"));
                 int afterReset = js.size();
                 rt.waitUntil("1500 robot cycles after the reset", T, () -> js.size() > afterReset + 1500);
-                for (CellRig.JointState j : js.snapshot().subList(afterReset, js.size())) {
+                for (CellRig.JointState j : js.since(afterReset)) {
                     assertTrue(j.maxSpeed() <= STILL, "the reset alone restarted motion: " + j);
                 }
                 CellRig.set(rt, "trajectory", "run", "true");

@@ -104,7 +104,7 @@ class FaultBench {
             });
             int mark = js.size();
             rt.waitUntil("1000 robot cycles after the reset", 30_000, () -> js.size() > mark + 1000);
-            boolean still = js.snapshot().subList(mark, js.size()).stream().allMatch(j -> j.maxSpeed() <= FailSafeIT.STILL);
+            boolean still = js.since(mark).stream().allMatch(j -> j.maxSpeed() <= FailSafeIT.STILL);
             s17Total++;
             if (still) {
                 s17Pass++;
@@ -247,7 +247,7 @@ class FaultBench {
                 }
                 int mark = js.size();
                 rt.waitUntil("2000 robot cycles with the guard lost", 30_000, () -> js.size() > mark + 2000);
-                boolean stayed = js.snapshot().subList(mark, js.size()).stream().allMatch(j -> j.maxSpeed() <= FailSafeIT.STILL);
+                boolean stayed = js.since(mark).stream().allMatch(j -> j.maxSpeed() <= FailSafeIT.STILL);
                 boolean failed = "FAILED".equals(rt.state("force-guard"));
                 boolean ok = resetThenCommand(rt, js);
                 record("G-guard-lost", new Run(safe >= 0 && stayed && failed && ok, safe, 0, failed ? "" : "(guard not FAILED)"));
@@ -275,7 +275,7 @@ class FaultBench {
                 }
                 int mark5 = js.size();
                 rt.waitUntil("2000 robot cycles in the crash loop's end", 30_000, () -> js.size() > mark5 + 2000);
-                boolean still5 = js.snapshot().subList(mark5, js.size()).stream().allMatch(j -> j.maxSpeed() <= FailSafeIT.STILL);
+                boolean still5 = js.since(mark5).stream().allMatch(j -> j.maxSpeed() <= FailSafeIT.STILL);
                 boolean failed5 = "FAILED".equals(rt.state("trajectory"));
                 boolean ok5 = resetThenCommand(rt, js);
                 record("S5-crash-loop", new Run(safe5 >= 0 && still5 && failed5 && ok5, safe5, 0,

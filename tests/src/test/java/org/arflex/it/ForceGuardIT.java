@@ -159,7 +159,7 @@ class ForceGuardIT {
                         rt.instance("trajectory").get("holding")).startsWith("stopped: waits for a fresh command"));
                 int afterReset = refT.size();
                 rt.waitUntil("500 trajectory cycles after the reset", T, () -> refT.size() > afterReset + 500);
-                for (CellRig.Ref x : refT.snapshot().subList(afterReset, refT.size())) {
+                for (CellRig.Ref x : refT.since(afterReset)) {
                     assertTrue(Arrays.equals(x.q(), heldQ), "the motion resumed after the reset without a command: " + x);
                 }
                 // The fresh command.

@@ -68,7 +68,7 @@ class StressBench {
                         long t = System.nanoTime();
                         rt.waitUntil("a second of the stressed cell", 10_000, () -> System.nanoTime() - t > 1_000_000_000L);
                         windows++;
-                        if (js.snapshot().subList(m, js.size()).stream().allMatch(j -> j.maxSpeed() <= FailSafeIT.STILL)) {
+                        if (js.since(m).stream().allMatch(j -> j.maxSpeed() <= FailSafeIT.STILL)) {
                             stillWindows++;
                         }
                         for (Map<String, Object> i : Runtime.list(rt.dto(), "instances")) {
