@@ -35,12 +35,53 @@ printf '%s\n' "$login" | sed '$d'
 [ -n "${ARFLEX_CONSOLE_PASSWORD:-}" ] && CREDS_TMP=$CREDS
 console_bundles=$(for jar in console/*.jar; do printf 'file:%s ' "$RUNTIME_DIR/$jar"; done)
 port=$(sed -n 's/^org.osgi.service.http.port=//p' conf/config.properties)
-echo "arflex: web console at http://127.0.0.1:${port:-8480}/system/console (user from $CREDS)"
+
+# The framework's configuration, a private copy per start (it may carry the TLS key's password).
+# The console listens on loopback (conf/config.properties); ARFLEX_CONSOLE_HOST beyond loopback
+# (or ARFLEX_CONSOLE_TLS=true on loopback) serves it over HTTPS only, plain HTTP off
+# (scripts/console-tls.sh: your PKCS12 key, or one generated in ARFLEX_HOME), and the console
+# refuses plain requests that reach it from beyond loopback anyway (docs/DECISIONS.md D16).
+CONF=$(umask 077 && mktemp "$ARFLEX_HOME/config.XXXXXX.properties")
+trap 'rm -f "$CONF"' EXIT
+cp conf/config.properties "$CONF"
+host=${ARFLEX_CONSOLE_HOST:-127.0.0.1}
+TLS_PASS=
+tls=${ARFLEX_CONSOLE_TLS:-}
+case "$host" in 127.*|localhost|::1) [ "$tls" = true ] || tls=false ;; *) tls=true ;; esac
+case "$tls" in
+  false)
+    echo "arflex: web console at http://127.0.0.1:${port:-8480}/system/console (user from $CREDS)" ;;
+  true)
+    if ! [[ "$host" =~ ^[A-Za-z0-9.:-]+$ ]]; then
+      echo "arflex run: ARFLEX_CONSOLE_HOST '$host' is not a host name or address" >&2; exit 2
+    fi
+    keys=$("$(dirname "${BASH_SOURCE[0]}")/console-tls.sh" "$ARFLEX_HOME" "$host")
+    ks=$(printf '%s\n' "$keys" | sed -n 1p)
+    TLS_PASS=$(printf '%s\n' "$keys" | sed -n 2p)
+    sport=${ARFLEX_CONSOLE_HTTPS_PORT:-8443}
+    { echo "org.apache.felix.http.host=$host"
+      echo "org.osgi.service.http.host=$host"
+      echo "org.apache.felix.http.enable=false"
+      echo "org.apache.felix.https.enable=true"
+      echo "org.osgi.service.http.port.secure=$sport"
+      echo "org.apache.felix.https.keystore=$ks"
+      echo "org.apache.felix.https.keystore.type=PKCS12"
+      echo "org.apache.felix.https.keystore.password=$(cat "$TLS_PASS")"
+      echo "org.apache.felix.https.keystore.key.password=$(cat "$TLS_PASS")"; } >> "$CONF"
+    case "$TLS_PASS" in "$ARFLEX_HOME"/console-tls.pass) TLS_PASS= ;; esac # the generated one stays
+    echo "arflex: web console at https://$host:$sport/system/console only (HTTPS; user from $CREDS)" ;;
+esac
+# JVM system properties of the assembly (conf/system.properties: URL connection timeouts), which
+# felix.system.properties below would otherwise replace.
+SYSPROPS=()
+while IFS= read -r line; do
+  case "$line" in "#"*|"") ;; *=*) SYSPROPS+=("-D$line") ;; esac
+done < conf/system.properties
 
 # The runtime's output also goes to a private log, so the command feeder below can wait for the
 # DRCR to be up before it types (Gogo starts reading before the DRCR's commands exist).
 LOG=$(mktemp "$ARFLEX_HOME/runtime.XXXXXX.log")
-trap 'rm -f "$LOG" ${CREDS_TMP:+"$CREDS_TMP"}' EXIT
+trap 'rm -f "$LOG" "$CONF" ${CREDS_TMP:+"$CREDS_TMP"} ${TLS_PASS:+"$TLS_PASS"}' EXIT
 
 # The cell's summary, read straight from the ports in shared memory (state seqlock, rt-core
 # ABI 1.0: value seq at byte 256, payload at 320). The TRUE error is |true TCP - nominal FK of
@@ -185,5 +226,6 @@ commands() {
 NICE=()
 if nice -n -10 true 2>/dev/null && [ "$(nice -n -10 nice)" = "-10" ]; then NICE=(nice -n -10); fi
 # arflex.home: where the console keeps its audit log (console-audit.log, mode 0600).
-commands | "${NICE[@]}" java -Dfelix.system.properties="file:$CREDS" -Darflex.console.bundles="$console_bundles" \
+commands | "${NICE[@]}" java "${SYSPROPS[@]}" -Dfelix.config.properties="file:$CONF" \
+  -Dfelix.system.properties="file:$CREDS" -Darflex.console.bundles="$console_bundles" \
   -Darflex.home="$ARFLEX_HOME" -Darflex.evaluation="${ARFLEX_EVALUATION:-true}" -jar bin/felix.jar 2>&1 | tee "$LOG"

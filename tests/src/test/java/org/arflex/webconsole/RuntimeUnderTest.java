@@ -35,9 +35,17 @@ final class RuntimeUnderTest implements AutoCloseable {
     final Path log;
     private final Process process;
     private final OutputStream stdin;
-    private final HttpClient http = HttpClient.newBuilder().connectTimeout(Duration.ofSeconds(5)).build();
+    private HttpClient http = HttpClient.newBuilder().connectTimeout(Duration.ofSeconds(5)).build();
+    /** The HTTPS port when the console was started with TLS (ARFLEX_CONSOLE_TLS), else 0. */
+    final int tlsPort;
+    private boolean tlsClient;
 
     RuntimeUnderTest(Path work) throws IOException {
+        this(work, false);
+    }
+
+    /** @param tls serve the console over HTTPS only (ARFLEX_CONSOLE_TLS=true, a generated key) */
+    RuntimeUnderTest(Path work, boolean tls) throws IOException {
         Path assembled = Path.of(System.getProperty("arflex.runtime.dir",
                 "../management/runtime/target/arflex-runtime")).toAbsolutePath().normalize();
         Path jar = Path.of(System.getProperty("arflex.webconsole.jar", "target/org.arflex.webconsole.jar"));
@@ -80,6 +88,7 @@ final class RuntimeUnderTest implements AutoCloseable {
             Files.copy(Path.of(debugmon), tools.resolve("org.arflex.debug.monitor.jar"));
         }
         this.port = freePort();
+        this.tlsPort = tls ? freePort() : 0;
         Path conf = runtimeDir.resolve("conf/config.properties");
         String props = Files.readString(conf).replaceAll("(?m)^org\\.osgi\\.service\\.http\\.port=.*$",
                 "org.osgi.service.http.port=" + port);
@@ -101,6 +110,10 @@ final class RuntimeUnderTest implements AutoCloseable {
         pb.environment().put("ARFLEX_HOME", home.toString());
         pb.environment().put("ARFLEX_CONSOLE_USER", USER);
         pb.environment().put("ARFLEX_CONSOLE_PASSWORD", password);
+        if (tls) {
+            pb.environment().put("ARFLEX_CONSOLE_TLS", "true");
+            pb.environment().put("ARFLEX_CONSOLE_HTTPS_PORT", Integer.toString(tlsPort));
+        }
         pb.redirectErrorStream(true).redirectOutput(log.toFile());
         pb.directory(runtimeDir.toFile());
         this.process = pb.start();
@@ -118,7 +131,15 @@ final class RuntimeUnderTest implements AutoCloseable {
         });
     }
 
+    /** A plain-HTTP base on the configured port (for checking that it is off under TLS). */
+    String plainBase() {
+        return "http://127.0.0.1:" + port;
+    }
+
     String base() {
+        if (tlsPort != 0) {
+            return "https://127.0.0.1:" + tlsPort;
+        }
         return "http://127.0.0.1:" + port;
     }
 
@@ -136,13 +157,43 @@ final class RuntimeUnderTest implements AutoCloseable {
             b.header("Authorization", basicAuth());
         }
         try {
-            return http.send(b.timeout(Duration.ofSeconds(10)).build(), HttpResponse.BodyHandlers.ofString());
+            return client().send(b.timeout(Duration.ofSeconds(10)).build(), HttpResponse.BodyHandlers.ofString());
         } catch (IOException e) {
             return null;
         } catch (InterruptedException e) {
             Thread.currentThread().interrupt();
             throw new IllegalStateException(e);
         }
+    }
+
+    /**
+     * The client; under TLS one that trusts exactly the certificate run-cell.sh generated in the
+     * home (once it exists), as an operator who checked its fingerprint would.
+     */
+    private HttpClient client() {
+        Path ks = home.resolve("console-tls.p12");
+        if (tlsPort != 0 && !tlsClient && Files.isRegularFile(ks) && Files.isRegularFile(home.resolve("console-tls.pass"))) {
+            try {
+                char[] pw = Files.readString(home.resolve("console-tls.pass")).toCharArray();
+                java.security.KeyStore store = java.security.KeyStore.getInstance("PKCS12");
+                try (var in = Files.newInputStream(ks)) {
+                    store.load(in, pw);
+                }
+                java.security.KeyStore trust = java.security.KeyStore.getInstance("PKCS12");
+                trust.load(null, null);
+                trust.setCertificateEntry("console", store.getCertificate("console"));
+                javax.net.ssl.TrustManagerFactory tmf = javax.net.ssl.TrustManagerFactory.getInstance(
+                        javax.net.ssl.TrustManagerFactory.getDefaultAlgorithm());
+                tmf.init(trust);
+                javax.net.ssl.SSLContext ctx = javax.net.ssl.SSLContext.getInstance("TLS");
+                ctx.init(null, tmf.getTrustManagers(), null);
+                http = HttpClient.newBuilder().connectTimeout(Duration.ofSeconds(5)).sslContext(ctx).build();
+                tlsClient = true;
+            } catch (IOException | java.security.GeneralSecurityException e) {
+                // not written completely yet: the next call tries again
+            }
+        }
+        return http;
     }
 
     /** Sends a Gogo command line to the runtime's shell. */
