@@ -46,6 +46,11 @@ final class RuntimeUnderTest implements AutoCloseable {
 
     /** @param tls serve the console over HTTPS only (ARFLEX_CONSOLE_TLS=true, a generated key) */
     RuntimeUnderTest(Path work, boolean tls) throws IOException {
+        this(work, tls, java.util.Map.of());
+    }
+
+    /** @param sysprops JVM system properties that replace the assembly's (conf/system.properties) */
+    RuntimeUnderTest(Path work, boolean tls, java.util.Map<String, String> sysprops) throws IOException {
         Path assembled = Path.of(System.getProperty("arflex.runtime.dir",
                 "../management/runtime/target/arflex-runtime")).toAbsolutePath().normalize();
         Path jar = Path.of(System.getProperty("arflex.webconsole.jar", "target/org.arflex.webconsole.jar"));
@@ -101,6 +106,11 @@ final class RuntimeUnderTest implements AutoCloseable {
         // build: the code gate (D12) trusts those folders as it trusts the runtime's own.
         props += "arflex.code.trusted=bundle,cell,tools," + assembled.resolve("cell") + "," + root.resolve("bundles") + "\n";
         Files.writeString(conf, props);
+        if (!sysprops.isEmpty()) {
+            StringBuilder sp = new StringBuilder();
+            sysprops.forEach((k, v) -> sp.append(k).append('=').append(v).append('\n'));
+            Files.writeString(runtimeDir.resolve("conf/system.properties"), sp.toString());
+        }
         byte[] pw = new byte[18];
         new SecureRandom().nextBytes(pw);
         this.password = Base64.getUrlEncoder().withoutPadding().encodeToString(pw);
