@@ -119,6 +119,67 @@ final class CodeDoors implements AutoCloseable {
                 rt.dir.resolve("tools/counter-ul.jar"), url("/evil.jar"));
         updateOf(withUl, "felix update <id> (Bundle-UpdateLocation: http://)", id -> "felix:update " + id);
         updateOf(withUl, "update <id> (Bundle-UpdateLocation: http://)", id -> "update " + id);
+        signatures();
+    }
+
+    /**
+     * Signed code (D14): a jar signed by a key the runtime trusts runs from anywhere (a control);
+     * one signed by an unknown key, and a trusted-signed one with an entry added afterwards, do not.
+     */
+    private void signatures() throws Exception {
+        Path keys = Files.createDirectories(outside.resolve("keys"));
+        Path trustedKs = keys.resolve("trusted.p12");
+        Path unknownKs = keys.resolve("unknown.p12");
+        jdk("keytool", "-genkeypair", "-alias", "k", "-keyalg", "EC", "-groupname", "secp256r1", "-validity", "30",
+                "-dname", "CN=ARFLEX test integrator", "-keystore", trustedKs.toString(), "-storetype", "PKCS12",
+                "-storepass", "changeit-test");
+        jdk("keytool", "-genkeypair", "-alias", "k", "-keyalg", "EC", "-groupname", "secp256r1", "-validity", "30",
+                "-dname", "CN=Somebody else", "-keystore", unknownKs.toString(), "-storetype", "PKCS12",
+                "-storepass", "changeit-test");
+        Path trustDir = Files.createDirectories(rt.dir.resolve("trust"));
+        Files.setPosixFilePermissions(trustDir, java.nio.file.attribute.PosixFilePermissions.fromString("rwxr-xr-x"));
+        jdk("keytool", "-exportcert", "-rfc", "-alias", "k", "-keystore", trustedKs.toString(), "-storetype", "PKCS12",
+                "-storepass", "changeit-test", "-file", trustDir.resolve("integrator.crt").toString());
+        Files.setPosixFilePermissions(trustDir.resolve("integrator.crt"),
+                java.nio.file.attribute.PosixFilePermissions.fromString("rw-r--r--"));
+        Path signedTrusted = Files.copy(evil, outside.resolve("signed-trusted.jar"));
+        jdk("jarsigner", "-keystore", trustedKs.toString(), "-storetype", "PKCS12", "-storepass", "changeit-test",
+                "-digestalg", "SHA-256", signedTrusted.toString(), "k");
+        Path signedUnknown = Files.copy(evil, outside.resolve("signed-unknown.jar"));
+        jdk("jarsigner", "-keystore", unknownKs.toString(), "-storetype", "PKCS12", "-storepass", "changeit-test",
+                "-digestalg", "SHA-256", signedUnknown.toString(), "k");
+        Path tampered = withExtraEntry(signedTrusted, outside.resolve("signed-tampered.jar"), null);
+
+        int mark = rt.logMark();
+        String out = rt.cmd("install " + signedTrusted.toUri());
+        Matcher m = BUNDLE_ID.matcher(out);
+        if (!m.find()) {
+            throw new AssertionError("control failed: a trusted-signed jar was not installed: " + out);
+        }
+        long id = Long.parseLong(m.group(1));
+        Attempt control = judge("control", id, mark, 0, rt.cmd("start " + id), true);
+        if (!control.succeeded()) {
+            throw new AssertionError("control failed: a jar signed by a trusted key did not run (" + control.detail() + ")\n"
+                    + rt.tail());
+        }
+        controls.add("jar signed by a key of the trust store, from outside the trusted folders: admitted, ACTIVE");
+        rt.cmd("uninstall " + id);
+        rt.waitUntil(COMPONENT + " gone", CellIT.T, () -> rt.instance(COMPONENT) == null);
+        freshInstall("felix install of a jar signed by an unknown key", "install " + signedUnknown.toUri());
+        freshInstall("felix install of a trusted-signed jar with an entry added", "install " + tampered.toUri());
+        freshInstall("deploy (no pin) of a jar signed by an unknown key", "arflex:deploy " + signedUnknown.toUri());
+    }
+
+    /** Runs a JDK tool (keytool, jarsigner) of this JVM, failing with its output. */
+    private static void jdk(String tool, String... args) throws Exception {
+        List<String> cmd = new ArrayList<>();
+        cmd.add(Path.of(System.getProperty("java.home"), "bin", tool).toString());
+        cmd.addAll(List.of(args));
+        Process p = new ProcessBuilder(cmd).redirectErrorStream(true).start();
+        String out = new String(p.getInputStream().readAllBytes(), StandardCharsets.UTF_8);
+        if (p.waitFor() != 0) {
+            throw new AssertionError(tool + " failed: " + out);
+        }
     }
 
     /**
