@@ -16,6 +16,13 @@
 // torque saturates at that fraction of each drive's max torque). The fraction applied is
 // published on `servo_power` (arflex.Sample) every period.
 //
+// Validated data (docs/safety.md): every joint_ref value is checked before use, with the
+// type's generated arflex_joint_ref_valid (q finite) and against the arm's joint limits. A
+// rejected value never reaches the servo: the last valid reference (or, before one was
+// acquired, the held measured pose) stays, the value is counted as an update error (-EINVAL
+// non-finite, -ERANGE outside the limits), and until a valid value comes the hold word says
+// REFERENCE / ARFLEX_HOLD_REF_INVALID with the input's index (the DRCR names the provider).
+//
 // Scripted disturbances come from parameters (see the contract, sim-robot.xml). The safe hook
 // holds the arm where it is (the servo's reference becomes the measured pose).
 //
@@ -148,6 +155,7 @@ struct Robot {
   uint32_t ref_binding = 0;
   bool acquired = false;
   bool refusing = false;  // refusals in this episode counted once
+  bool ref_invalid = false;  // the newest joint_ref value was rejected: the last valid one holds
   // Blend-in after an acquisition: the servo follows ref - blend_offset * (1 - s(t)), s a
   // quintic from 0 to 1 over kBlendSeconds of simulated time, so the offset between the held
   // pose and the acquired reference is taken up smoothly instead of as a step.
@@ -346,12 +354,15 @@ void HoldMeasured(Robot& r) {
   r.cell->SetCorrection(JointVector{});
 }
 
-bool ReferenceValid(const Cell& cell, const double* q) {
+// 0 when @ref may be used: the contract's check (arflex_joint_ref_valid: every q finite),
+// then the arm's joint limits. -EINVAL for a non-finite value, -ERANGE outside the limits.
+int CheckReference(const Cell& cell, const arflex_joint_ref& ref) {
+  if (!arflex_joint_ref_valid(&ref)) return -EINVAL;
   for (int i = 0; i < kNumJoints; ++i) {
     const auto& link = cell.config().arm.links[i];
-    if (!std::isfinite(q[i]) || q[i] < link.lower || q[i] > link.upper) return false;
+    if (!(ref.q[i] >= link.lower && ref.q[i] <= link.upper)) return -ERANGE;
   }
-  return true;
+  return 0;
 }
 
 // True when @q is within @tol (rad) of the measured joints on every axis.
@@ -431,6 +442,7 @@ int Start(arflex_component* c, void* user) {
   Robot& r = *static_cast<Robot*>(user);
   r.acquired = false;  // after STOP/START the reference must meet the arm again
   r.refusing = false;
+  r.ref_invalid = false;
   r.after_stop = false;
   r.blend_wait = false;
   r.guard_hold = false;
@@ -485,10 +497,13 @@ int Update(arflex_component* c, void* user, uint64_t release_ns) {
     r.ref_binding = binding;
     r.acquired = false;
     r.refusing = false;
+    r.ref_invalid = false;
   }
   if (got == 1) {
-    if (!ReferenceValid(*r.cell, ref.q)) {
-      ret = -ERANGE;  // refused: non-finite or outside the joint limits; keep the last one
+    const int bad = CheckReference(*r.cell, ref);
+    r.ref_invalid = bad < 0;
+    if (bad < 0) {
+      ret = bad;  // rejected: never reaches the servo; the last valid reference is held
     } else if (!r.acquired && r.after_stop && !AtRest(r, ref.q)) {
       // after a stop: not yet a reference at rest (still decelerating): keep holding
     } else if (!r.acquired && !NearArm(*r.cell, ref.q, P(c, r, kRefAcquireTol))) {
@@ -510,10 +525,15 @@ int Update(arflex_component* c, void* user, uint64_t release_ns) {
       for (int i = 0; i < kNumJoints; ++i) r.q_ref[i] = ref.q[i];
     }
   }
-  // The arm holds on its own account while no reference is acquired after a stop, or one is
-  // refused as too far from it: say so (a reference that meets the arm is expected).
-  if (!r.acquired && (r.refusing || r.after_stop))
-    arflex_component_hold(c, ARFLEX_HOLD_REFERENCE, 0, arflex_input_index(c, r.joint_ref));
+  // The arm holds on its own account while the newest reference was rejected as invalid, no
+  // reference is acquired after a stop, or one is refused as too far from it: say so (a valid
+  // reference that meets the arm is expected).
+  if (r.ref_invalid)
+    arflex_component_hold(c, ARFLEX_HOLD_REFERENCE, ARFLEX_HOLD_REF_INVALID,
+                          arflex_input_index(c, r.joint_ref));
+  else if (!r.acquired && (r.refusing || r.after_stop))
+    arflex_component_hold(c, ARFLEX_HOLD_REFERENCE, ARFLEX_HOLD_REF_NOT_MET,
+                          arflex_input_index(c, r.joint_ref));
   else
     arflex_component_hold(c, ARFLEX_HOLD_NONE, 0, 0);
   JointVector servo = r.q_ref;

@@ -8,6 +8,12 @@
 // when none is mounted); out tool_id (arflex.Sample: the id of the tool lin
 // motions are planned for, 0 = the flange). Parameters: see the contract (src/main/resources/OSGI-INF/arflex/trajectory.xml).
 //
+// Validated data (docs/safety.md): every value read from joint_state and tool is checked before
+// use (the type's generated arflex_<type>_valid, then what this component needs of it). A
+// rejected value is not used and is counted (update returns -EINVAL: stats.update_errors): a
+// joint state neither starts nor restarts the program from the arm nor moves the idle output
+// to it; a tool state leaves the last valid tool in use. The output is the player's as before.
+//
 // Threads: configure loads every program (main thread, file I/O); start/update/safe/stop run
 // on the RT thread and only read the loaded programs: no allocation, I/O or printing there.
 #include <algorithm>
@@ -207,16 +213,32 @@ int Start(struct arflex_component* c, void*) {
   return 0;
 }
 
+// True when a tool state value may be used: the contract's check, a known status, and for a
+// mounted tool (id != 0, status not NONE) a finite TCP within 2 m of the flange with a unit
+// quaternion. A value that says no tool is mounted is valid whatever its TCP fields hold.
+bool ToolValid(const struct arflex_tool_state& t) {
+  if (!arflex_tool_state_valid(&t) || t.status > ARFLEX_TOOL_STATE_STATUS_FAULT) return false;
+  if (t.tool_id == 0 || t.status == ARFLEX_TOOL_STATE_STATUS_NONE) return true;
+  const Eigen::Vector3d p(t.tcp_p[0], t.tcp_p[1], t.tcp_p[2]);
+  const Eigen::Vector4d r(t.tcp_quat[0], t.tcp_quat[1], t.tcp_quat[2], t.tcp_quat[3]);
+  return p.allFinite() && r.allFinite() && std::fabs(r.norm() - 1.0) < 1e-3 && p.norm() < 2.0;
+}
+
 // The mounted tool: its TCP for the lin motions that begin from now on. No tool component
-// bound, none written yet, or one that reports no tool (id 0, STATUS_NONE, a non-finite or
-// non-unit TCP) is the flange. Returns the id of the tool in use (0 = the flange).
-uint32_t TrackTool() {
+// bound, none written yet, or one that reports no tool (id 0, STATUS_NONE) is the flange. An
+// invalid value (ToolValid) is not used: the last valid one stays in use and *err is set to
+// -EINVAL (counted). Returns the id of the tool in use (0 = the flange).
+uint32_t TrackTool(int* err) {
   struct arflex_tool_state t;
   if (!arflex_input_bound(g.in_tool)) {
     g.tool_seen = false;
   } else if (arflex_input_state_read(g.in_tool, &t, sizeof(t), nullptr) == 1) {
-    g.tool = t;
-    g.tool_seen = true;
+    if (ToolValid(t)) {
+      g.tool = t;
+      g.tool_seen = true;
+    } else {
+      *err = -EINVAL;
+    }
   }
   Eigen::Isometry3d tcp = Eigen::Isometry3d::Identity();
   uint32_t id = 0;
@@ -224,33 +246,36 @@ uint32_t TrackTool() {
     const Eigen::Vector3d p(g.tool.tcp_p[0], g.tool.tcp_p[1], g.tool.tcp_p[2]);
     const Eigen::Quaterniond r(g.tool.tcp_quat[0], g.tool.tcp_quat[1], g.tool.tcp_quat[2],
                                g.tool.tcp_quat[3]);
-    if (p.allFinite() && r.coeffs().allFinite() && std::fabs(r.norm() - 1.0) < 1e-3 &&
-        p.norm() < 2.0) {
-      tcp.translation() = p;
-      tcp.linear() = r.normalized().toRotationMatrix();
-      id = g.tool.tool_id;
-    }
+    tcp.translation() = p;
+    tcp.linear() = r.normalized().toRotationMatrix();
+    id = g.tool.tool_id;
   }
   g.player.SetTool(tcp);
   return id;
 }
 
 int Step(struct arflex_component* c, uint64_t release_ns, bool force_stop) {
+  int input_err = 0;  // an input value rejected this cycle (-EINVAL), returned at the end
   struct arflex_sample tool_id;
   tool_id.seq = ++g.tool_seq;
   tool_id.t_ns = (int64_t)release_ns;
-  tool_id.value = (double)TrackTool();
+  tool_id.value = (double)TrackTool(&input_err);
   int r = arflex_state_write(g.out_tool, &tool_id, sizeof(tool_id));
   if (r < 0) return r;
   // The arm: the first reference starts where it is; and a robot that appears later, or is
   // replaced or restarted (another joint_state binding), somewhere else than the output, makes
   // the program start over from where that arm is (from its first motion, at rest), instead
   // of the reference pulling the arm across to where the program had got to.
+  // A joint state that fails its contract (a non-finite q, qd or tau) is not used (counted).
   struct arflex_joint_state js;
-  const bool measured = arflex_input_state_read(g.in_state, &js, sizeof(js), nullptr) == 1;
+  bool measured = arflex_input_state_read(g.in_state, &js, sizeof(js), nullptr) == 1;
+  if (measured && !arflex_joint_state_valid(&js)) {
+    measured = false;
+    input_err = -EINVAL;
+  }
   Q qm;
   for (int j = 0; j < 6; ++j) qm[j] = measured ? js.q[j] : 0.0;
-  const bool arm = measured && qm.allFinite();
+  const bool arm = measured;
   const uint32_t binding = arflex_input_binding(g.in_state);
   if (arm && binding != 0 && binding != g.state_binding) {
     g.state_binding = binding;
@@ -262,7 +287,7 @@ int Step(struct arflex_component* c, uint64_t release_ns, bool force_stop) {
     }
   }
   if (!g.player.initialized()) {
-    if (arflex_input_bound(g.in_state)) return 0;  // wait for the first measurement
+    if (arflex_input_bound(g.in_state)) return input_err;  // wait for the first valid measurement
     g.player.Init(g.player.program()->has_start ? g.player.program()->start : Q::Zero());
   }
   // The safety input: bound, it must permit (fresh, valid, not stopped). Unbound from the
@@ -341,7 +366,8 @@ int Step(struct arflex_component* c, uint64_t release_ns, bool force_stop) {
   ref.seq = ++g.seq;
   for (int j = 0; j < 6; ++j) ref.q[j] = g.player.q_out()[j];
   r = arflex_state_write(g.out, &ref, sizeof(ref));
-  return r < 0 ? r : switch_err;
+  if (r < 0) return r;
+  return input_err < 0 ? input_err : switch_err;
 }
 
 int Update(struct arflex_component* c, void*, uint64_t release_ns) {

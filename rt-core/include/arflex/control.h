@@ -130,6 +130,13 @@ enum arflex_hold_cause {
 	ARFLEX_HOLD_AWAIT_COMMAND = 2, /**< stopped; after the reset, waits for a fresh command */
 	ARFLEX_HOLD_REFERENCE = 3,     /**< the reference input does not meet the arm */
 };
+/** Detail (bits 8..15) of ARFLEX_HOLD_REFERENCE. */
+enum arflex_hold_reference_detail {
+	ARFLEX_HOLD_REF_NOT_MET = 0, /**< no acquired reference: too far from the arm, or not yet at
+					  rest after a stop */
+	ARFLEX_HOLD_REF_INVALID = 1, /**< the newest value failed validation (non-finite, out of
+					  range): the last valid reference is held */
+};
 #define ARFLEX_HOLD_WORD(cause, detail, input) \
 	((uint32_t)(cause) | ((uint32_t)(detail) & 0xffu) << 8 | ((uint32_t)(input) & 0xffu) << 16)
 

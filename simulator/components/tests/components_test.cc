@@ -498,6 +498,76 @@ TEST_F(SimComponents, RobotAcquiresOnlyAReferenceNearTheArm) {
   Shutdown(&robot_);
 }
 
+// Validated data (docs/safety.md): a joint reference that is NaN, infinite or outside the
+// joint limits never reaches the servo. Each one is counted (update_errors), the arm holds the
+// last valid reference and the hold word says REFERENCE / invalid on the joint_ref input; the
+// next valid value is followed again and the hold word clears.
+TEST_F(SimComponents, RobotRejectsAnInvalidReference) {
+  CreateRobot(1 * kMs, 1, false);
+  CreateReference();
+  arflex_port js_port;
+  OpenReader(&robot_, "joint_state", ARFLEX_PORT_STATE, &kJointStateType, &js_port);
+  ASSERT_EQ(arflex_host_start(&robot_, kCall), 0);
+  ASSERT_EQ(arflex_host_bind(&robot_, "joint_ref", ref_name_.c_str(), kCall), 0);
+  AcquireAtHome(&js_port);
+  arflex_joint_state js{};
+  bool have = false;
+  auto reach = [&](const double* q) {
+    return WaitFor([&] {
+      if (!Latest(&js_port, &js, &have)) return false;
+      for (int i = 0; i < 6; ++i)
+        if (!(std::fabs(js.q[i] - q[i]) <= 1e-4)) return false;
+      return true;
+    });
+  };
+  const double target[6] = {0.05, 0.5, 0.3, 0.0, 0.8, 0.0};
+  WriteReference(target);
+  ASSERT_TRUE(reach(target));
+  EXPECT_EQ(HoldCause(), static_cast<uint32_t>(ARFLEX_HOLD_NONE));
+  arflex_stats st;
+  auto errors = [&] {
+    EXPECT_EQ(arflex_ctl_stats_read(robot_.ctl, &st), 0);
+    return st.update_errors;
+  };
+  const double nan = std::nan(""), inf = HUGE_VAL;
+  const double bad[3][6] = {
+      {0.3, 0.5, nan, 0.0, 0.8, 0.0},   // NaN on one joint
+      {0.3, 0.5, 0.3, -inf, 0.8, 0.0},  // -Inf
+      {0.3, 0.5, 0.3, 0.0, 3.0, 0.0},   // joint 5 beyond its limit (125 deg)
+  };
+  for (const auto& q : bad) {
+    const uint64_t e0 = errors();
+    WriteReference(q);
+    ASSERT_TRUE(WaitFor([&] { return errors() > e0; })) << "an invalid reference was not counted";
+    EXPECT_EQ(HoldCause(), static_cast<uint32_t>(ARFLEX_HOLD_REFERENCE));
+    EXPECT_EQ(HoldDetail(), static_cast<uint32_t>(ARFLEX_HOLD_REF_INVALID));
+    EXPECT_EQ((arflex_ctl_hold(robot_.ctl) >> 16) & 0xffu,
+              0u /* joint_ref: the first input sim-robot declares */) << "the hold word names joint_ref";
+    // 200 periods later the arm is still at the last valid reference.
+    ASSERT_TRUE(WaitFor([&] { return Latest(&js_port, &js, &have); }));
+    const uint64_t seq0 = js.seq;
+    double worst = 0;
+    ASSERT_TRUE(WaitFor([&] {
+      arflex_joint_state v;
+      if (arflex_state_read(&js_port, &v, sizeof(v), nullptr) == 1) {
+        js = v;
+        for (int i = 0; i < 6; ++i) worst = std::max(worst, std::fabs(v.q[i] - target[i]));
+      }
+      return js.seq > seq0 + 200;
+    }));
+    EXPECT_LT(worst, 1e-4) << "the arm moved on an invalid reference";
+    EXPECT_EQ(errors(), e0 + 1) << "one error per invalid value";
+  }
+  // A valid value afterwards is followed again and the hold word clears.
+  const double next[6] = {0.1, 0.5, 0.3, 0.0, 0.8, 0.0};
+  WriteReference(next);
+  ASSERT_TRUE(reach(next));
+  EXPECT_EQ(HoldCause(), static_cast<uint32_t>(ARFLEX_HOLD_NONE));
+  EXPECT_EQ(arflex_host_stop(&robot_, kCall), 0);
+  arflex_port_close(&js_port);
+  Shutdown(&robot_);
+}
+
 // The force guard's power limit reaches the drives, and the guard permits motion (fail
 // closed, SAFETY.md 1): without a fresh valid value the arm holds where it is, says why in its
 // hold word, and a guard that had permitted motion and went silent latches an operator reset

@@ -17,6 +17,18 @@
 // measurement holds the correction; then ramp the applied correction towards its target at
 // max_rate and write reference + correction with the reference's time and a fresh seq.
 // Disabling ramps the correction out. Fixed-size Eigen only: update() does not allocate.
+//
+// Validated data (docs/safety.md, README "Invalid input"): every value read is checked before
+// use (the type's generated arflex_<type>_valid, then what this component needs of it); a
+// rejected value is not used and is counted (update returns -EINVAL: stats.update_errors).
+//   reference: not finite -> the output holds the last value written (the last valid
+//     reference + the correction then applied; the correction does not move) and the hold word
+//     says REFERENCE / ARFLEX_HOLD_REF_INVALID on this input until a valid reference comes.
+//   tcp_pose: a measurement that claims validity with non-finite numbers, a negative variance,
+//     a non-unit quaternion, or a validity flag other than 0/1 -> held like an invalid one (the
+//     correction stays where it is, it is neither updated nor dropped).
+//   joint_state: not finite -> the robot's position is unknown: measurements are held as by the
+//     tracking interlock until a valid joint state comes.
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -57,6 +69,8 @@ struct TcpCorrection {
   uint64_t error_seq = 0;
   double last_out[6] = {0, 0, 0, 0, 0, 0};  // the corrected reference written last
   arflex_joint_state js{};                   // the robot's newest joint state (seq 0: none)
+  bool ref_invalid = false;  // the newest reference was rejected: the output holds
+  bool js_invalid = false;   // the newest joint state was rejected: measurements are held
   double dt = 0.001;
 };
 
@@ -83,6 +97,24 @@ void ApplyParams(arflex_component* c) {
   g.track_tol = F64(c, g.p_track, 2e-3);
   const bool enable = Bool(c, g.p_enable, true);
   if (enable != g.law.enabled()) g.law.SetEnabled(enable);
+}
+
+// A measurement tcp-correction may interpret: the contract's check; valid is 0 or 1; one that
+// claims validity has finite numbers, variances >= 0 and a unit quaternion. (valid = 0, "no
+// estimate", is a correct value whatever its other fields hold: it is held, not counted.)
+bool PoseWellFormed(const arflex_pose& m) {
+  if (!arflex_pose_valid(&m) || m.valid > 1) return false;
+  if (m.valid == 0) return true;
+  double n2 = 0;
+  for (int i = 0; i < 4; ++i) {
+    if (!std::isfinite(m.quat[i])) return false;
+    n2 += m.quat[i] * m.quat[i];
+  }
+  for (int i = 0; i < 3; ++i)
+    if (!std::isfinite(m.p[i])) return false;
+  for (int i = 0; i < 6; ++i)
+    if (!(m.cov[i] >= 0 && std::isfinite(m.cov[i]))) return false;
+  return std::fabs(std::sqrt(n2) - 1.0) < 1e-3;
 }
 
 int Configure(arflex_component* c, void*) {
@@ -117,7 +149,10 @@ int Start(arflex_component* c, void*) {
   g.law = CorrectionLaw(g.law.options());
   ApplyParams(c);
   g.have_ref = false;
+  g.ref_invalid = false;
+  g.js_invalid = false;
   g.js = arflex_joint_state{};
+  arflex_component_hold(c, ARFLEX_HOLD_NONE, 0, 0);
   return 0;
 }
 
@@ -125,20 +160,53 @@ int Update(arflex_component* c, void*, uint64_t) {
   ApplyParams(c);
   // A state read returns 1 only for a value newer than the last one it returned (0: none new,
   // the buffer untouched), so only a 1 may be used.
+  int err = 0;  // a rejected input value this cycle (-EINVAL), returned at the end
   arflex_joint_ref ref{};
   if (arflex_input_state_read(g.reference, &ref, sizeof(ref), nullptr) == 1 && ref.seq != 0) {
-    g.ref = ref;
-    g.have_ref = true;
+    g.ref_invalid = !arflex_joint_ref_valid(&ref);
+    if (g.ref_invalid) {
+      err = -EINVAL;  // never passed on: the output holds (below)
+    } else {
+      g.ref = ref;
+      g.have_ref = true;
+    }
   }
-  if (!g.have_ref) return 0;
+  if (!arflex_input_bound(g.reference)) g.ref_invalid = false;  // nothing to hold against
+  if (g.ref_invalid)
+    arflex_component_hold(c, ARFLEX_HOLD_REFERENCE, ARFLEX_HOLD_REF_INVALID, arflex_input_index(c, g.reference));
+  else
+    arflex_component_hold(c, ARFLEX_HOLD_NONE, 0, 0);
+  if (!g.have_ref) return err;
+  if (g.ref_invalid && g.out_seq != 0) {
+    // The reference is invalid: the last output again (fresh seq), the correction frozen.
+    arflex_joint_ref out = g.ref;
+    for (int i = 0; i < 6; ++i) out.q[i] = g.last_out[i];
+    out.seq = ++g.out_seq;
+    const int w = arflex_state_write(g.out, &out, sizeof(out));
+    return w < 0 ? w : err;
+  }
   arflex::sim::JointVector q;
   for (int i = 0; i < 6; ++i) q[i] = g.ref.q[i];
   arflex_joint_state js{};
-  if (arflex_input_state_read(g.robot, &js, sizeof(js), nullptr) == 1 && js.seq != 0) g.js = js;
-  if (!arflex_input_bound(g.robot)) g.js.seq = 0;  // no robot: no interlock
+  if (arflex_input_state_read(g.robot, &js, sizeof(js), nullptr) == 1 && js.seq != 0) {
+    g.js_invalid = !arflex_joint_state_valid(&js);
+    if (g.js_invalid)
+      err = -EINVAL;
+    else
+      g.js = js;
+  }
+  if (!arflex_input_bound(g.robot)) {  // no robot: no interlock
+    g.js.seq = 0;
+    g.js_invalid = false;
+  }
   arflex_pose m{};
   uint64_t seq = 0;
-  if (arflex_input_state_read(g.pose, &m, sizeof(m), &seq) == 1 && m.seq != 0 && m.seq != g.pose_seq) {
+  const bool fresh =
+      arflex_input_state_read(g.pose, &m, sizeof(m), &seq) == 1 && m.seq != 0 && m.seq != g.pose_seq;
+  if (fresh && !PoseWellFormed(m)) {
+    g.pose_seq = m.seq;  // a malformed measurement: held (the correction stays), counted
+    err = -EINVAL;
+  } else if (fresh) {
     g.pose_seq = m.seq;
     Eigen::Isometry3d measured = Eigen::Isometry3d::Identity();
     measured.linear() = Eigen::Quaterniond(m.quat[0], m.quat[1], m.quat[2], m.quat[3]).normalized().toRotationMatrix();
@@ -152,8 +220,9 @@ int Update(arflex_component* c, void*, uint64_t) {
     // last output asked it to be (safe mode, a hold, a protective stop, still moving), a
     // measurement says nothing about the correction: holding it avoids winding the correction
     // up against a robot that does not move (it would jump when the robot follows again).
-    bool tracking = true;
-    if (g.out_seq != 0 && g.js.seq != 0) {
+    // A rejected joint state leaves the robot's position unknown: not tracking.
+    bool tracking = !g.js_invalid;
+    if (tracking && g.out_seq != 0 && g.js.seq != 0) {
       for (int i = 0; i < 6; ++i) tracking = tracking && std::abs(g.js.q[i] - g.last_out[i]) <= g.track_tol;
     }
     const bool valid = m.valid != 0 && certain && tracking;
@@ -179,7 +248,8 @@ int Update(arflex_component* c, void*, uint64_t) {
   size.value = 1e3 * dq.norm();
   arflex_state_write(g.size, &size, sizeof(size));
   for (int i = 0; i < 6; ++i) g.last_out[i] = out.q[i];
-  return arflex_state_write(g.out, &out, sizeof(out));
+  const int w = arflex_state_write(g.out, &out, sizeof(out));
+  return w < 0 ? w : err;
 }
 
 // Safe mode, either mode: the last output is held. Dropping the correction at once would make

@@ -3,7 +3,7 @@
 // the plant: the measured TCP is the nominal TCP of the corrected output, shifted by a fixed
 // error (what the true arm does differently from the nominal model).
 //
-//   tcpcorr_comp_test <case> <tcp-correction exe>     cases: converge, hold
+//   tcpcorr_comp_test <case> <tcp-correction exe>     cases: converge, hold, invalid
 //
 // Every case ends by checking that no /dev/shm or /dev/mqueue object of its runtime id and no
 // child process is left. Waits are on conditions with deadlines; nothing asserts on timing.
@@ -235,6 +235,42 @@ struct Rig {
     arflex_state_write(arflex_host_output(&feeder, "tcp_pose"), &p, sizeof(p));
   }
 
+  // Writes a measurement of the last output (as Measure) made malformed: 1 position NaN,
+  // 2 quaternion not unit, 3 a negative variance, 4 validity flag 2, 5 orientation Inf.
+  void MeasureMalformed(int how, const Eigen::Vector3d& extra) {
+    arflex::sim::JointVector q;
+    for (int i = 0; i < 6; ++i) q[i] = last.q[i];
+    const Eigen::Isometry3d t = kin.Tcp(q);
+    arflex_pose p;
+    std::memset(&p, 0, sizeof(p));
+    p.seq = ++pose_seq;
+    const Eigen::Vector3d pos = t.translation() + kPlantError + extra;
+    const Eigen::Quaterniond quat(t.linear());
+    for (int i = 0; i < 3; ++i) p.p[i] = pos(i);
+    p.quat[0] = quat.w();
+    p.quat[1] = quat.x();
+    p.quat[2] = quat.y();
+    p.quat[3] = quat.z();
+    p.valid = 1;
+    p.n_views = 4;
+    if (how == 1) p.p[1] = std::nan("");
+    if (how == 2) p.quat[0] *= 1.5;
+    if (how == 3) p.cov[2] = -1e-9;
+    if (how == 4) p.valid = 2;
+    if (how == 5) p.quat[3] = HUGE_VAL;
+    arflex_state_write(arflex_host_output(&feeder, "tcp_pose"), &p, sizeof(p));
+  }
+
+  uint64_t Errors() {
+    arflex_stats st;
+    return arflex_ctl_stats_read(corr.ctl, &st) == 0 ? st.update_errors : 0;
+  }
+  bool WaitErrors(uint64_t above) {
+    const uint64_t deadline = arflex_sys_now_ns() + 20 * kSec;
+    while (Errors() <= above && arflex_sys_now_ns() < deadline) Read();
+    return Errors() > above;
+  }
+
   // Runs the loop (a measurement every 20 ms of wall time) until the true TCP error is
   // below `tol` or the deadline passes. Returns the final error (m).
   double Converge(double tol) {
@@ -282,6 +318,113 @@ int RunCase(const std::string& name, const char* exe) {
   rig.Watch(100 * kMs, true, true, Eigen::Vector3d::Zero());
   CHECK(rig.last_error_mm >= 0 && rig.last_error_mm < 0.01, "error output %.6f mm after converging", rig.last_error_mm);
   CHECK(rig.last_size_mrad > 0.01, "correction output %.6f mrad after converging", rig.last_size_mrad);
+  if (name == "invalid") {
+    // Validated data (docs/safety.md, README "Invalid input"): values that fail their checks
+    // are not used and are counted (update_errors); the output stays where the valid ones put it.
+    rig.Watch(200 * kMs, false, true, Eigen::Vector3d::Zero());  // let the ramp finish
+    const arflex_joint_ref before = rig.last;
+    const Eigen::Vector3d far(0.01, 0, 0);  // 10 mm: a valid measurement this far moves the output
+    // 1. tcp_pose: malformed measurements claiming validity, 10 mm off: held, each kind counted.
+    for (int how = 1; how <= 5; ++how) {
+      const uint64_t e0 = rig.Errors();
+      rig.MeasureMalformed(how, far);
+      CHECK(rig.WaitErrors(e0), "malformed measurement %d was not counted", how);
+      const uint64_t end = arflex_sys_now_ns() + 100 * kMs;
+      uint64_t last_measure = 0;
+      while (arflex_sys_now_ns() < end) {
+        rig.Read();
+        if (arflex_sys_now_ns() - last_measure > 20 * kMs) {
+          rig.MeasureMalformed(how, far);
+          last_measure = arflex_sys_now_ns();
+        }
+      }
+      for (int i = 0; i < 6; ++i)
+        CHECK(rig.last.q[i] == before.q[i], "joint %d moved on malformed measurement %d", i, how);
+    }
+    // 2. reference: NaN on one joint. The output holds its last value (no NaN passed on, the
+    //    correction frozen even under valid measurements 10 mm off), counted; the hold word
+    //    names the reference input as invalid.
+    {
+      arflex_joint_ref bad;
+      std::memset(&bad, 0, sizeof(bad));
+      bad.t_ns = 2;
+      bad.seq = 2;
+      for (int i = 0; i < 6; ++i) bad.q[i] = kRef[i];
+      bad.q[2] = std::nan("");
+      const uint64_t e0 = rig.Errors();
+      arflex_state_write(arflex_host_output(&rig.feeder, "reference"), &bad, sizeof(bad));
+      CHECK(rig.WaitErrors(e0), "the NaN reference was not counted");
+      const uint32_t hold = arflex_ctl_hold(rig.corr.ctl);
+      CHECK((hold & 0xffu) == ARFLEX_HOLD_REFERENCE && ((hold >> 8) & 0xffu) == ARFLEX_HOLD_REF_INVALID &&
+                ((hold >> 16) & 0xffu) == 0u,
+            "hold word 0x%x", hold);
+      const uint64_t seq0 = rig.last.seq;
+      rig.Watch(300 * kMs, true, true, far);
+      CHECK(rig.last.seq > seq0 + 50, "the output is not written while the reference is invalid");
+      for (int i = 0; i < 6; ++i)
+        CHECK(rig.last.q[i] == before.q[i], "joint %d moved from %.12f to %.12f on an invalid reference", i,
+              before.q[i], rig.last.q[i]);
+      // Inf too.
+      bad.seq = 3;
+      bad.q[2] = kRef[2];
+      bad.q[5] = -HUGE_VAL;
+      const uint64_t e1 = rig.Errors();
+      arflex_state_write(arflex_host_output(&rig.feeder, "reference"), &bad, sizeof(bad));
+      CHECK(rig.WaitErrors(e1), "the Inf reference was not counted");
+      rig.Watch(100 * kMs, false, true, far);
+      for (int i = 0; i < 6; ++i) CHECK(rig.last.q[i] == before.q[i], "joint %d moved on an Inf reference", i);
+      // A valid reference again: the hold clears and the output follows it (+ the correction).
+      arflex_joint_ref good = bad;
+      good.seq = 4;
+      for (int i = 0; i < 6; ++i) good.q[i] = kRef[i] + (i == 0 ? 1e-3 : 0.0);
+      const double excess = rig.max_jump_excess;  // the reference's own 1 mrad step is passed on as is
+      arflex_state_write(arflex_host_output(&rig.feeder, "reference"), &good, sizeof(good));
+      const uint64_t deadline = arflex_sys_now_ns() + 20 * kSec;
+      bool moved = false;
+      while (!moved && arflex_sys_now_ns() < deadline) {
+        if (rig.Read()) moved = std::abs(rig.last.q[0] - before.q[0] - 1e-3) < 1e-4;
+      }
+      rig.max_jump_excess = excess;
+      CHECK(moved, "a valid reference after invalid ones was not followed");
+      CHECK((arflex_ctl_hold(rig.corr.ctl) & 0xffu) == ARFLEX_HOLD_NONE, "hold word 0x%x after a valid reference",
+            arflex_ctl_hold(rig.corr.ctl));
+    }
+    // 3. joint_state: bound, the robot where the output is, but its values NaN: the robot's
+    //    position is unknown, valid measurements 10 mm off are held (counted); a valid joint
+    //    state at the output lets them in again and the output moves.
+    {
+      rig.Watch(200 * kMs, false, true, Eigen::Vector3d::Zero());
+      const arflex_joint_ref held = rig.last;
+      arflex_joint_state js;
+      std::memset(&js, 0, sizeof(js));
+      js.seq = 1;
+      for (int i = 0; i < 6; ++i) js.q[i] = held.q[i];
+      js.tau[1] = std::nan("");
+      arflex_state_write(arflex_host_output(&rig.feeder, "joint_state"), &js, sizeof(js));
+      const uint64_t e0 = rig.Errors();
+      CHECK(arflex_host_bind(&rig.corr, "joint_state", arflex_host_output_name(&rig.feeder, "joint_state"), 2 * kSec) == 0,
+            "BIND joint_state");
+      CHECK(rig.WaitErrors(e0), "the NaN joint state was not counted");
+      rig.Watch(300 * kMs, true, true, far);
+      for (int i = 0; i < 6; ++i)
+        CHECK(rig.last.q[i] == held.q[i], "joint %d moved while the robot's joint state was invalid", i);
+      js.seq = 2;
+      js.tau[1] = 0;
+      arflex_state_write(arflex_host_output(&rig.feeder, "joint_state"), &js, sizeof(js));
+      const uint64_t deadline = arflex_sys_now_ns() + 20 * kSec;
+      uint64_t last_measure = 0;
+      bool moved = false;
+      while (!moved && arflex_sys_now_ns() < deadline) {
+        if (rig.Read()) moved = rig.last.q[0] != held.q[0] || rig.last.q[1] != held.q[1];
+        if (arflex_sys_now_ns() - last_measure > 20 * kMs) {
+          rig.Measure(true, far);
+          last_measure = arflex_sys_now_ns();
+        }
+      }
+      CHECK(moved, "measurements were still held after a valid joint state");
+    }
+    printf("invalid: %llu invalid values counted as update errors\n", (unsigned long long)rig.Errors());
+  }
   if (name == "hold") {
     // Vision drops out: invalid measurements far off are held, the output does not move.
     const arflex_joint_ref before = rig.last;
@@ -338,12 +481,12 @@ out:
 
 int main(int argc, char** argv) {
   if (argc != 3) {
-    std::fprintf(stderr, "usage: tcpcorr_comp_test <converge|hold> <tcp-correction exe>\n");
+    std::fprintf(stderr, "usage: tcpcorr_comp_test <converge|hold|invalid> <tcp-correction exe>\n");
     return 2;
   }
   std::snprintf(rid, sizeof(rid), "tcc%d", static_cast<int>(getpid()));
   const std::string name = argv[1];
-  if (name != "converge" && name != "hold") {
+  if (name != "converge" && name != "hold" && name != "invalid") {
     std::fprintf(stderr, "tcpcorr_comp_test: unknown case '%s'\n", argv[1]);
     return 2;
   }

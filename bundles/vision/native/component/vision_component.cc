@@ -15,6 +15,12 @@
 // (full frame for the board calibration, an ROI around the tags predicted from the nominal
 // forward kinematics of the joint state, or around the last pose, otherwise the full frame),
 // estimates the multi-view pose and leaves the result for the next update.
+//
+// Validated data (docs/safety.md): a joint state that fails arflex_joint_state_valid (a
+// non-finite q, qd or tau) is not used for the ROI prediction (the worker searches around the
+// last pose, or the full frame) and is counted (update returns -EINVAL: stats.update_errors)
+// until a valid one comes. Frame headers are checked as before (format, size, stride) plus
+// the type's generated arflex_image_frame_valid; a malformed frame is skipped.
 #include <semaphore.h>
 
 #include <array>
@@ -65,6 +71,7 @@ struct Vision {
   FrameSlot frames[kCameras];
   arflex_joint_state joint_state{};
   bool have_joints = false;
+  bool joints_invalid = false;  // the newest joint state read was rejected (RT thread only)
   double fovy_deg = 50.0, margin = 30.0;
   Eigen::Vector3d tcp{0.30, 0.0, 0.0};
   bool recalibrate = false;
@@ -251,7 +258,7 @@ int Update(arflex_component* c, void*, uint64_t) {
           h.format == ARFLEX_IMAGE_FRAME_FORMAT_RGB8 || h.format == ARFLEX_IMAGE_FRAME_FORMAT_GRAY8;
       const uint64_t bytes = static_cast<uint64_t>(h.stride) * h.height;
       // A malformed frame is ignored (the estimate uses the other cameras).
-      if (format_ok && h.width > 0 && h.height > 0 && h.width <= kMaxWidth && h.height <= kMaxHeight &&
+      if (arflex_image_frame_valid(&h) && format_ok && h.width > 0 && h.height > 0 && h.width <= kMaxWidth && h.height <= kMaxHeight &&
           h.stride >= h.width * bpp && bytes <= kMaxPixels && bytes + ARFLEX_TYPE_IMAGE_FRAME_SIZE <= view.length) {
         f.present = false;  // the pixels of a pending frame are being replaced
         std::memcpy(f.pixels.get(), static_cast<const uint8_t*>(view.data) + ARFLEX_TYPE_IMAGE_FRAME_SIZE,
@@ -268,8 +275,19 @@ int Update(arflex_component* c, void*, uint64_t) {
   if (!any) return 0;
   if (!all && ++g.waiting_cycles < 3) return 0;
   g.waiting_cycles = 0;
-  g.have_joints = arflex_input_state_read(g.joints, &g.joint_state, sizeof(g.joint_state), nullptr) >= 0 &&
-                  g.joint_state.seq != 0;
+  // The joint state for the ROI prediction: the newest valid one; none while the newest value
+  // read is invalid (each invalid value read is counted).
+  int err = 0;
+  arflex_joint_state js;
+  const int got = arflex_input_state_read(g.joints, &js, sizeof(js), nullptr);
+  if (got == 1) {
+    g.joints_invalid = !arflex_joint_state_valid(&js);
+    if (g.joints_invalid)
+      err = -EINVAL;
+    else
+      g.joint_state = js;
+  }
+  g.have_joints = got >= 0 && !g.joints_invalid && g.joint_state.seq != 0;
   g.fovy_deg = ParamF64(c, g.p_fovy, 50.0);
   g.margin = ParamF64(c, g.p_margin, 30.0);
   g.tcp = Eigen::Vector3d(ParamF64(c, g.p_tcp[0], 0.30), ParamF64(c, g.p_tcp[1], 0.0),
@@ -283,7 +301,7 @@ int Update(arflex_component* c, void*, uint64_t) {
   }
   g.busy.store(1, std::memory_order_release);
   sem_post(&g.go);
-  return 0;
+  return err;
 }
 
 void Cleanup(arflex_component*, void*) {

@@ -3,7 +3,7 @@
 // state) it writes itself, with synthetic frames of the board and the tool tags drawn through
 // the cell's camera model, spawns the vision component, binds it and reads tcp_pose.
 //
-//   vision_comp_test <case> <vision exe>      cases: pose, loss
+//   vision_comp_test <case> <vision exe>      cases: pose, loss, invalid
 //
 // Every case ends by checking that no /dev/shm or /dev/mqueue object of its runtime id and no
 // child process is left. Waits are on conditions with deadlines; nothing asserts on timing.
@@ -149,6 +149,7 @@ class Feeder {
     if (created_) arflex_host_destroy(&host_);
   }
   arflex_host* host() { return &host_; }
+  bool bad_joints = false;  // publish a NaN joint state with the frames
 
   // Draws the frames of the scene once (it is static): with and without the tags.
   void Draw() {
@@ -190,6 +191,7 @@ class Feeder {
     js.t_ns = static_cast<int64_t>(arflex_sys_now_ns());
     js.seq = seq;
     for (int i = 0; i < 6; ++i) js.q[i] = kQ[i];
+    if (bad_joints) js.q[3] = std::nan("");
     arflex_state_write(arflex_host_output(&host_, "joint_state"), &js, sizeof(js));
   }
 
@@ -286,6 +288,30 @@ int RunCase(const std::string& name, const char* exe) {
     const Eigen::Quaterniond q(pose.quat[0], pose.quat[1], pose.quat[2], pose.quat[3]);
     CHECK(q.angularDistance(Eigen::Quaterniond(truth.linear())) < 5e-3, "orientation off");
   }
+  if (name == "invalid") {
+    // Validated data (docs/safety.md): a NaN joint state is not used for the ROI prediction
+    // (counted as update errors); the pose stays valid (searched around the last pose); a
+    // valid joint state afterwards is used again (no more errors).
+    arflex_stats st;
+    CHECK(arflex_ctl_stats_read(vis.ctl, &st) == 0, "stats");
+    const uint64_t e0 = st.update_errors;
+    feeder.bad_joints = true;
+    for (int k = 0; k < 3; ++k)
+      CHECK(WaitPose(&feeder, &reader, true, true, &pose), "no valid tcp_pose with a NaN joint state");
+    CHECK(arflex_ctl_stats_read(vis.ctl, &st) == 0 && st.update_errors > e0, "the NaN joint state was not counted");
+    {
+      const Eigen::Vector3d p(pose.p[0], pose.p[1], pose.p[2]);
+      CHECK((p - truth.translation()).norm() < 1.0e-3, "tcp_pose %.3f mm off with a NaN joint state",
+            1e3 * (p - truth.translation()).norm());
+    }
+    feeder.bad_joints = false;
+    CHECK(WaitPose(&feeder, &reader, true, true, &pose), "no valid tcp_pose after a valid joint state");
+    CHECK(arflex_ctl_stats_read(vis.ctl, &st) == 0, "stats");
+    const uint64_t e1 = st.update_errors;
+    for (int k = 0; k < 3; ++k) CHECK(WaitPose(&feeder, &reader, true, true, &pose), "valid pose %d", k);
+    CHECK(arflex_ctl_stats_read(vis.ctl, &st) == 0 && st.update_errors == e1,
+          "errors counted with a valid joint state (%llu)", static_cast<unsigned long long>(st.update_errors - e1));
+  }
   if (name == "loss") {
     // Vision drops out (the tags are covered): the pose turns invalid, it never keeps
     // reporting the stale one as valid; then it recovers.
@@ -310,12 +336,12 @@ out:
 
 int main(int argc, char** argv) {
   if (argc != 3) {
-    std::fprintf(stderr, "usage: vision_comp_test <pose|loss> <vision exe>\n");
+    std::fprintf(stderr, "usage: vision_comp_test <pose|loss|invalid> <vision exe>\n");
     return 2;
   }
   std::snprintf(rid, sizeof(rid), "vct%d", static_cast<int>(getpid()));
   const std::string name = argv[1];
-  if (name != "pose" && name != "loss") {
+  if (name != "pose" && name != "loss" && name != "invalid") {
     std::fprintf(stderr, "vision_comp_test: unknown case '%s'\n", argv[1]);
     return 2;
   }

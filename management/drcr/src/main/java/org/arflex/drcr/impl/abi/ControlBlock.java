@@ -37,6 +37,8 @@ public final class ControlBlock implements AutoCloseable {
     public static final int HOLD_SAFETY_INPUT = 1;
     public static final int HOLD_AWAIT_COMMAND = 2;
     public static final int HOLD_REFERENCE = 3;
+    /** Detail of HOLD_REFERENCE: the newest reference value was rejected (arflex_hold_reference_detail). */
+    public static final int HOLD_REF_INVALID = 1;
     // config (struct arflex_ctl_config at 64)
     public static final int OFF_CONFIG = 64;
     public static final int OFF_CFG_PERIOD = 64;

@@ -19,6 +19,8 @@ final class Holding {
 
     private static final String SAFETY_TYPE = "arflex.SafetyState";
 
+    private static final String REFERENCE_TYPE = "arflex.JointRef";
+
     private Holding() {
     }
 
@@ -32,6 +34,8 @@ final class Holding {
             why = "protective stop: " + safetyInput(cell, i, (hold >> 8) & 0xff, (hold >> 16) & 0xff);
         } else if (cause == ControlBlock.HOLD_AWAIT_COMMAND && !awaitingReset) {
             why = "stopped: waits for a fresh command (" + freshCommand(i) + ") after the reset";
+        } else if (cause == ControlBlock.HOLD_REFERENCE && ((hold >> 8) & 0xff) == ControlBlock.HOLD_REF_INVALID) {
+            why = "holds the last valid reference: " + invalidInput(cell, i, (hold >> 16) & 0xff);
         } else if (cause == ControlBlock.HOLD_REFERENCE) {
             why = "holds: waits for a reference that meets the arm (after a stop: one at rest)";
         }
@@ -51,6 +55,24 @@ final class Holding {
         boolean run = i.contract.properties().stream().anyMatch(p -> p.name().equals("run"));
         boolean command = i.contract.properties().stream().anyMatch(p -> p.name().equals("command"));
         return run ? "set run true, or a program" : command ? "write its command again" : "a new command";
+    }
+
+    /** The reference input whose newest value was rejected (NaN, Inf, out of range), and its provider. */
+    private static String invalidInput(Cell cell, Instance i, int index) {
+        List<PortSpec> ins = i.contract.inputs();
+        String port = index < ins.size() && !SAFETY_TYPE.equals(ins.get(index).type()) ? ins.get(index).name()
+                : typedPort(ins, index, REFERENCE_TYPE);
+        if (port == null) {
+            return "input #" + index + " sends invalid values (NaN, Inf or out of range)";
+        }
+        String provider = null;
+        for (var w : cell.planner().wires()) {
+            if (w.consumer().equals(i.name) && w.inPort().equals(port)) {
+                provider = w.provider();
+            }
+        }
+        return "input '" + port + "' " + (provider == null ? "" : "from " + provider + " ")
+                + "sends invalid values (NaN, Inf or out of range)";
     }
 
     private static String safetyInput(Cell cell, Instance i, int verdict, int index) {
@@ -107,10 +129,15 @@ final class Holding {
      * taken when it is an arflex.SafetyState input, else the contract's only such input.
      */
     static String safetyPort(List<PortSpec> ins, int index) {
-        if (index < ins.size() && SAFETY_TYPE.equals(ins.get(index).type())) {
+        return typedPort(ins, index, SAFETY_TYPE);
+    }
+
+    /** As {@link #safetyPort}, for an input of port type {@code type}. */
+    static String typedPort(List<PortSpec> ins, int index, String type) {
+        if (index < ins.size() && type.equals(ins.get(index).type())) {
             return ins.get(index).name();
         }
-        List<PortSpec> safety = ins.stream().filter(p -> SAFETY_TYPE.equals(p.type())).toList();
-        return safety.size() == 1 ? safety.get(0).name() : null;
+        List<PortSpec> typed = ins.stream().filter(p -> type.equals(p.type())).toList();
+        return typed.size() == 1 ? typed.get(0).name() : null;
     }
 }

@@ -526,6 +526,13 @@ class CellTest {
         h.flags = 0;
         h.hold = ControlBlock.HOLD_AWAIT_COMMAND;
         assertTrue(Snapshots.instance(cell, "arm").orElseThrow().holding.startsWith("stopped: waits for a fresh command"));
+        // validated data: the newest value of input 0 was rejected, the last valid one is held
+        h.hold = ControlBlock.HOLD_REFERENCE | ControlBlock.HOLD_REF_INVALID << 8;
+        String invalid = Snapshots.instance(cell, "arm").orElseThrow().holding;
+        assertTrue(invalid.startsWith("holds the last valid reference: input 'ref' ")
+                && invalid.endsWith("sends invalid values (NaN, Inf or out of range)"), invalid);
+        h.hold = ControlBlock.HOLD_REFERENCE;
+        assertTrue(Snapshots.instance(cell, "arm").orElseThrow().holding.startsWith("holds: waits for a reference"));
         // the supervisor lost (seen by a later runtime's snapshot of an orphan)
         h.flags = ControlBlock.FLAG_SUPERVISOR_LOST | ControlBlock.FLAG_SAFE_ACTIVE;
         assertTrue(Snapshots.instance(cell, "arm").orElseThrow().holding.startsWith("supervisor lost"));
