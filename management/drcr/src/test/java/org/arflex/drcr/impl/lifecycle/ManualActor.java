@@ -37,9 +37,12 @@ public final class ManualActor implements Actor {
         }
     }
 
+    /** May be called from any thread (a stop thread records its outcome this way). */
     @Override
     public void submit(Runnable r) {
-        queue.addLast(r);
+        synchronized (queue) {
+            queue.addLast(r);
+        }
     }
 
     @Override
@@ -65,7 +68,10 @@ public final class ManualActor implements Actor {
         stepping = true;
         try {
             while (true) {
-                Runnable r = queue.pollFirst();
+                Runnable r;
+                synchronized (queue) {
+                    r = queue.pollFirst();
+                }
                 if (r == null) {
                     Timer due = timers.stream().filter(t -> t.due <= now)
                             .min(Comparator.comparingLong((Timer t) -> t.due).thenComparingLong(t -> t.order)).orElse(null);
