@@ -34,11 +34,10 @@ final class FakeLauncher implements RtLauncher {
         boolean started;
         /** Runs while the cell waits for this half's cycles (what happens meanwhile). */
         Runnable duringAwait = () -> { };
-        /**
-         * Runs in shutdown before the half is gone (a test blocks it, as a frozen process blocks
-         * its stop); returning false means it did not answer STOP and was killed.
-         */
-        java.util.function.BooleanSupplier duringShutdown = () -> true;
+        /** Whether it answers STOP/SHUTDOWN; tests make it a frozen process. */
+        boolean answers = true;
+        /** Runs in a shutdown that went unanswered, before the kill ends it (a test blocks it). */
+        Runnable untilKilled = () -> { };
         boolean cleaned;
         /** What flags() reports (control block flags); tests set it. */
         int flags;
@@ -140,9 +139,10 @@ final class FakeLauncher implements RtLauncher {
         @Override
         public String shutdown(long deadlineMs, Runnable unanswered) {
             events.add(inst + " SHUTDOWN");
-            boolean answered = duringShutdown.getAsBoolean();
+            boolean answered = answers;
             if (!answered) {
                 unanswered.run();
+                untilKilled.run();
                 events.add(inst + " SIGKILL");
             }
             running.remove(inst);
