@@ -448,7 +448,10 @@ public final class Cell {
             rebind(instances.get(a.component()), plan.wiringOf(a.component()).stream()
                     .filter(w -> !waiting.contains(w.provider())).toList(), true, a.reason());
         }
-        // Everything the plan leaves inactive shows the planner's reason.
+        // Everything the plan leaves inactive shows the planner's reason (a start that waited is
+        // off when the planner no longer wants it).
+        Set<String> activeNow = planner.active();
+        waiting.removeIf(n -> !activeNow.contains(n));
         for (var e : plan.inactiveAfter().entrySet()) {
             Instance inst = instances.get(e.getKey());
             if (inst != null && inst.half == null && inst.life.state() != State.FAILED
