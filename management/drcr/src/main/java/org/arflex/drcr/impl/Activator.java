@@ -5,6 +5,7 @@ import java.time.LocalTime;
 import java.util.ArrayList;
 import java.util.Hashtable;
 import java.util.List;
+import java.util.concurrent.Executors;
 import java.util.concurrent.ScheduledExecutorService;
 import java.util.concurrent.ScheduledThreadPoolExecutor;
 import java.util.concurrent.TimeUnit;
@@ -61,6 +62,7 @@ public final class Activator implements BundleActivator {
     private static final long SAMPLE_MS = 1_000;
 
     private ThreadActor actor;
+    private java.util.concurrent.ExecutorService stopper;
     private Cell cell;
     private Services services;
     private ScheduledExecutorService ticker;
@@ -120,6 +122,12 @@ public final class Activator implements BundleActivator {
         java.nio.file.Path storage = java.nio.file.Path.of(prop(ctx, Constants.FRAMEWORK_STORAGE, "felix-cache"));
         StoragePermissions.secure(storage, Posix.LIBC::umask, log);
         actor = new ThreadActor(log);
+        // RT halves are stopped, killed and reaped here, never on the actor (issue 17 finding 1)
+        stopper = Executors.newCachedThreadPool(r -> {
+            Thread t = new Thread(r, "arflex-drcr-stop");
+            t.setDaemon(true);
+            return t;
+        });
         VerifiedExecutables executables = new VerifiedExecutables(storage, log);
         Cell.Config cfg = new Cell.Config(rid, Long.parseLong(prop(ctx, "arflex.ready.timeout.ms", "5000")), 3_000,
                 Boolean.parseBoolean(prop(ctx, "arflex.nomlock", "false")), types, Posix::monotonicNs,
@@ -129,7 +137,7 @@ public final class Activator implements BundleActivator {
         cell = actor.call(() -> {
             ResourceManagerImpl tmp = new ResourceManagerImpl(null, cap, reserved);
             Planner planner = new Planner(tmp.capacities(cpus, memory, network));
-            Cell c = new Cell(cfg, actor, new ProcessLauncher(log, executables), planner, log);
+            Cell c = new Cell(cfg, actor, new ProcessLauncher(log, executables), planner, log, stopper);
             rm[0] = new ResourceManagerImpl(c, cap, reserved);
             return c;
         }, 10_000);
@@ -256,6 +264,17 @@ public final class Activator implements BundleActivator {
                 services.unregisterAll();
                 return null;
             }, 120_000);
+            // the halves stop on the stop threads; their outcomes are recorded on the actor
+            try {
+                cell.stopsDone().get(60_000, TimeUnit.MILLISECONDS);
+            } catch (java.util.concurrent.ExecutionException | java.util.concurrent.TimeoutException e) {
+                log.accept("arflex: RT halves not all stopped: " + e + "; the sweep takes what is left");
+            } catch (InterruptedException e) {
+                Thread.currentThread().interrupt();
+            }
+        }
+        if (stopper != null) {
+            stopper.shutdown();
         }
         if (ticker != null) {
             ticker.shutdownNow();

@@ -6,6 +6,10 @@ import java.net.URL;
 import java.nio.file.Path;
 import java.util.ArrayList;
 import java.util.List;
+import java.util.concurrent.CompletableFuture;
+import java.util.concurrent.ExecutionException;
+import java.util.concurrent.TimeUnit;
+import java.util.concurrent.TimeoutException;
 import java.util.function.Consumer;
 import org.arflex.contract.Contract;
 import org.arflex.drcr.impl.runtime.Cell;
@@ -184,16 +188,28 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
         }
         String why = label(bundle) + " stopped";
         List<Contract> cs = t.contracts;
-        cell.actor().call(() -> {
-            cell.uninstall(names, why);
+        CompletableFuture<Void> settled = cell.actor().call(() -> {
+            CompletableFuture<Void> f = cell.uninstall(names, why);
             // the bundle is still installed: its components show as INSTALLED again
             for (Contract c : cs) {
                 if (names.contains(c.name())) {
                     cell.register(c, bundle.getBundleId());
                 }
             }
-            return null;
+            return f;
         }, CALL_MS);
+        // Off the actor: Felix's command returns once the halves stopped in order, or once one
+        // of them did not answer; that one is terminated and reaped on a stop thread, and the
+        // cell records it (issue 17: a frozen half must not hold the shell).
+        if (!cell.actor().inActor()) {
+            try {
+                settled.get(CALL_MS, TimeUnit.MILLISECONDS);
+            } catch (ExecutionException | TimeoutException e) {
+                log.accept("arflex: " + why + ": stops not settled: " + e);
+            } catch (InterruptedException e) {
+                Thread.currentThread().interrupt();
+            }
+        }
         log.accept("arflex: " + why + ": destroyed " + names);
     }
 

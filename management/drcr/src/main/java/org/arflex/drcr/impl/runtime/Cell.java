@@ -4,9 +4,13 @@ import java.io.IOException;
 import java.nio.file.Path;
 import java.util.ArrayList;
 import java.util.LinkedHashMap;
+import java.util.LinkedHashSet;
 import java.util.List;
 import java.util.Map;
 import java.util.Optional;
+import java.util.Set;
+import java.util.concurrent.CompletableFuture;
+import java.util.concurrent.Executor;
 import java.util.concurrent.atomic.AtomicLong;
 import java.util.function.Consumer;
 import java.util.function.LongSupplier;
@@ -78,14 +82,35 @@ public final class Cell {
     private final List<String> problems = new ArrayList<>();
     private final AtomicLong generation = new AtomicLong();
     private volatile Runnable onChange = () -> { };
+    private final Stops stops;
+    /**
+     * Components the planner wants running whose start waits until an earlier RT half of the
+     * same name has exited (or until a provider they bind to has started), in start order.
+     */
+    private final Set<String> waiting = new LinkedHashSet<>();
 
+    /** A cell whose stops run inline, on the caller (tests with a steppable actor). */
     public Cell(Config cfg, Actor actor, RtLauncher launcher, Planner planner, Consumer<String> log) {
+        this(cfg, actor, launcher, planner, log, Runnable::run);
+    }
+
+    /**
+     * @param stopper where RT halves are stopped, killed and reaped: never the actor thread in the
+     *                runtime (a frozen half must not hold crash handling or the shell, issue 17)
+     */
+    public Cell(Config cfg, Actor actor, RtLauncher launcher, Planner planner, Consumer<String> log, Executor stopper) {
         this.cfg = cfg;
         this.actor = actor;
         this.launcher = launcher;
         this.planner = planner;
         this.log = log;
         this.monitor = new HeartbeatMonitor((half, why) -> actor.submit(() -> onHang(half, why)));
+        this.stops = new Stops(actor, stopper, monitor, cfg.shutdownMs(), log, this::stopped);
+    }
+
+    /** Completes when every stop handed to the stop threads so far is recorded (any thread). */
+    public CompletableFuture<Void> stopsDone() {
+        return stops.idle();
     }
 
     /** Called after every change (on the actor thread): service registrations follow it. */
@@ -247,7 +272,8 @@ public final class Cell {
             inst.executable = exe;
             inst.policy = new RestartPolicy(c.fault(), actor.clock());
             if (replace) {
-                closeOutputs(inst);
+                // the new contract's outputs replace the old ones once the old producer is gone
+                inst.outputsStale = true;
             }
         }
         inst.planned = true;
@@ -260,16 +286,21 @@ public final class Cell {
     }
 
     /** Removes a component for good: stops it (and what depends on it), removes its objects. */
-    public void uninstall(String name, String why) {
-        uninstall(List.of(name), why);
+    public CompletableFuture<Void> uninstall(String name, String why) {
+        return uninstall(List.of(name), why);
     }
 
     /**
      * Removes components for good (a bundle's, or all of them) in one plan: what depends on
      * them stops or is rewired once, and their own halves stop side by side (as a plan's stops
-     * do), then their objects are removed.
+     * do), then their objects are removed. The halves stop on a stop thread: an instance whose
+     * half is still on its way out becomes DESTROYED, and its output segments go, when the half
+     * is gone.
+     *
+     * @return completes when the stops settled: every half exited, or one did not answer and is
+     *         being terminated (a caller may wait for it, off the actor)
      */
-    public void uninstall(List<String> names, String why) {
+    public CompletableFuture<Void> uninstall(List<String> names, String why) {
         actor.checkThread();
         List<Instance> going = new ArrayList<>();
         for (String name : names) {
@@ -281,7 +312,7 @@ public final class Cell {
             }
         }
         if (going.isEmpty()) {
-            return;
+            return CompletableFuture.completedFuture(null);
         }
         String[] planned = going.stream().filter(i -> i.planned).map(i -> i.name).toArray(String[]::new);
         if (planned.length > 0) {
@@ -291,24 +322,32 @@ public final class Cell {
                 log.accept("arflex: planner failed on uninstall of " + String.join(", ", planned) + ": " + e);
             }
         }
-        List<Stopping> stopping = new ArrayList<>();
+        List<Stops.Going> rest = new ArrayList<>();
         for (Instance inst : going) {
-            Stopping st = detach(inst);
-            if (st != null) {
-                stopping.add(st);
+            Stops.Going g = detach(inst, why);
+            if (g != null) {
+                rest.add(g);
             }
         }
-        stopping.forEach(this::settle);
-        stopping.forEach(st -> finish(st, why));
+        stops.submit(rest);
         for (Instance inst : going) {
-            closeOutputs(inst);
-            inst.life.to(State.DESTROYED, why);
             instances.remove(inst.name);
+            waiting.remove(inst.name);
+            inst.destroyReason = why;
+            if (!stops.stopping(inst)) {
+                closeOutputs(inst);
+                inst.life.to(State.DESTROYED, why);
+            }
         }
         changed();
+        return stops.settled(going);
     }
 
-    /** Uninstalls everything (DRCR stop): leaves no process and no shared object behind. */
+    /**
+     * Uninstalls everything (DRCR stop). The halves stop on stop threads: wait for
+     * {@link #stopsDone()} (off the actor) before the actor ends, so that no process and no
+     * shared object is left behind.
+     */
     public void shutdownAll(String why) {
         actor.checkThread();
         List<String> names = new ArrayList<>(instances.keySet());
@@ -358,26 +397,37 @@ public final class Cell {
         // detached and its inputs unbound, then each is given its cycles to run its safe
         // behaviour (counted from the unbind, so the waits run side by side), then each is
         // stopped and shut down in the plan's stop order.
-        List<Stopping> stopping = new ArrayList<>();
+        // They run on a stop thread (Stops), so the actor is free for crashes and the shell
+        // while a half that does not answer is terminated.
+        List<Stops.Going> going = new ArrayList<>();
         for (String name : plan.stopOrder()) {
             Instance inst = instances.get(name);
-            Stopping s = inst == null ? null : detach(inst);
-            if (s != null) {
-                stopping.add(s);
+            Stops.Going g = inst == null ? null : detach(inst, plan.inactiveAfter().getOrDefault(name,
+                    plan.action(name).map(Plan.Action::reason).orElse("stopped by plan")));
+            if (g != null) {
+                going.add(g);
             }
         }
-        stopping.forEach(this::settle);
-        for (Stopping s : stopping) {
-            String name = s.inst().name;
-            finish(s, plan.inactiveAfter().getOrDefault(name,
-                    plan.action(name).map(Plan.Action::reason).orElse("stopped by plan")));
+        stops.submit(going);
+        // A component whose previous half is still on its way out starts when it is gone (its
+        // objects have the same names), and so does one bound to such a component.
+        Set<String> later = new LinkedHashSet<>();
+        for (String name : plan.startOrder()) {
+            Instance inst = instances.get(name);
+            if (inst != null && inst.half == null && (stops.pending(name) || waiting.contains(name)
+                    || plan.wiringOf(name).stream().anyMatch(w -> later.contains(w.provider())))) {
+                later.add(name);
+            }
+        }
+        for (String name : later) {
+            waitFor(instances.get(name));
         }
         // Every output segment of every component about to start exists before the first one
         // starts: a member of a start group (a cycle) binds to its partners' outputs at once.
         // A failure here is reported by that component's own start below.
         for (String name : plan.startOrder()) {
             Instance inst = instances.get(name);
-            if (inst != null && inst.half == null) {
+            if (inst != null && inst.half == null && !later.contains(name)) {
                 try {
                     ensureOutputs(inst);
                 } catch (IOException | RuntimeException e) {
@@ -390,18 +440,22 @@ public final class Cell {
             // A start that failed earlier in this loop blocked its component, and the nested
             // plan took its dependents out of the active set: ask the planner again.
             if (inst != null && inst.half == null && inst.life.state() != State.FAILED
-                    && planner.active().contains(name)) {
+                    && planner.active().contains(name) && !later.contains(name)) {
                 startHalf(inst, plan.cpuAssignment().getOrDefault(name, -1), plan.wiringOf(name));
             }
         }
         for (Plan.Action a : plan.rewires()) {
-            rebind(instances.get(a.component()), plan.wiringOf(a.component()), true, a.reason());
+            rebind(instances.get(a.component()), plan.wiringOf(a.component()).stream()
+                    .filter(w -> !waiting.contains(w.provider())).toList(), true, a.reason());
         }
-        // Everything the plan leaves inactive shows the planner's reason.
+        // Everything the plan leaves inactive shows the planner's reason (a start that waited is
+        // off when the planner no longer wants it).
+        Set<String> activeNow = planner.active();
+        waiting.removeIf(n -> !activeNow.contains(n));
         for (var e : plan.inactiveAfter().entrySet()) {
             Instance inst = instances.get(e.getKey());
             if (inst != null && inst.half == null && inst.life.state() != State.FAILED
-                    && inst.life.state() != State.DESTROYED) {
+                    && inst.life.state() != State.DESTROYED && !waiting.contains(inst.name)) {
                 if (inst.restartTimer == null || inst.life.reason() == null) {
                     inst.life.to(State.UNSATISFIED, e.getValue());
                 }
@@ -454,6 +508,10 @@ public final class Cell {
     }
 
     private void ensureOutputs(Instance inst) throws IOException {
+        if (inst.outputsStale && !stops.stopping(inst)) {
+            closeOutputs(inst); // a replaced contract's segments, their producer gone
+            inst.outputsStale = false;
+        }
         for (PortSpec p : inst.contract.outputs()) {
             if (inst.outputs.containsKey(p.name())) {
                 continue;
@@ -560,7 +618,8 @@ public final class Cell {
             half.start();
         } catch (IOException | RuntimeException e) {
             if (half != null) {
-                half.shutdown(cfg.shutdownMs());
+                // stopped and reaped on a stop thread; a restart of the name waits for it
+                stops.submit(List.of(new Stops.Going(inst, half, List.of(), 0, "start failed")));
             }
             inst.bound.clear();
             log.accept("arflex: " + inst.name + ": start failed: " + e.getMessage());
@@ -581,54 +640,112 @@ public final class Cell {
                 + "; spawn to READY " + (tLaunched - t0) / 1000 + " us, bind+start " + (t1 - tLaunched) / 1000 + " us)");
     }
 
-    /** An RT half on its way out: detached from its instance, its inputs unbound. */
-    private record Stopping(Instance inst, RtHalf half, long cycles, boolean hadInputs) {
-    }
-
     /**
-     * First step of a stop: the half is detached (its exit is expected from here and ignored by
-     * onExit, a hang by onHang) and its inputs are unbound. It stays watched, so the runtime
-     * heartbeat goes on while it settles: a slow component (cameras at 500 ms) must not see the
-     * runtime lost and latch safe mode on its way out. Returns null when nothing runs.
+     * First step of a stop, on the actor: the half is detached (its exit is expected from here
+     * and ignored by onExit, a hang by onHang) and the instance is no longer Active. The rest
+     * (UNBIND, the wait for its safe behaviour, STOP, SHUTDOWN, the signals) runs on a stop
+     * thread ({@link Stops}). The half stays watched until then, so the runtime heartbeat goes
+     * on while it settles: a slow component (cameras at 500 ms) must not see the runtime lost
+     * and latch safe mode on its way out. Returns null when nothing runs.
      */
-    private Stopping detach(Instance inst) {
+    private Stops.Going detach(Instance inst, String why) {
         RtHalf half = inst.half;
         if (half == null) {
             return null;
         }
         inst.half = null;
-        for (String port : List.copyOf(inst.bound.keySet())) {
-            try {
-                half.unbind(port);
-            } catch (IOException e) {
-                log.accept("arflex: " + inst.name + ": " + e.getMessage());
-            }
-        }
-        boolean had = !inst.bound.isEmpty();
-        return new Stopping(inst, half, had ? half.cycles() : -1, had);
-    }
-
-    /** Second step: the RT thread sees the lost inputs and runs its safe behaviour before STOP. */
-    private void settle(Stopping s) {
-        if (s.hadInputs()) {
-            long periods = 3 * s.inst().contract.timing().periodNs() / 1_000_000L;
-            if (!s.half().awaitCycles(s.cycles(), 2, Math.max(100, periods))) {
-                log.accept("arflex: " + s.inst().name + ": no RT cycle after UNBIND; stopping anyway");
-            }
-        }
-    }
-
-    /** Last step: STOP, SHUTDOWN, the process gone. */
-    private void finish(Stopping s, String why) {
-        Instance inst = s.inst();
+        List<String> inputs = List.copyOf(inst.bound.keySet());
         inst.bound.clear();
-        monitor.unwatch(s.half());
-        s.half().shutdown(cfg.shutdownMs());
         inst.cpu = -1;
         if (inst.life.state() == State.ACTIVE) {
             inst.life.to(State.UNSATISFIED, why);
         }
-        log.accept("arflex: " + inst.name + " stopped: " + why);
+        long periods = 3 * inst.contract.timing().periodNs() / 1_000_000L;
+        return new Stops.Going(inst, half, inputs, Math.max(100, periods), why);
+    }
+
+    /**
+     * Records a batch of stops (actor thread): the log line with how each half ended, the reason
+     * of an instance whose half had to be killed, the output segments of uninstalled instances
+     * (closed only now that their producer is gone), and the starts that waited for a name.
+     */
+    private void stopped(Stops.Batch b) {
+        for (Stops.Going g : b.halves) {
+            Instance inst = g.inst;
+            log.accept("arflex: " + inst.name + " (pid " + g.half.pid() + ") stopped: " + g.why + " (" + g.outcome + ")");
+            boolean destroyed = inst.life.target() == State.DESTROYED && instances.get(inst.name) != inst;
+            String why = g.forced() ? g.why + "; RT half " + g.outcome : g.why;
+            if (destroyed) {
+                closeOutputs(inst);
+                String base = inst.destroyReason != null ? inst.destroyReason : g.why;
+                inst.life.to(State.DESTROYED, g.forced() ? base + "; RT half " + g.outcome : base);
+            } else if (inst.half == null && g.forced() && g.why.equals(inst.life.reason())) {
+                inst.life.reason(why);
+            }
+        }
+        resume();
+        changed();
+    }
+
+    /** Marks a component as starting once its name is free (actor thread). */
+    private void waitFor(Instance inst) {
+        if (waiting.add(inst.name) && inst.life.state() != State.FAILED) {
+            inst.life.to(State.UNSATISFIED, "starts when its previous RT half has exited");
+            log.accept("arflex: " + inst.name + ": start waits for its previous RT half to exit");
+        }
+    }
+
+    /**
+     * Starts what waited for a name that is free now, with the planner's current CPU and
+     * wiring, providers first; then binds running consumers to providers that started here.
+     */
+    private void resume() {
+        if (waiting.isEmpty()) {
+            return;
+        }
+        Plan now = planner.current();
+        List<String> ready = new ArrayList<>();
+        Set<String> still = new LinkedHashSet<>();
+        for (String name : List.copyOf(waiting)) {
+            Instance inst = instances.get(name);
+            if (inst == null || inst.half != null || inst.life.state() == State.FAILED || !planner.active().contains(name)) {
+                waiting.remove(name);
+                continue;
+            }
+            if (stops.pending(name) || now.wiringOf(name).stream().anyMatch(w -> still.contains(w.provider()))) {
+                still.add(name);
+            } else {
+                ready.add(name);
+            }
+        }
+        if (ready.isEmpty()) {
+            return;
+        }
+        waiting.removeAll(ready);
+        for (String name : ready) {
+            Instance inst = instances.get(name);
+            try {
+                ensureOutputs(inst);
+            } catch (IOException | RuntimeException e) {
+                // startHalf tries again and fails the component with this reason
+            }
+        }
+        for (String name : ready) {
+            Instance inst = instances.get(name);
+            if (inst.half == null && inst.life.state() != State.FAILED && planner.active().contains(name)) {
+                log.accept("arflex: " + name + ": its previous RT half has exited; starting");
+                startHalf(inst, now.cpuAssignment().getOrDefault(name, -1), now.wiringOf(name));
+            }
+        }
+        for (Instance inst : List.copyOf(instances.values())) {
+            if (inst.half == null) {
+                continue;
+            }
+            List<Wire> wires = now.wiringOf(inst.name).stream().filter(w -> !waiting.contains(w.provider())).toList();
+            if (wires.stream().anyMatch(w -> !segmentOf(w.provider(), w.outPort()).equals(inst.bound.get(w.inPort())))) {
+                rebind(inst, wires, true, "its provider started after its previous RT half exited");
+            }
+        }
     }
 
     private void onHang(RtHalf half, String why) {

@@ -57,6 +57,13 @@ public final class Instance {
     boolean transientWcetLogged;
     /** Known to the planner (its bundle is started); false while only INSTALLED. */
     volatile boolean planned;
+    /**
+     * The contract was replaced while its RT half ran: the output segments are recreated once
+     * that half is gone (never while their producer may still write them). Actor thread.
+     */
+    boolean outputsStale;
+    /** Why it was uninstalled: its DESTROYED reason once its RT half is gone. Actor thread. */
+    String destroyReason;
 
     Instance(Contract c, long bundleId, Path exe, Actor actor, java.util.function.Consumer<String> log) {
         this.name = c.name();

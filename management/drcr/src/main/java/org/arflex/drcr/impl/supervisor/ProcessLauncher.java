@@ -34,6 +34,11 @@ public final class ProcessLauncher implements RtLauncher {
 
     /** Mailbox call timeout. */
     static final long CALL_TIMEOUT_MS = 2_000;
+    /**
+     * Deadline of each mailbox command on the way out (UNBIND, STOP, SHUTDOWN): a cooperating
+     * half answers within a cycle or two; one that does not is terminated, not waited for.
+     */
+    public static final long STOP_CALL_TIMEOUT_MS = 250;
     private static final int TAIL_LINES = 8;
     /** How long an RT half that reported FAILED may take to exit by itself before it is killed. */
     private static final long FAILED_EXIT_GRACE_MS = 500;
@@ -283,10 +288,7 @@ public final class ProcessLauncher implements RtLauncher {
 
         @Override
         public void unbind(String port) throws IOException {
-            Mailbox.Reply r = mb.unbind(port, CALL_TIMEOUT_MS);
-            if (r.status() != 0) {
-                throw new IOException("UNBIND " + inst + "." + port + " refused: status " + r.status());
-            }
+            unbind(port, CALL_TIMEOUT_MS);
         }
 
         @Override
@@ -414,33 +416,69 @@ public final class ProcessLauncher implements RtLauncher {
         }
 
         @Override
-        public void shutdown(long deadlineMs) {
+        public void unbind(String port, long timeoutMs) throws IOException {
+            Mailbox.Reply r = mb.unbind(port, timeoutMs);
+            if (r.status() != 0) {
+                throw new IOException("UNBIND " + inst + "." + port + " refused: status " + r.status());
+            }
+        }
+
+        /**
+         * ABI.md 6.1: STOP and SHUTDOWN (each within {@link #STOP_CALL_TIMEOUT_MS}); a half that
+         * answered gets two thirds of the deadline to exit by itself, one that did not is sent
+         * SIGTERM at once (the RT half stops and exits cleanly on it, unless it is frozen); SIGKILL
+         * when the deadline has passed.
+         */
+        @Override
+        public String shutdown(long deadlineMs, Runnable unanswered) {
             stopping = true;
-            if (process.isAlive()) {
-                try {
-                    if (rtState() == ControlBlock.STATE_RUNNING) {
-                        mb.call(Mailbox.Cmd.STOP, Math.min(CALL_TIMEOUT_MS, deadlineMs));
-                    }
-                    mb.call(Mailbox.Cmd.SHUTDOWN, Math.min(CALL_TIMEOUT_MS, deadlineMs));
-                } catch (IOException e) {
-                    // no answer: the deadline below and SIGKILL take over
-                }
-                try {
-                    // ABI.md 6.1: SHUTDOWN, then SIGTERM (the RT half stops and exits cleanly),
-                    // then SIGKILL, each after a deadline.
-                    if (!process.waitFor(deadlineMs, TimeUnit.MILLISECONDS)) {
-                        process.destroy();
-                        if (!process.waitFor(deadlineMs, TimeUnit.MILLISECONDS)) {
-                            process.destroyForcibly();
-                            process.waitFor(deadlineMs, TimeUnit.MILLISECONDS);
+            long t0 = System.nanoTime();
+            String how;
+            try {
+                if (!process.isAlive()) {
+                    how = "had exited";
+                } else {
+                    long callMs = Math.max(1, Math.min(STOP_CALL_TIMEOUT_MS, deadlineMs));
+                    String silent = null;
+                    try {
+                        if (rtState() == ControlBlock.STATE_RUNNING) {
+                            mb.call(Mailbox.Cmd.STOP, callMs);
                         }
+                        mb.call(Mailbox.Cmd.SHUTDOWN, callMs);
+                    } catch (IOException e) {
+                        silent = e.getMessage();
+                        unanswered.run();
                     }
-                } catch (InterruptedException e) {
-                    process.destroyForcibly();
-                    Thread.currentThread().interrupt();
+                    how = reap(t0, deadlineMs, silent);
                 }
+            } catch (InterruptedException e) {
+                process.destroyForcibly();
+                Thread.currentThread().interrupt();
+                how = "killed (interrupted while stopping)";
             }
             cleanup();
+            return how;
+        }
+
+        private String reap(long t0, long deadlineMs, String silent) throws InterruptedException {
+            long deadline = t0 + deadlineMs * 1_000_000L;
+            if (silent == null && process.waitFor(deadlineMs * 2 / 3, TimeUnit.MILLISECONDS)) {
+                return "exited after SHUTDOWN in " + ms(t0) + " ms";
+            }
+            long termAt = ms(t0);
+            process.destroy(); // SIGTERM
+            if (process.waitFor(Math.max(0, deadline - System.nanoTime()), TimeUnit.NANOSECONDS)) {
+                return "exited on SIGTERM after " + ms(t0) + " ms (" + (silent != null ? silent
+                        : "answered SHUTDOWN but had not exited") + ")";
+            }
+            process.destroyForcibly(); // SIGKILL
+            process.waitFor(deadlineMs, TimeUnit.MILLISECONDS);
+            return "killed after " + ms(t0) + " ms (" + (silent != null ? silent : "answered SHUTDOWN but did not exit")
+                    + "; SIGTERM at " + termAt + " ms did not end it" + (process.isAlive() ? "; still not reaped" : "") + ")";
+        }
+
+        private static long ms(long t0) {
+            return (System.nanoTime() - t0) / 1_000_000L;
         }
 
         @Override

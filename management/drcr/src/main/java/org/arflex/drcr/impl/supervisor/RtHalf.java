@@ -23,6 +23,14 @@ public interface RtHalf {
     /** UNBIND input {@code port}. */
     void unbind(String port) throws IOException;
 
+    /**
+     * UNBIND input {@code port}, answered within {@code timeoutMs} (a stop's short deadline: a
+     * half that does not answer is not waited for longer).
+     */
+    default void unbind(String port, long timeoutMs) throws IOException {
+        unbind(port);
+    }
+
     /** Cycles the RT loop has completed so far (from its statistics), or -1 when unknown. */
     long cycles();
 
@@ -90,10 +98,22 @@ public interface RtHalf {
     }
 
     /**
-     * Orderly end: STOP, SHUTDOWN, wait for the exit until {@code deadlineMs}, SIGKILL if it is
-     * still there, then remove the control block and queues. Never throws; idempotent.
+     * Orderly end: STOP and SHUTDOWN, each with a short deadline; then SIGTERM, and SIGKILL once
+     * {@code deadlineMs} have passed since the call; then the control block and queues are
+     * removed. Blocks up to about {@code deadlineMs}: never called on the actor thread. Never
+     * throws; idempotent.
+     *
+     * @param unanswered run (on the calling thread) as soon as STOP or SHUTDOWN went unanswered:
+     *                   the half is not cooperating and is on its way to being killed
+     * @return how it ended, e.g. "exited after SHUTDOWN in 3 ms" or "killed after 3002 ms (no
+     *         answer to STOP within 250 ms; SIGTERM at 251 ms did not end it)"
      */
-    void shutdown(long deadlineMs);
+    String shutdown(long deadlineMs, Runnable unanswered);
+
+    /** {@link #shutdown(long, Runnable)} without a listener. */
+    default String shutdown(long deadlineMs) {
+        return shutdown(deadlineMs, () -> { });
+    }
 
     /** SIGKILL now (hang), without waiting; the exit future completes when it is gone. */
     void kill();

@@ -16,7 +16,9 @@ public final class ManualActor implements Actor {
     private final Deque<Runnable> queue = new ArrayDeque<>();
     private final List<Timer> timers = new ArrayList<>();
     private long now;
-    private boolean stepping;
+    private volatile boolean stepping;
+    /** The thread that steps (the test's); another thread (a stop thread) is never the actor. */
+    private volatile Thread stepper;
     private long seq;
 
     private final class Timer implements Cancellable {
@@ -37,9 +39,12 @@ public final class ManualActor implements Actor {
         }
     }
 
+    /** May be called from any thread (a stop thread records its outcome this way). */
     @Override
     public void submit(Runnable r) {
-        queue.addLast(r);
+        synchronized (queue) {
+            queue.addLast(r);
+        }
     }
 
     @Override
@@ -51,7 +56,7 @@ public final class ManualActor implements Actor {
 
     @Override
     public boolean inActor() {
-        return stepping;
+        return stepping && Thread.currentThread() == stepper;
     }
 
     @Override
@@ -63,9 +68,13 @@ public final class ManualActor implements Actor {
     public int runAll() {
         int n = 0;
         stepping = true;
+        stepper = Thread.currentThread();
         try {
             while (true) {
-                Runnable r = queue.pollFirst();
+                Runnable r;
+                synchronized (queue) {
+                    r = queue.pollFirst();
+                }
                 if (r == null) {
                     Timer due = timers.stream().filter(t -> t.due <= now)
                             .min(Comparator.comparingLong((Timer t) -> t.due).thenComparingLong(t -> t.order)).orElse(null);
@@ -103,6 +112,7 @@ public final class ManualActor implements Actor {
     public void onActor(Runnable r) {
         boolean was = stepping;
         stepping = true;
+        stepper = Thread.currentThread();
         try {
             r.run();
         } finally {
@@ -114,6 +124,7 @@ public final class ManualActor implements Actor {
     public <T> T call(java.util.concurrent.Callable<T> c, long timeoutMs) {
         boolean was = stepping;
         stepping = true;
+        stepper = Thread.currentThread();
         try {
             return c.call();
         } catch (RuntimeException e) {

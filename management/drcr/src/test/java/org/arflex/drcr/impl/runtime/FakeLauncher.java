@@ -13,8 +13,9 @@ import org.arflex.drcr.impl.supervisor.RtLauncher;
 /** An RT launcher without processes: records every command; tests end processes at will. */
 final class FakeLauncher implements RtLauncher {
 
-    final List<String> events = new ArrayList<>();
-    final Map<String, FakeHalf> running = new HashMap<>();
+    /** Thread-safe: stops may run on a stop thread. */
+    final List<String> events = java.util.Collections.synchronizedList(new ArrayList<>());
+    final Map<String, FakeHalf> running = new java.util.concurrent.ConcurrentHashMap<>();
     final List<Spec> specs = new ArrayList<>();
     final Map<String, Integer> openOutputs = new HashMap<>();
     /** Segment name -> what damage() of its output reports (tests set it). */
@@ -33,6 +34,10 @@ final class FakeLauncher implements RtLauncher {
         boolean started;
         /** Runs while the cell waits for this half's cycles (what happens meanwhile). */
         Runnable duringAwait = () -> { };
+        /** Whether it answers STOP/SHUTDOWN; tests make it a frozen process. */
+        boolean answers = true;
+        /** Runs in a shutdown that went unanswered, before the kill ends it (a test blocks it). */
+        Runnable untilKilled = () -> { };
         boolean cleaned;
         /** What flags() reports (control block flags); tests set it. */
         int flags;
@@ -132,11 +137,19 @@ final class FakeLauncher implements RtLauncher {
         }
 
         @Override
-        public void shutdown(long deadlineMs) {
+        public String shutdown(long deadlineMs, Runnable unanswered) {
             events.add(inst + " SHUTDOWN");
+            boolean answered = answers;
+            if (!answered) {
+                unanswered.run();
+                untilKilled.run();
+                events.add(inst + " SIGKILL");
+            }
             running.remove(inst);
-            exit.complete(new Exit(0, false, "exited normally after SHUTDOWN"));
+            exit.complete(answered ? new Exit(0, false, "exited normally after SHUTDOWN")
+                    : new Exit(137, true, "killed by signal 9"));
             cleanup();
+            return answered ? "exited after SHUTDOWN in 0 ms" : "killed after " + deadlineMs + " ms (no answer to STOP)";
         }
 
         @Override
