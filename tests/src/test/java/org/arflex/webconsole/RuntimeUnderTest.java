@@ -104,7 +104,10 @@ final class RuntimeUnderTest implements AutoCloseable {
         props += "\narflex.console.stage.dirs=" + stageDirs + "\n";
         // The tests install cell bundles from the assembly they were copied from and from the
         // build: the code gate (D12) trusts those folders as it trusts the runtime's own.
-        props += "arflex.code.trusted=bundle,cell,tools," + assembled.resolve("cell") + "," + root.resolve("bundles") + "\n";
+        // The jars the browser tests make for themselves (work/jars) are trusted too: they test
+        // the console's defences behind the gate, not the gate.
+        props += "arflex.code.trusted=bundle,cell,tools,console," + assembled.resolve("cell") + "," + root.resolve("bundles")
+                + "," + work.resolve("jars") + "\n";
         Files.writeString(conf, props);
         if (!sysprops.isEmpty()) {
             StringBuilder sp = new StringBuilder();

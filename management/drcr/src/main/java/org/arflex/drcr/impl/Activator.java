@@ -48,7 +48,7 @@ import org.osgi.util.tracker.BundleTracker;
  * {@code arflex.ready.timeout.ms} (default 5000), {@code arflex.nomlock} (true: RT halves skip
  * mlockall, for tests with many instances), {@code arflex.code.trusted} (the folders whose jars
  * may run RT halves without a pinned SHA-256, comma separated; default
- * {@code bundle,cell,tools} of the working directory: docs/DECISIONS.md D12),
+ * {@code bundle,cell,tools,console} of the working directory: docs/DECISIONS.md D12),
  * {@code arflex.code.truststore} (the folder of certificates whose keys may sign component
  * bundles; default {@code trust} of the working directory, {@code none}: no signature is
  * trusted; D14).
@@ -143,10 +143,13 @@ public final class Activator implements BundleActivator {
         }, 10_000);
         ContractReader reader = new ContractReader(types);
         String store = prop(ctx, "arflex.code.truststore", "trust");
-        CodeGate gate = new CodeGate(trustedFolders(prop(ctx, "arflex.code.trusted", "bundle,cell,tools")),
+        CodeGate gate = new CodeGate(trustedFolders(prop(ctx, "arflex.code.trusted", "bundle,cell,tools,console")),
                 store.equals("none") ? null : java.nio.file.Path.of(store).toAbsolutePath().normalize(), log);
         log.accept("arflex: code gate: trusted folders " + gate.trusted() + ", trust store for signed code "
                 + (gate.trustStore() == null ? "none" : gate.trustStore()));
+        // Java code too: a bundle the gate refuses does not resolve, so none of its classes load.
+        regs.add(ctx.registerService(org.osgi.framework.hooks.resolver.ResolverHookFactory.class,
+                new org.arflex.drcr.impl.services.CodeGateHook(gate), null));
         services = new Services(cell, rm[0], reader, ctx, gate, log);
         VerifiedInstaller installer = new VerifiedInstaller(ctx, gate, log);
         cell.onChange(services::sync);

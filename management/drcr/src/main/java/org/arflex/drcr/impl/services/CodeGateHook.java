@@ -1,0 +1,79 @@
+package org.arflex.drcr.impl.services;
+
+import java.util.Collection;
+import java.util.Collections;
+import java.util.Iterator;
+import java.util.Map;
+import java.util.WeakHashMap;
+import org.osgi.framework.Bundle;
+import org.osgi.framework.hooks.resolver.ResolverHook;
+import org.osgi.framework.hooks.resolver.ResolverHookFactory;
+import org.osgi.framework.wiring.BundleCapability;
+import org.osgi.framework.wiring.BundleRequirement;
+import org.osgi.framework.wiring.BundleRevision;
+
+/**
+ * The code gate for Java code (issue 16: "nothing unverified is installed or executed"). The
+ * {@link CodeGate} decides at the extender whether a bundle's RT halves may run; a bundle's
+ * Java code (its activator, its components) would still run once Felix starts it, whatever
+ * door it came through. OSGi cannot veto an install, but a resolver hook can keep a revision
+ * from resolving (Core 60.2): a bundle the gate refuses stays INSTALLED, none of its classes
+ * load, and {@code start} says it cannot be resolved; the gate's log line says why. This covers
+ * installs and updates from every path (shell, console, {@code Bundle-UpdateLocation}).
+ *
+ * <p>Bundles resolved before the DRCR registered this hook (the runtime's own, from its
+ * trusted folders) are judged again only when they are refreshed. The system bundle is never
+ * judged. Each revision is judged once (its content does not change).
+ */
+public final class CodeGateHook implements ResolverHookFactory {
+
+    private final CodeGate gate;
+    private final Map<BundleRevision, String> verdicts = Collections.synchronizedMap(new WeakHashMap<>());
+
+    public CodeGateHook(CodeGate gate) {
+        this.gate = gate;
+    }
+
+    /** Null when the revision may resolve, else why not (judged once per revision). */
+    String refusal(BundleRevision r) {
+        Bundle b = r.getBundle();
+        if (b == null || b.getBundleId() == 0) {
+            return null;
+        }
+        String v = verdicts.computeIfAbsent(r, x -> {
+            String why = gate.refusal(b);
+            return why == null ? "" : why;
+        });
+        return v.isEmpty() ? null : v;
+    }
+
+    @Override
+    public ResolverHook begin(Collection<BundleRevision> triggers) {
+        return new ResolverHook() {
+            @Override
+            public void filterResolvable(Collection<BundleRevision> candidates) {
+                for (Iterator<BundleRevision> it = candidates.iterator(); it.hasNext();) {
+                    if (refusal(it.next()) != null) {
+                        it.remove();
+                    }
+                }
+            }
+
+            @Override
+            public void filterSingletonCollisions(BundleCapability singleton,
+                                                    Collection<BundleCapability> collisionCandidates) {
+                // not the gate's business
+            }
+
+            @Override
+            public void filterMatches(BundleRequirement requirement, Collection<BundleCapability> candidates) {
+                // not the gate's business
+            }
+
+            @Override
+            public void end() {
+                // nothing held
+            }
+        };
+    }
+}
