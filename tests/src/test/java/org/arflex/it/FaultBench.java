@@ -118,6 +118,39 @@ class FaultBench {
         }
     }
 
+    /**
+     * Kills {@code name} each time it is back until it is FAILED; the arm must stop at the first
+     * kill, stay still for 2000 robot cycles at the end, and move again only after the reset and
+     * the fresh command.
+     */
+    private Run crashUntilFailed(Runtime rt, CellRig.Trace<CellRig.JointState> js, String name) throws Exception {
+        long t0 = System.nanoTime();
+        double safe = -1;
+        for (int k = 0; k < 6 && !"FAILED".equals(rt.state(name)); k++) {
+            long pid = rt.pid(name);
+            if (pid == 0) {
+                break;
+            }
+            FailSafeIT.kill9(pid);
+            if (k == 0) {
+                safe = timeToStill(rt, js, t0);
+            }
+            try {
+                rt.waitUntil(name + " back or FAILED", 30_000,
+                        () -> rt.activeWithNewPid(name, pid) || "FAILED".equals(rt.state(name)));
+            } catch (AssertionError e) {
+                break;
+            }
+        }
+        int mark = js.size();
+        rt.waitUntil("2000 robot cycles with " + name + " lost", 30_000, () -> js.size() > mark + 2000);
+        boolean stayed = js.since(mark).stream().allMatch(j -> j.maxSpeed() <= FailSafeIT.STILL);
+        boolean failed = "FAILED".equals(rt.state(name));
+        boolean ok = resetThenCommand(rt, js);
+        return new Run(safe >= 0 && stayed && failed && ok, safe, 0,
+                (failed ? "(" + name + " FAILED" : "(" + name + " not FAILED") + (stayed ? ", arm still)" : ", arm MOVED)"));
+    }
+
     private static double backToActive(Runtime rt, String name, long oldPid, long t0) {
         try {
             rt.waitUntil(name + " back", 30_000, () -> rt.activeWithNewPid(name, oldPid));
@@ -227,59 +260,11 @@ class FaultBench {
                     }
                 }
                 // G: the guard lost for good (killed until FAILED), the arm stays stopped.
-                long t0 = System.nanoTime();
-                double safe = -1;
-                for (int k = 0; k < 6 && !"FAILED".equals(rt.state("force-guard")); k++) {
-                    long pid = rt.pid("force-guard");
-                    if (pid == 0) {
-                        break;
-                    }
-                    FailSafeIT.kill9(pid);
-                    if (k == 0) {
-                        safe = timeToStill(rt, js, t0);
-                    }
-                    try {
-                        rt.waitUntil("force-guard back or FAILED", 30_000,
-                                () -> rt.activeWithNewPid("force-guard", pid) || "FAILED".equals(rt.state("force-guard")));
-                    } catch (AssertionError e) {
-                        break;
-                    }
-                }
-                int mark = js.size();
-                rt.waitUntil("2000 robot cycles with the guard lost", 30_000, () -> js.size() > mark + 2000);
-                boolean stayed = js.since(mark).stream().allMatch(j -> j.maxSpeed() <= FailSafeIT.STILL);
-                boolean failed = "FAILED".equals(rt.state("force-guard"));
-                boolean ok = resetThenCommand(rt, js);
-                record("G-guard-lost", new Run(safe >= 0 && stayed && failed && ok, safe, 0, failed ? "" : "(guard not FAILED)"));
-
+                record("G-guard-lost", crashUntilFailed(rt, js, "force-guard"));
                 // S5: the motion component in a crash loop (killed each time it is back) until FAILED.
                 awaitRestartBudget(rt, "trajectory");
                 rt.waitUntil("the arm moving", 30_000, () -> FailSafeIT.moving(js));
-                long t5 = System.nanoTime();
-                double safe5 = -1;
-                for (int k = 0; k < 6 && !"FAILED".equals(rt.state("trajectory")); k++) {
-                    long pid = rt.pid("trajectory");
-                    if (pid == 0) {
-                        break;
-                    }
-                    FailSafeIT.kill9(pid);
-                    if (k == 0) {
-                        safe5 = timeToStill(rt, js, t5);
-                    }
-                    try {
-                        rt.waitUntil("trajectory back or FAILED", 30_000,
-                                () -> rt.activeWithNewPid("trajectory", pid) || "FAILED".equals(rt.state("trajectory")));
-                    } catch (AssertionError e) {
-                        break;
-                    }
-                }
-                int mark5 = js.size();
-                rt.waitUntil("2000 robot cycles in the crash loop's end", 30_000, () -> js.size() > mark5 + 2000);
-                boolean still5 = js.since(mark5).stream().allMatch(j -> j.maxSpeed() <= FailSafeIT.STILL);
-                boolean failed5 = "FAILED".equals(rt.state("trajectory"));
-                boolean ok5 = resetThenCommand(rt, js);
-                record("S5-crash-loop", new Run(safe5 >= 0 && still5 && failed5 && ok5, safe5, 0,
-                        failed5 ? "(trajectory FAILED, arm still)" : "(trajectory not FAILED)"));
+                record("S5-crash-loop", crashUntilFailed(rt, js, "trajectory"));
                 rec.close();
             }
         }
