@@ -61,6 +61,7 @@ final class CodeDoors implements AutoCloseable {
      */
     CodeDoors(Runtime rt, Path outside) throws IOException {
         this.rt = rt;
+        Runtime.deleteTree(outside); // what an earlier run left
         this.outside = Files.createDirectories(outside);
         Path counter = Path.of(System.getProperty("arflex.it.counter"));
         this.trusted = Files.copy(counter, Files.createDirectories(rt.dir.resolve("tools")).resolve("counter.jar"));
@@ -318,6 +319,11 @@ final class CodeDoors implements AutoCloseable {
         long id = Long.parseLong(m.group(1));
         String started = rt.cmd("start " + id);
         Attempt a = judge(door, id, mark, 0, started.isEmpty() ? "" : started, true);
+        // Java code: the gate keeps the bundle from resolving, so it cannot be ACTIVE (32)
+        String state = rt.cmd("(bundle " + id + ") state").strip();
+        boolean javaRuns = state.equals("32") || state.equals("8") || state.equals("4");
+        a = new Attempt(a.door(), a.succeeded() || javaRuns, a.detail() + "; bundle state " + state
+                + (javaRuns ? " (resolved: its Java code can run)" : " (INSTALLED: not resolved, no code of it runs)"));
         attempts.add(a);
         rt.cmd("uninstall " + id);
         rt.waitUntil(COMPONENT + " gone", CellIT.T, () -> rt.instance(COMPONENT) == null);

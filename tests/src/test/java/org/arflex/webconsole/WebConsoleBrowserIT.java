@@ -87,9 +87,11 @@ class WebConsoleBrowserIT {
         Browser.requireInstalled();
         Path work = Path.of(System.getProperty("arflex.it.work", "target/it")).toAbsolutePath().resolve("webconsole-browser");
         RuntimeUnderTest.deleteTree(work);
-        jars = Files.createDirectories(work.resolve("jars"));
         screenshots = Path.of(System.getProperty("arflex.screenshots", "target/screenshots")).toAbsolutePath();
         rt = new RuntimeUnderTest(work.resolve("runtime"));
+        // the jars this test makes lie where the runtime's code gate trusts them (RuntimeUnderTest):
+        // it tests the console's defences behind the gate
+        jars = Files.createDirectories(rt.work.resolve("jars"));
         rt.awaitUp(Duration.ofSeconds(90));
 
         evil = HttpServer.create(new InetSocketAddress("127.0.0.1", 0), 0);
