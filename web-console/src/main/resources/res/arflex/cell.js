@@ -6,7 +6,24 @@
   const status = el('div', {id: 'arflex-cell-status'});
   const body = el('div', {id: 'arflex-cell'});
   const tcp = el('div', {id: 'arflex-tcp-error'});
-  app.replaceChildren(el('h2', {}, 'Cell'), status, body, tcp);
+  // One cell-level reset (arflex:reset --cell): everything that waits, in dependency order; it
+  // permits motion, it never starts it (motion sources wait for a fresh command).
+  const resetStatus = el('div', {id: 'arflex-reset-cell-status'});
+  const resetButton = el('button', {id: 'arflex-reset-cell', type: 'button',
+    title: 'Reset every component that waits for an operator reset or is FAILED, providers first'}, 'Reset cell');
+  resetButton.addEventListener('click', async () => {
+    resetButton.disabled = true;
+    try {
+      const r = await post('reset-cell', {});
+      message(resetStatus, r.result, /refused/.test(r.result) ? 'error' : 'ok');
+      refresh();
+    } catch (e) {
+      message(resetStatus, 'reset cell: ' + e.message, 'error');
+    } finally {
+      resetButton.disabled = false;
+    }
+  });
+  app.replaceChildren(el('h2', {}, 'Cell'), status, el('p', {}, resetButton), resetStatus, body, tcp);
 
   // Preset plot: the tool-centre error that tcp-correction publishes (output `error`,
   // arflex.Sample, mm), drawn as two series, with and without correction, split by the applied

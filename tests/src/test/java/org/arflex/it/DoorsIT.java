@@ -44,6 +44,24 @@ class DoorsIT {
         }
     }
 
+    /** A refused bundle left INSTALLED keeps no other bundle from resolving and starting. */
+    @Test
+    void aRefusedBundleLeftInstalledBlocksNothingElse() throws Exception {
+        Path outside = Path.of(System.getProperty("arflex.it.work")).resolve("refused-left-attacker");
+        try (Runtime rt = new Runtime("refused-left", null, true, "bundle,cell,tools");
+                CodeDoors doors = new CodeDoors(rt, outside)) {
+            String out = rt.cmd("install " + outside.resolve("evil.jar").toUri());
+            long evil = Long.parseLong(out.replaceAll("(?s).*Bundle ID: (\\d+).*", "$1"));
+            rt.cmd("start " + evil);
+            Path scaler = java.nio.file.Files.copy(Path.of(System.getProperty("arflex.it.scaler")),
+                    rt.dir.resolve("tools/scaler.jar"));
+            long ok = rt.installAndStart(scaler);
+            assertEquals("32", rt.cmd("(bundle " + ok + ") state").strip(), "a trusted bundle still starts");
+            assertEquals("2", rt.cmd("(bundle " + evil + ") state").strip(), "the refused one stays INSTALLED");
+            rt.cmd("uninstall " + evil);
+        }
+    }
+
     /**
      * Finding 6: forged requests (SHUTDOWN made force-guard exit, STOP made it look hung, three
      * made it FAILED) are counted and ignored; a flooded queue does not lose the DRCR's own

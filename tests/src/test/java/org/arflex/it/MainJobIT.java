@@ -125,9 +125,13 @@ class MainJobIT {
             c.disconnect();
             return s;
         } catch (IOException e) {
+            lastError = e.toString();
             return -1;
         }
     }
+
+    /** The last I/O error of {@link #status}, for failure messages. */
+    static volatile String lastError = "";
 
     static void await(String what, long timeoutMs, BooleanSupplier cond, List<String> output) {
         long deadline = System.nanoTime() + timeoutMs * 1_000_000L;
@@ -183,7 +187,15 @@ class MainJobIT {
             rid = rm.group(1);
 
             URI cell = URI.create("http://127.0.0.1:" + port + "/system/console/arflex-cell");
-            await("the console's cell page with the generated login", T, () -> status(cell, login) == 200, out);
+            int[] last = {0};
+            try {
+                await("the console's cell page with the generated login", T, () -> (last[0] = status(cell, login)) == 200, out);
+            } catch (AssertionError e) {
+                Path dump = Path.of(System.getProperty("arflex.it.work")).resolve("mainjob-output.txt");
+                Files.write(dump, out);
+                throw new AssertionError("last status " + last[0] + " (" + lastError + "), whole output in " + dump + "; "
+                        + e.getMessage(), e);
+            }
             assertEquals(401, status(cell, null), "without credentials");
             assertEquals(401, status(cell, "admin:admin"), "the Web Console's default login");
             assertEquals(401, status(cell, m.group(1) + ":" + m.group(2) + "x"), "a wrong password");

@@ -844,6 +844,19 @@ class WebConsoleIT {
         shot("24-component-reset");
         assertEquals(restartedPid, pid("sample-counter"), "the reset does not restart the process");
         assertEquals("ACTIVE", instanceState("sample-counter"));
+
+        // The same from the cell page's one button: everything that waits, and what it did.
+        ProcessHandle.of(restartedPid).ifPresent(ProcessHandle::destroyForcibly);
+        RuntimeUnderTest.awaitCondition("sample-counter restarted again, awaiting a reset", WAIT, () -> {
+            long now = pid("sample-counter");
+            return now > 0 && now != restartedPid && Boolean.TRUE.equals(awaitingReset("sample-counter"));
+        });
+        open("arflex-cell");
+        await(By.id("arflex-reset-cell")).click();
+        awaitElementText(By.id("arflex-reset-cell-status"), "cell: reset sample-counter");
+        RuntimeUnderTest.awaitCondition("the DRCR to clear awaitingReset after the cell reset", WAIT,
+                () -> Boolean.FALSE.equals(awaitingReset("sample-counter")));
+        shot("25-cell-reset");
     }
 
     private static String sha256(Path p) throws IOException {

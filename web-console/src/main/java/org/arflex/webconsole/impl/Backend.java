@@ -19,6 +19,7 @@ import java.util.regex.Pattern;
 import java.util.stream.Stream;
 import org.arflex.contract.ContractParser;
 import org.arflex.contract.Problem;
+import org.arflex.drcr.CellReset;
 import org.arflex.drcr.ComponentManagement;
 import org.arflex.drcr.DrcrService;
 import org.arflex.drcr.ResourceManager;
@@ -382,6 +383,12 @@ public class Backend {
         } catch (IllegalStateException e) {
             throw new HttpError(409, e.getMessage());
         }
+    }
+
+    /** The cell-level reset (arflex:reset --cell): everything that waits, providers first; what it did. */
+    String resetCell() throws HttpError {
+        return CellReset.run(drcr(), n -> management(n).orElseThrow(() -> new IllegalStateException(
+                "no management service")).reset());
     }
 
     /** start, stop (the component's bundle) or reset (operator reset of the instance). */

@@ -160,6 +160,7 @@ abstract class PluginBase extends AbstractServlet {
         return switch (what) {
             case "param" -> b.setParam(name, req.getParameter("param"), req.getParameter("value"));
             case "command" -> b.command(name, req.getParameter("cmd"));
+            case "reset-cell" -> Map.of("result", b.resetCell());
             case "stage-url" -> b.stageUrl(req.getParameter("url"), req.getParameter("sha256"));
             case "stage-upload" -> {
                 try (InputStream in = req.getInputStream()) {

@@ -40,12 +40,38 @@ public final class CodeGateHook implements ResolverHookFactory {
         if (b == null || b.getBundleId() == 0) {
             return null;
         }
-        String v = verdicts.computeIfAbsent(r, x -> {
-            String why = gate.refusal(b);
-            return why == null ? "" : why;
-        });
+        String v = verdicts.get(r);
+        if (v == null) {
+            v = judge(b);
+            if (!v.contains(UNREADABLE)) {
+                verdicts.put(r, v);
+            }
+        }
         return v.isEmpty() ? null : v;
     }
+
+    /**
+     * The gate's verdict ("" when admitted). A bundle whose install is still under way when a
+     * resolve started by another thread includes it cannot be read yet ("No bundle associated
+     * with resource"): it is asked again for up to {@link #SETTLE_MS}, and if it still cannot be
+     * read it is refused for this resolve only (fail closed; the next resolve asks again).
+     */
+    private String judge(Bundle b) {
+        long deadline = System.nanoTime() + SETTLE_MS * 1_000_000L;
+        while (true) {
+            String why = gate.refusal(b);
+            String v = why == null ? "" : why;
+            if (!v.contains(UNREADABLE) || System.nanoTime() - deadline > 0) {
+                return v;
+            }
+            java.util.concurrent.locks.LockSupport.parkNanos(20_000_000L); // the install completes meanwhile
+        }
+    }
+
+    /** How CodeGate names content it could not read. */
+    private static final String UNREADABLE = "(unreadable:";
+    /** How long a bundle that is still being installed is given to become readable. */
+    static final long SETTLE_MS = 2_000;
 
     @Override
     public ResolverHook begin(Collection<BundleRevision> triggers) {

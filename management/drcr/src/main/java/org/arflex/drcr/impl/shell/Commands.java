@@ -5,6 +5,7 @@ import java.util.Arrays;
 import java.util.List;
 import java.util.Optional;
 import java.util.function.Function;
+import org.arflex.drcr.CellReset;
 import org.arflex.drcr.ComponentManagement;
 import org.arflex.drcr.DrcrService;
 import org.arflex.drcr.ResourceManager;

@@ -6,6 +6,7 @@ import static org.junit.jupiter.api.Assertions.assertTrue;
 import java.lang.reflect.Proxy;
 import java.util.ArrayList;
 import java.util.List;
+import org.arflex.drcr.CellReset;
 import org.arflex.drcr.DrcrService;
 import org.arflex.drcr.dto.CellDTO;
 import org.arflex.drcr.dto.InstanceDTO;

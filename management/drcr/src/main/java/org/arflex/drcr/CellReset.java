@@ -1,11 +1,10 @@
-package org.arflex.drcr.impl.shell;
+package org.arflex.drcr;
 
 import java.util.ArrayList;
 import java.util.LinkedHashMap;
 import java.util.List;
 import java.util.Map;
 import java.util.function.Consumer;
-import org.arflex.drcr.DrcrService;
 import org.arflex.drcr.dto.InstanceDTO;
 
 /**
@@ -14,14 +13,21 @@ import org.arflex.drcr.dto.InstanceDTO;
  * is found by trying: a reset refused because its cause persists (a safety provider that is
  * itself still stopped) is tried again after the others, as long as a round resets something, so
  * providers are reset before their consumers, cycles included (the guard reads the robot's wrench
- * and the robot the guard's state). A reset never starts motion (SAFETY.md 2).
+ * and the robot the guard's state). A reset never starts motion (SAFETY.md 2). Since 0.4.0, for
+ * every client that resets the cell (the shell's {@code arflex:reset --cell}, the console's cell
+ * page).
  */
-final class CellReset {
+public final class CellReset {
 
     private CellReset() {
     }
 
-    static String run(DrcrService drcr, Consumer<String> reset) {
+    /**
+     * @param reset resets one instance by name (its ComponentManagement); a refusal is a
+     *              RuntimeException whose message says why
+     * @return what was reset and what was refused, one line each
+     */
+    public static String run(DrcrService drcr, Consumer<String> reset) {
         List<String> waiting = new ArrayList<>();
         for (InstanceDTO i : drcr.cell().instances) {
             if (i.awaitingReset || i.safeMode || "FAILED".equals(i.state)) {
@@ -53,7 +59,7 @@ final class CellReset {
             sb.append("\n  refused ").append(e.getKey()).append(": ").append(e.getValue());
         }
         if (!done.isEmpty()) {
-            sb.append("\n  motion sources wait for a fresh command (arflex:set <source> run true)");
+            sb.append("\n  motion sources wait for a fresh command (a program or run true; a tool: its command)");
         }
         return sb.toString();
     }
