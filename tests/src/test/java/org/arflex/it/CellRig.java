@@ -148,6 +148,13 @@ final class CellRig {
         int total;
         private final Runtime rt;
         private long last;
+        /** The operator paused the program for the arm to take up its reference. */
+        private boolean paused;
+
+        private String param(String n, String p) {
+            String v = rt.cmd("arflex:get " + n + " " + p).strip();
+            return v.substring(v.lastIndexOf(' ') + 1);
+        }
 
         Operator(Runtime rt) {
             this.rt = rt;
@@ -163,12 +170,35 @@ final class CellRig {
         /** Resets what waits for a reset, now. */
         void tickNow() {
             last = System.nanoTime();
-            for (String n : awaitingReset(rt)) {
+            List<String> reset = awaitingReset(rt);
+            for (String n : reset) {
                 rt.cmd("arflex:reset " + n);
                 resets.merge(n, 1, Integer::sum);
                 total++;
             }
-            // a reset permits motion, it does not start it: the operator's fresh command
+            if (!reset.isEmpty()) {
+                return; // the fresh command at the next tick, once the arm has taken up its reference
+            }
+            // a reset permits motion, it does not start it: the operator's fresh command, once the
+            // arm has taken up its reference again (after a stop the robot takes one at rest only:
+            // a program started before that moves its reference away and the arm keeps holding)
+            Map<String, Object> dto = rt.dto();
+            if (!Runtime.names(dto, i -> String.valueOf(i.get("holding")).startsWith("holds: waits for a reference"))
+                    .isEmpty()) {
+                // a program that kept running while the robot stopped (a reset latched by a
+                // heartbeat lost at start-up) moves its reference on: pause it so that the
+                // reference comes to rest, the arm takes it up, then go on
+                if (!Runtime.names(dto, i -> "trajectory".equals(i.get("name")) && i.get("holding") == null
+                        && "ACTIVE".equals(i.get("state"))).isEmpty() && "true".equals(param("trajectory", "run"))) {
+                    rt.cmd("arflex:set trajectory run false");
+                    paused = true;
+                }
+                return; // the next tick
+            }
+            if (paused) {
+                paused = false;
+                rt.cmd("arflex:set trajectory run true");
+            }
             for (String n : awaitingCommand(rt)) {
                 if (n.startsWith("tool-")) {
                     // a tool's fresh command is a write of its command (the level it had)
