@@ -226,6 +226,9 @@ commands() {
 NICE=()
 if nice -n -10 true 2>/dev/null && [ "$(nice -n -10 nice)" = "-10" ]; then NICE=(nice -n -10); fi
 # arflex.home: where the console keeps its audit log (console-audit.log, mode 0600).
-commands | "${NICE[@]}" java "${SYSPROPS[@]}" -Dfelix.config.properties="file:$CONF" \
+# G1's default pause goal is 200 ms, twice the 100 ms runtime heartbeat timeout of the 1 kHz
+# components: a collection during the cell's start-up put sim-robot into safe mode now and then.
+JVM_OPTS=(-XX:+UseG1GC -XX:MaxGCPauseMillis=20)
+commands | "${NICE[@]}" java "${JVM_OPTS[@]}" "${SYSPROPS[@]}" -Dfelix.config.properties="file:$CONF" \
   -Dfelix.system.properties="file:$CREDS" -Darflex.console.bundles="$console_bundles" \
   -Darflex.home="$ARFLEX_HOME" -Darflex.evaluation="${ARFLEX_EVALUATION:-true}" -jar bin/felix.jar 2>&1 | tee "$LOG"

@@ -110,7 +110,7 @@ final class Runtime implements AutoCloseable {
             command.addAll(List.of("sh", "-c", "umask " + umask + " && exec \"$@\"", "sh"));
         }
         command.addAll(List.of(Path.of(System.getProperty("java.home"), "bin", "java").toString(),
-                "-Darflex.runtime.id=" + rid, "-Darflex.nomlock=" + !mlock, "-Dorg.osgi.service.http.port=0",
+                "-XX:+UseG1GC", "-XX:MaxGCPauseMillis=20", "-Darflex.runtime.id=" + rid, "-Darflex.nomlock=" + !mlock, "-Dorg.osgi.service.http.port=0",
                 "-Darflex.code.trusted=" + trusted, "-jar", "bin/felix.jar"));
         ProcessBuilder pb = new ProcessBuilder(command).directory(dir.toFile());
         process = pb.start();
