@@ -148,8 +148,8 @@ public final class Activator implements BundleActivator {
         log.accept("arflex: code gate: trusted folders " + gate.trusted() + ", trust store for signed code "
                 + (gate.trustStore() == null ? "none" : gate.trustStore()));
         // Java code too: a bundle the gate refuses does not resolve, so none of its classes load.
-        regs.add(ctx.registerService(org.osgi.framework.hooks.resolver.ResolverHookFactory.class,
-                new org.arflex.drcr.impl.services.CodeGateHook(gate), null));
+        org.arflex.drcr.impl.services.CodeGateHook gateHook = new org.arflex.drcr.impl.services.CodeGateHook(gate);
+        regs.add(ctx.registerService(org.osgi.framework.hooks.resolver.ResolverHookFactory.class, gateHook, null));
         services = new Services(cell, rm[0], reader, ctx, gate, log);
         VerifiedInstaller installer = new VerifiedInstaller(ctx, gate, log);
         cell.onChange(services::sync);
@@ -203,7 +203,7 @@ public final class Activator implements BundleActivator {
         ticker.scheduleAtFixedRate(() -> actor.submit(() -> rm[0].overruns(cell.sample())), SAMPLE_MS, SAMPLE_MS,
                 TimeUnit.MILLISECONDS);
         tracker = new BundleTracker<>(ctx, ContractExtender.MASK, new ContractExtender(cell, reader, ctx,
-                (dir, name, source) -> executables.extract(dir, name, source::open), gate::refusal, log));
+                (dir, name, source) -> executables.extract(dir, name, source::open), gateHook::refusal, log));
         tracker.open();
         log.accept("arflex: DRCR started, runtime id " + rid + ", cpus " + cpus + ", memory " + memory + ", network "
                 + network);

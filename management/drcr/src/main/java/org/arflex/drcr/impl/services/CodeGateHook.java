@@ -34,6 +34,15 @@ public final class CodeGateHook implements ResolverHookFactory {
         this.gate = gate;
     }
 
+    /**
+     * The gate's verdict on a bundle's current revision, judged once: the extender asks this
+     * after the resolve asked it, so a bundle's content is hashed once, not twice.
+     */
+    public String refusal(Bundle b) {
+        BundleRevision r = b.adapt(BundleRevision.class);
+        return r == null ? gate.refusal(b) : refusal(r);
+    }
+
     /** Null when the revision may resolve, else why not (judged once per revision). */
     String refusal(BundleRevision r) {
         Bundle b = r.getBundle();

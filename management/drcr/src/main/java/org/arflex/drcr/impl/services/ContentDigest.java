@@ -100,8 +100,19 @@ final class ContentDigest {
             md.update(e.getKey().getBytes(StandardCharsets.UTF_8));
             md.update((byte) 0);
             md.update(ByteBuffer.allocate(8).putLong(e.getValue().length).array());
-            md.update(e.getValue());
+            update(md, e.getValue());
         }
         return HexFormat.of().formatHex(md.digest());
+    }
+
+    /**
+     * Hashes in 64 KiB pieces: one call over megabytes is a loop without a safepoint poll, and
+     * on a busy machine every other JVM thread (the runtime heartbeat's included) then waits at
+     * the next safepoint for as long as that thread is kept off the CPU.
+     */
+    static void update(java.security.MessageDigest md, byte[] data) {
+        for (int off = 0; off < data.length; off += 64 << 10) {
+            md.update(data, off, Math.min(64 << 10, data.length - off));
+        }
     }
 }
