@@ -44,9 +44,12 @@ final class Squatters {
                 throw e;
             }
         }
+        List<String> kept = new java.util.ArrayList<>();
         for (String n : shm) {
             String who = owner(Path.of("/dev/shm", n.substring(1)));
-            if (who != null && ShmSegment.unlinkQuietly(n)) {
+            if (who != null && !ShmSegment.unlinkQuietly(n)) {
+                kept.add(n + " (" + who + ")");
+            } else if (who != null) {
                 log.accept("arflex: " + inst + ": shared memory " + n + " existed before this runtime created it ("
                         + who + "): removed, never adopted");
             }
@@ -57,6 +60,10 @@ final class Squatters {
                 log.accept("arflex: " + inst + ": message queue " + n + " existed before this runtime created it ("
                         + (who != null ? who : "owner unknown: /dev/mqueue not mounted") + "): removed, never adopted");
             }
+        }
+        if (!kept.isEmpty()) {
+            throw new IOException(inst + ": " + kept + " existed before this runtime created it and cannot be removed by "
+                    + "it (not its own): never adopted; remove it as its owner or root");
         }
         try {
             return create.create();
