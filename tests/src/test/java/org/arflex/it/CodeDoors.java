@@ -344,7 +344,8 @@ final class CodeDoors implements AutoCloseable {
         long pid = rt.pid(COMPONENT);
         int mark = rt.logMark();
         String out = rt.cmd(command.of(id));
-        attempts.add(judge(door, id, mark, pid, out, out.isEmpty()));
+        // the transport took the jar when Felix says nothing, or that the gate's hook kept it from resolving
+        attempts.add(judge(door, id, mark, pid, out, out.isEmpty() || out.contains("Resolver hook prevented resolution")));
         rt.cmd("uninstall " + id);
         rt.waitUntil(COMPONENT + " gone", CellIT.T, () -> rt.instance(COMPONENT) == null);
     }
