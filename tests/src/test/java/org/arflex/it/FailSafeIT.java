@@ -36,8 +36,7 @@ class FailSafeIT {
             + "ptp 0.3 0.5 0.3 0 0.8 0 speed 0.1\nptp -0.3 0.5 0.3 0 0.8 0 speed 0.1\n";
 
     static void kill9(long pid) throws Exception {
-        Process p = new ProcessBuilder("kill", "-9", Long.toString(pid)).inheritIO().start();
-        assertEquals(0, p.waitFor());
+        Signals.send(pid, "9");
     }
 
     /** A moving arm: robot, guard, correction stage and the trajectory looping program 1. */

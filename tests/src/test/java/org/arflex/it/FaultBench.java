@@ -172,10 +172,6 @@ class FaultBench {
         });
     }
 
-    private static void signal(long pid, String sig) throws Exception {
-        new ProcessBuilder("kill", "-" + sig, Long.toString(pid)).inheritIO().start().waitFor();
-    }
-
     @Test
     void faults() throws Exception {
         int rounds = Integer.getInteger("arflex.bench.rounds", 3);
@@ -236,10 +232,10 @@ class FaultBench {
                         }
                         case "S3-guard" -> {
                             long pid = rt.pid("force-guard");
-                            signal(pid, "STOP");
+                            Signals.tryToSend(pid, "STOP");
                             double safe = timeToStill(rt, js, t0);
                             double back = backToActive(rt, "force-guard", pid, t0);
-                            signal(pid, "CONT"); // if the DRCR did not kill it, it goes on
+                            Signals.tryToSend(pid, "CONT"); // if the DRCR did not kill it, it goes on
                             boolean ok = resetThenCommand(rt, js);
                             record(s, new Run(safe >= 0 && back >= 0 && ok, safe, back, "(hang detection restarts it)"));
                         }

@@ -22,11 +22,6 @@ import org.junit.jupiter.api.Test;
  */
 class FrozenStopIT {
 
-    private static void signal(long pid, String sig) throws Exception {
-        Process p = new ProcessBuilder("kill", "-" + sig, Long.toString(pid)).inheritIO().start();
-        assertEquals(0, p.waitFor());
-    }
-
     /** Waits (deadline) until a log line after {@code mark} contains every text; returns when it was seen (nanoTime). */
     private static long awaitLog(Runtime rt, int mark, long timeoutMs, String... texts) {
         long deadline = System.nanoTime() + timeoutMs * 1_000_000L;
@@ -57,7 +52,7 @@ class FrozenStopIT {
             rt.awaitState("ACTIVE", CellIT.T, "sample-counter", "sample-scaler");
             long scalerPid = rt.pid("sample-scaler");
             long counterPid = rt.pid("sample-counter");
-            signal(scalerPid, "STOP"); // alive, holds its mailbox unanswered
+            Signals.send(scalerPid, "STOP"); // alive, holds its mailbox unanswered
             int mark = rt.logMark();
             AtomicLong killedAt = new AtomicLong();
             long t0 = System.nanoTime();

@@ -86,6 +86,16 @@ final class Runtime implements AutoCloseable {
     /** @param umask the file mode creation mask to start the JVM with (octal), null: this JVM's */
     Runtime(String name, String fixedRid, boolean waitForDrcr, String trusted, String umask)
             throws IOException, InterruptedException {
+        this(name, fixedRid, waitForDrcr, trusted, umask, List.of());
+    }
+
+    /** A runtime whose framework gets these properties too ("key=value", e.g. a heartbeat grace). */
+    static Runtime withProperties(String name, String... properties) throws IOException, InterruptedException {
+        return new Runtime(name, null, true, trustedFolders(), null, List.of(properties));
+    }
+
+    private Runtime(String name, String fixedRid, boolean waitForDrcr, String trusted, String umask, List<String> properties)
+            throws IOException, InterruptedException {
         Path assembly = Path.of(System.getProperty("arflex.it.runtime"));
         if (!Files.isRegularFile(assembly.resolve("bin/felix.jar"))) {
             fail("runtime assembly not found at " + assembly + " (build management/runtime first)");
@@ -111,7 +121,9 @@ final class Runtime implements AutoCloseable {
         }
         command.addAll(List.of(Path.of(System.getProperty("java.home"), "bin", "java").toString(),
                 "-XX:+UseG1GC", "-XX:MaxGCPauseMillis=20", "-Darflex.runtime.id=" + rid, "-Darflex.nomlock=" + !mlock, "-Dorg.osgi.service.http.port=0",
-                "-Darflex.code.trusted=" + trusted, "-jar", "bin/felix.jar"));
+                "-Darflex.code.trusted=" + trusted));
+        properties.forEach(p -> command.add("-D" + p));
+        command.addAll(List.of("-jar", "bin/felix.jar"));
         ProcessBuilder pb = new ProcessBuilder(command).directory(dir.toFile());
         process = pb.start();
         stdin = new OutputStreamWriter(process.getOutputStream(), StandardCharsets.UTF_8);

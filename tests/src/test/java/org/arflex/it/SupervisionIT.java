@@ -11,18 +11,13 @@ import org.junit.jupiter.api.Test;
 /** Hangs, runtime crashes, dry runs, Felix's own update. */
 class SupervisionIT {
 
-    private static void signal(long pid, String sig) throws Exception {
-        Process p = new ProcessBuilder("kill", "-" + sig, Long.toString(pid)).inheritIO().start();
-        assertEquals(0, p.waitFor());
-    }
-
     @Test
     void aHungRtHalfIsDetectedByItsHeartbeatAndRestarted() throws Exception {
         try (Runtime rt = new Runtime("hang")) {
             rt.installAndStart(CellIT.COUNTER);
             rt.awaitState("ACTIVE", CellIT.T, "sample-counter");
             long pid = rt.pid("sample-counter");
-            signal(pid, "STOP"); // alive but silent: only the heartbeat can tell
+            Signals.send(pid, "STOP"); // alive but silent: only the heartbeat can tell
             rt.waitUntil("sample-counter restarted after the hang", CellIT.T,
                     () -> rt.activeWithNewPid("sample-counter", pid));
             assertTrue(rt.logContains("hung: no RT heartbeat"), rt.tail());
@@ -43,7 +38,7 @@ class SupervisionIT {
             // Orphans leave by themselves after their orphan hold (D10); the sweep is for those
             // that cannot: hung ones, stopped here before their hold ends.
             for (String o : orphans) {
-                signal(Long.parseLong(o.substring(0, o.indexOf(':'))), "STOP");
+                Signals.send(Long.parseLong(o.substring(0, o.indexOf(':'))), "STOP");
             }
             assertFalse(first.shmObjects().isEmpty(), "a crashed runtime leaves its objects");
         }

@@ -25,6 +25,7 @@ import org.arflex.drcr.impl.services.CodeGate;
 import org.arflex.drcr.impl.services.Services;
 import org.arflex.drcr.impl.services.VerifiedInstaller;
 import org.arflex.drcr.impl.shell.Commands;
+import org.arflex.drcr.impl.supervisor.HeartbeatBridge;
 import org.arflex.drcr.impl.supervisor.ProcessLauncher;
 import org.arflex.drcr.impl.supervisor.VerifiedExecutables;
 import org.arflex.planner.Planner;
@@ -66,6 +67,7 @@ public final class Activator implements BundleActivator {
     private Cell cell;
     private Services services;
     private ScheduledExecutorService ticker;
+    private HeartbeatBridge bridge;
     private BundleTracker<ContractExtender.Tracked> tracker;
     private final List<ServiceRegistration<?>> regs = new ArrayList<>();
     private String rid;
@@ -179,6 +181,14 @@ public final class Activator implements BundleActivator {
         if (hbPriority < 0 || hbPriority > 98) {
             throw new IllegalArgumentException("arflex.heartbeat.priority " + hbPriority + " is not in 0..98 (0: no SCHED_FIFO)");
         }
+        long graceMs = Long.parseLong(prop(ctx, "arflex.heartbeat.grace.ms", "1000"));
+        if (graceMs < HEARTBEAT_MS || graceMs > 60_000) {
+            throw new IllegalArgumentException("arflex.heartbeat.grace.ms " + graceMs + " is not in " + HEARTBEAT_MS + "..60000");
+        }
+        // D17: a native thread writes the heartbeat while this JVM's round is at most graceMs late
+        bridge = HeartbeatBridge.open(ctx.getBundle()::getEntry, executables, java.util.Objects.requireNonNull(ctx.getDataFile("native"),
+                "the framework has no data area for bundles").toPath(),
+                Boolean.parseBoolean(prop(ctx, "arflex.heartbeat.native", "true")), HEARTBEAT_MS, graceMs, hbPriority, log);
         ticker = new ScheduledThreadPoolExecutor(1, r -> {
             Thread t = new Thread(() -> {
                 if (hbPriority > 0) {
@@ -195,6 +205,7 @@ public final class Activator implements BundleActivator {
         });
         ticker.scheduleAtFixedRate(() -> {
             try {
+                bridge.round();
                 cell.monitor().check(Posix.monotonicNs());
             } catch (RuntimeException e) {
                 log.accept("arflex: heartbeat round failed: " + e);
@@ -281,6 +292,9 @@ public final class Activator implements BundleActivator {
         }
         if (ticker != null) {
             ticker.shutdownNow();
+        }
+        if (bridge != null) {
+            bridge.close();
         }
         if (actor != null) {
             actor.shutdown(10_000);

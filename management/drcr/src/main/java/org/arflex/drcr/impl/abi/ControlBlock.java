@@ -255,6 +255,8 @@ public final class ControlBlock implements AutoCloseable {
             // ABI.md 6.1: magic last (release), then the runtime heartbeat.
             s.setLongRelease(OFF_MAGIC, MAGIC);
             s.setLongRelease(OFF_RUNTIME_HB, Posix.monotonicNs());
+            // from now on the native writer (if running) keeps the runtime heartbeat fresh
+            NativeHeartbeat.register(s.address());
             return new ControlBlock(s);
         } catch (RuntimeException e) {
             s.unlink();
@@ -433,11 +435,17 @@ public final class ControlBlock implements AutoCloseable {
         return seq + 2;
     }
 
-    /** Unmaps and removes the object. */
+    /**
+     * Removes the object and unmaps it, once the native heartbeat writer no longer touches it
+     * (if a round of the writer did not end within its deadline the mapping is left in place:
+     * a few kilobytes kept is better than a write into unmapped memory).
+     */
     @Override
     public void close() {
         shm.unlink();
-        shm.close();
+        if (NativeHeartbeat.unregister(shm.address())) {
+            shm.close();
+        }
     }
 
     /** Exposes the segment to other ABI classes and tests. */

@@ -79,6 +79,11 @@ public final class ShmSegment implements AutoCloseable {
         return size;
     }
 
+    /** The mapping's address (null once closed); for the native heartbeat writer only. */
+    synchronized Pointer address() {
+        return base;
+    }
+
     /** The mapped bytes (little endian, absolute indexing only). */
     public ByteBuffer buffer() {
         return buf;

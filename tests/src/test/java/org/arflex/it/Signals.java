@@ -1,0 +1,21 @@
+package org.arflex.it;
+
+import static org.junit.jupiter.api.Assertions.assertEquals;
+
+/** Faults from outside: a signal to a process, as an operator's kill(1) sends it. */
+final class Signals {
+
+    private Signals() {
+    }
+
+    /** Sends {@code SIG<sig>} (e.g. "STOP", "CONT", "9") to {@code pid}; kill(1) must succeed. */
+    static void send(long pid, String sig) throws Exception {
+        assertEquals(true, tryToSend(pid, sig), "kill -" + sig + " " + pid);
+    }
+
+    /** As {@link #send}, for a process that may be gone already: true when it was signalled. */
+    static boolean tryToSend(long pid, String sig) throws Exception {
+        Process p = new ProcessBuilder("kill", "-" + sig, Long.toString(pid)).inheritIO().start();
+        return p.waitFor() == 0;
+    }
+}
