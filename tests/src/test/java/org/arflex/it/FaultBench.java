@@ -76,19 +76,15 @@ class FaultBench {
                 r.safeMs, r.backMs, r.note);
     }
 
-    /** Waits for the arm to stand still after t0; ms from t0, or -1 after the deadline. */
-    private static double timeToStill(Runtime rt, CellRig.Trace<CellRig.JointState> js, long t0) {
+    /** Waits for the arm to stand still after the fault; robot ms to the first still value, or -1 after the deadline. */
+    private static double timeToStill(Runtime rt, CellRig.Trace<CellRig.JointState> js) {
         int mark = js.size();
         try {
             rt.waitUntil("the arm still", 20_000, () -> js.size() > mark + 50 && FailSafeIT.stillFor(js, 50));
         } catch (AssertionError e) {
             return -1;
         }
-        // the first of the 50 still samples, in robot time
-        List<CellRig.JointState> s = js.snapshot();
-        CellRig.JointState first = s.get(s.size() - 50);
-        CellRig.JointState atFault = s.get(Math.max(0, mark - 1));
-        return Math.max(0, (first.tNs() - atFault.tNs()) / 1e6);
+        return FailSafeIT.stillAfterMs(js, mark);
     }
 
     /** S17: after the reset(s), 1000 robot cycles without motion; then the fresh command moves it. */
@@ -133,7 +129,7 @@ class FaultBench {
             }
             FailSafeIT.kill9(pid);
             if (k == 0) {
-                safe = timeToStill(rt, js, t0);
+                safe = timeToStill(rt, js);
             }
             try {
                 rt.waitUntil(name + " back or FAILED", 30_000,
@@ -208,7 +204,7 @@ class FaultBench {
                             int mark = rt.logMark();
                             java.time.LocalTime at = java.time.LocalTime.now();
                             FailSafeIT.kill9(pid);
-                            double safe = timeToStill(rt, js, t0);
+                            double safe = timeToStill(rt, js);
                             double detect = detection(rt, mark, at, name + " (pid " + pid + ") ");
                             double back = backToActive(rt, name, pid, t0);
                             boolean ok = resetThenCommand(rt, js);
@@ -223,7 +219,7 @@ class FaultBench {
                                     rt.segment("force-guard", "safety"), java.nio.file.StandardOpenOption.WRITE)) {
                                 ch.write(java.nio.ByteBuffer.allocate(8), 0);
                             }
-                            double safe = timeToStill(rt, js, t0);
+                            double safe = timeToStill(rt, js);
                             double detect = detection(rt, mark, at, "output force-guard.safety damaged while running");
                             double back = backToActive(rt, "force-guard", pid, t0);
                             boolean ok = resetThenCommand(rt, js);
@@ -233,7 +229,7 @@ class FaultBench {
                         case "S3-guard" -> {
                             long pid = rt.pid("force-guard");
                             Signals.tryToSend(pid, "STOP");
-                            double safe = timeToStill(rt, js, t0);
+                            double safe = timeToStill(rt, js);
                             double back = backToActive(rt, "force-guard", pid, t0);
                             Signals.tryToSend(pid, "CONT"); // if the DRCR did not kill it, it goes on
                             boolean ok = resetThenCommand(rt, js);
@@ -242,7 +238,7 @@ class FaultBench {
                         default -> {
                             CellRig.set(rt, "sim-robot", "push_duration_ms", "200");
                             CellRig.set(rt, "sim-robot", "push_force_n", "400");
-                            double safe = timeToStill(rt, js, t0);
+                            double safe = timeToStill(rt, js);
                             // the operator resets once the contact is over: the push (200 ms of
                             // simulated time) has ended and the arm is at rest again
                             rt.waitUntil("the push over", 30_000, () -> System.nanoTime() - t0 > 400_000_000L);
