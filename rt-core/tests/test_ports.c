@@ -365,6 +365,56 @@ static void state_read_refuses_a_damaged_header(void **state)
 	th_assert_clean(rid);
 }
 
+/* Stream and frame readers re-check the header as state readers do: damage is -EPROTO,
+ * nothing is consumed or lent, and reads go on once the header is restored. */
+static void stream_and_frame_reads_refuse_a_damaged_header(void **state)
+{
+	struct arflex_port_spec ss = {
+		.method = ARFLEX_PORT_STREAM, .type = sample_type, .depth = 4,
+		.overflow = ARFLEX_OVERFLOW_DROP_NEWEST,
+	};
+	struct arflex_port_spec fs = {
+		.method = ARFLEX_PORT_FRAME, .type = { "test.Frame", 1, 0, 64 }, .depth = 2,
+	};
+	const struct arflex_port_type ft = { "test.Frame", 1, 0, 64 };
+	struct arflex_port q, f, fr;
+	struct arflex_frame_view v;
+	struct sample s;
+	char qn[ARFLEX_OBJ_NAME_SIZE], fn[ARFLEX_OBJ_NAME_SIZE];
+
+	(void)state;
+	th_rid(rid, sizeof(rid), "hdr2");
+	name_of(qn, "q");
+	name_of(fn, "image");
+	assert_int_equal(arflex_port_create(&q, qn, &ss), 0);
+	fill(&s, 1);
+	assert_int_equal(arflex_stream_push(&q, &s, sizeof(s)), 1);
+	q.hdr->magic ^= 1;
+	assert_int_equal(arflex_stream_pop(&q, &s, sizeof(s)), -EPROTO);
+	assert_int_equal(arflex_stream_peek(&q, &s, sizeof(s)), -EPROTO);
+	q.hdr->magic ^= 1;
+	q.hdr->slot_stride += 64;
+	assert_int_equal(arflex_stream_pop(&q, &s, sizeof(s)), -EPROTO);
+	q.hdr->slot_stride -= 64;
+	assert_int_equal(arflex_stream_pop(&q, &s, sizeof(s)), 1); /* nothing was consumed */
+	assert_int_equal(s.seq, 1);
+	assert_int_equal(arflex_port_destroy(&q), 0);
+
+	assert_int_equal(arflex_port_create(&f, fn, &fs), 0);
+	assert_int_equal(arflex_port_open(&fr, fn, false, false, ARFLEX_PORT_FRAME, &ft), 0);
+	memset(arflex_frame_begin(&f), 7, 64);
+	assert_int_equal(arflex_frame_commit(&f, 64), 0);
+	f.hdr->depth = 3;
+	assert_int_equal(arflex_frame_acquire(&fr, &v), -EPROTO);
+	f.hdr->depth = 2;
+	assert_int_equal(arflex_frame_acquire(&fr, &v), 1); /* nothing was lent before */
+	assert_int_equal(v.index, 0);
+	assert_true(arflex_frame_valid(&v));
+	arflex_port_close(&fr);
+	assert_int_equal(arflex_port_destroy(&f), 0);
+	th_assert_clean(rid);
+}
+
 static void stream_single_process_semantics(void **state)
 {
 	struct arflex_port_spec spec = {
@@ -499,6 +549,7 @@ int main(void)
 		cmocka_unit_test(port_open_checks_type),
 		cmocka_unit_test(port_age_and_header_recheck),
 		cmocka_unit_test(state_read_refuses_a_damaged_header),
+		cmocka_unit_test(stream_and_frame_reads_refuse_a_damaged_header),
 		cmocka_unit_test(stream_single_process_semantics),
 		cmocka_unit_test(stream_drop_newest_exact_counts),
 		cmocka_unit_test(stream_drop_oldest_exact_counts),

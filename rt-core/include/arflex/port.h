@@ -215,11 +215,13 @@ ARFLEX_API int arflex_state_read(struct arflex_port *p, void *out, size_t len, u
  *  0 if dropped (drop-newest, ring full), -EINVAL. RT safe. */
 ARFLEX_API int arflex_stream_push(struct arflex_port *p, const void *val, size_t len);
 
-/** Pops the oldest unread element into @out. Returns 1, 0 (empty), -EINVAL. Single consumer.
- *  RT safe. */
+/** Pops the oldest unread element into @out. Returns 1, 0 (empty), -EPROTO (the segment
+ *  header no longer matches what was opened, as for arflex_state_read: nothing consumed),
+ *  -EINVAL. Single consumer. RT safe. */
 ARFLEX_API int arflex_stream_pop(struct arflex_port *p, void *out, size_t len);
 
-/** Copies the newest element without consuming (monitors). Returns 1, 0 (none/torn). */
+/** Copies the newest element without consuming (monitors). Returns 1, 0 (none/torn),
+ *  -EPROTO (damaged header), -EINVAL. */
 ARFLEX_API int arflex_stream_peek(const struct arflex_port *p, void *out, size_t len);
 
 /** Counters (atomic snapshot of each). */
@@ -251,7 +253,7 @@ struct arflex_frame_view {
 };
 
 /** Reader: lends the newest frame newer than the last one lent by this handle. Returns 1, 0
- *  (nothing new), -EINVAL. No copy. RT safe. */
+ *  (nothing new), -EPROTO (damaged header: nothing lent), -EINVAL. No copy. RT safe. */
 ARFLEX_API int arflex_frame_acquire(struct arflex_port *p, struct arflex_frame_view *v);
 
 /** Reader: true if the frame in @v was not overwritten while it was used; call after use and

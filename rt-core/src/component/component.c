@@ -132,26 +132,27 @@ int arflex_input_age(const struct arflex_input *in, uint64_t now_ns, uint64_t *a
 	return in->cur ? arflex_port_age(in->cur, now_ns, age_ns) : -ENOTCONN;
 }
 
-int arflex_input_state_read(struct arflex_input *in, void *out, size_t len, uint64_t *seq)
+/* A damaged input header (-EPROTO) is counted as an input warning, whatever the method. */
+static int counted(struct arflex_input *in, int r)
 {
-	int r;
-
-	if (!in->cur)
-		return -ENOTCONN;
-	r = arflex_state_read(in->cur, out, len, seq);
 	if (r == -EPROTO && in->warnings)
 		__atomic_add_fetch(&in->warnings[ARFLEX_WARN_INPUT], 1, __ATOMIC_RELAXED);
 	return r;
 }
 
+int arflex_input_state_read(struct arflex_input *in, void *out, size_t len, uint64_t *seq)
+{
+	return in->cur ? counted(in, arflex_state_read(in->cur, out, len, seq)) : -ENOTCONN;
+}
+
 int arflex_input_stream_pop(struct arflex_input *in, void *out, size_t len)
 {
-	return in->cur ? arflex_stream_pop(in->cur, out, len) : -ENOTCONN;
+	return in->cur ? counted(in, arflex_stream_pop(in->cur, out, len)) : -ENOTCONN;
 }
 
 int arflex_input_frame_acquire(struct arflex_input *in, struct arflex_frame_view *v)
 {
-	return in->cur ? arflex_frame_acquire(in->cur, v) : -ENOTCONN;
+	return in->cur ? counted(in, arflex_frame_acquire(in->cur, v)) : -ENOTCONN;
 }
 
 /* ---- port declaration (configure) ---------------------------------------------------- */

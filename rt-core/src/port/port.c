@@ -338,6 +338,8 @@ int arflex_stream_pop(struct arflex_port *p, void *out, size_t len)
 
 	if (!h || !p->writable || p->method != ARFLEX_PORT_STREAM || len > p->elem_size)
 		return -EINVAL;
+	if (!hdr_intact(p))
+		return -EPROTO;
 	tail = LOADR(&h->tail);
 	for (;;) {
 		struct arflex_slot_hdr *s;
@@ -381,6 +383,8 @@ int arflex_stream_peek(const struct arflex_port *p, void *out, size_t len)
 
 	if (!h || p->method != ARFLEX_PORT_STREAM || len > p->elem_size)
 		return -EINVAL;
+	if (!hdr_intact(p))
+		return -EPROTO;
 	head = LOAD(&h->head);
 	if (!head)
 		return 0;
@@ -450,6 +454,8 @@ int arflex_frame_acquire(struct arflex_port *p, struct arflex_frame_view *v)
 
 	if (!p->hdr || p->method != ARFLEX_PORT_FRAME)
 		return -EINVAL;
+	if (!hdr_intact(p))
+		return -EPROTO;
 	head = LOAD(&p->hdr->head);
 	seen = p->last_seq; /* frames lent so far are [0, seen) */
 	if (head == 0 || head <= seen)
