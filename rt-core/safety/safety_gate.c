@@ -52,6 +52,8 @@ static enum arflex_safety_verdict judge(struct arflex_safety_gate *g, struct arf
 		g->bad = !state_ok(&s);
 		if (g->bad) {
 			g->rejected++;
+			if (g->in) /* counted on the input too: the DRCR names its provider */
+				arflex_input_reject(g->in);
 			g->seen = false; /* the last valid value is not the provider's word now */
 		} else {
 			g->state = s;

@@ -121,8 +121,10 @@ static int scaler_update(struct arflex_component *c, void *user, uint64_t releas
 	k->was_bound = true;
 	if (ret <= 0)
 		return ret; /* 0: no new value this cycle */
-	if (!arflex_sample_valid(&in))
-		return -EINVAL; /* not used: y holds the last valid value */
+	if (!arflex_sample_valid(&in)) {
+		arflex_input_reject(k->x); /* counted on the input: the DRCR names its provider */
+		return -EINVAL;            /* not used: y holds the last valid value */
+	}
 	out.seq = in.seq;
 	out.t_ns = in.t_ns;
 	out.value = arflex_param_f64(c, k->p_gain) * in.value;

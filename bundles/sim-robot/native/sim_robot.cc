@@ -503,6 +503,7 @@ int Update(arflex_component* c, void* user, uint64_t release_ns) {
     const int bad = CheckReference(*r.cell, ref);
     r.ref_invalid = bad < 0;
     if (bad < 0) {
+      arflex_input_reject(r.joint_ref);  // counted on the input (the DRCR names its provider)
       ret = bad;  // rejected: never reaches the servo; the last valid reference is held
     } else if (!r.acquired && r.after_stop && !AtRest(r, ref.q)) {
       // after a stop: not yet a reference at rest (still decelerating): keep holding

@@ -237,6 +237,7 @@ uint32_t TrackTool(int* err) {
       g.tool = t;
       g.tool_seen = true;
     } else {
+      arflex_input_reject(g.in_tool);
       *err = -EINVAL;
     }
   }
@@ -270,6 +271,7 @@ int Step(struct arflex_component* c, uint64_t release_ns, bool force_stop) {
   struct arflex_joint_state js;
   bool measured = arflex_input_state_read(g.in_state, &js, sizeof(js), nullptr) == 1;
   if (measured && !arflex_joint_state_valid(&js)) {
+    arflex_input_reject(g.in_state);
     measured = false;
     input_err = -EINVAL;
   }

@@ -158,13 +158,19 @@ ARFLEX_API struct arflex_port *arflex_input_port(struct arflex_input *in);
  *  re-checked); -ENOTCONN when unbound. RT safe. */
 ARFLEX_API int arflex_input_age(const struct arflex_input *in, uint64_t now_ns, uint64_t *age_ns);
 /** arflex_state_read on the bound provider; -ENOTCONN when unbound. A damaged provider
- *  header (-EPROTO) is also counted in the ARFLEX_WARN_INPUT warning. RT safe. */
+ *  header (-EPROTO) is counted as a rejected value of the input (arflex_input_reject). RT
+ *  safe. */
 ARFLEX_API int arflex_input_state_read(struct arflex_input *in, void *out, size_t len,
 				       uint64_t *seq);
-/** arflex_stream_pop on the bound provider; -ENOTCONN when unbound. */
+/** arflex_stream_pop on the bound provider; -ENOTCONN when unbound; -EPROTO counted. */
 ARFLEX_API int arflex_input_stream_pop(struct arflex_input *in, void *out, size_t len);
-/** arflex_frame_acquire on the bound provider; -ENOTCONN when unbound. */
+/** arflex_frame_acquire on the bound provider; -ENOTCONN when unbound; -EPROTO counted. */
 ARFLEX_API int arflex_input_frame_acquire(struct arflex_input *in, struct arflex_frame_view *v);
+/** The component refused the newest value of @in (its validator: NaN, Inf, out of range).
+ *  Counts it in the input's slot of the control block (ctl.inputs, ABI 1.2: the DRCR shows
+ *  rejected values per input and its provider) and in the ARFLEX_WARN_INPUT warning. The
+ *  count starts at 0 with each run of the RT half. RT safe (two atomic adds). */
+ARFLEX_API void arflex_input_reject(struct arflex_input *in);
 
 /** The control block (read-only use; e.g. config.period_ns). */
 ARFLEX_API const struct arflex_ctl *arflex_component_ctl(const struct arflex_component *c);

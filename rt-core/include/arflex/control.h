@@ -34,8 +34,9 @@ extern "C" {
 /** ABI major: a reader refuses an object whose major differs. */
 #define ARFLEX_ABI_MAJOR 1u
 /** ABI minor: additions only; a reader accepts any minor >= the one it needs.
- *  1.1: config.orphan_hold_ns, ARFLEX_CFG_SUPERVISOR_PIPE, ARFLEX_FLAG_SUPERVISOR_LOST. */
-#define ARFLEX_ABI_MINOR 1u
+ *  1.1: config.orphan_hold_ns, ARFLEX_CFG_SUPERVISOR_PIPE, ARFLEX_FLAG_SUPERVISOR_LOST.
+ *  1.2: inputs[]: rejected values counted per input (in the former tail padding). */
+#define ARFLEX_ABI_MINOR 2u
 
 /** Magic of the control block: bytes "ARFLXCTL" read as little-endian uint64. */
 #define ARFLEX_CTL_MAGIC UINT64_C(0x4C5443584C465241)
@@ -233,6 +234,16 @@ struct arflex_ctl_config {
 /* ---- the control block -------------------------------------------------------------- */
 
 /** The whole control block segment. Size ARFLEX_CTL_SIZE (40960 bytes = 10 pages). */
+/** Count of one input's rejected values (ABI 1.2). The RT process writes both words: the name
+ *  hash at configure, the count from its RT thread. */
+struct arflex_input_count {
+	uint32_t name_hash; /**< low 32 bits of FNV-1a 64 of the input's name (0: slot unused) */
+	uint32_t rejects;   /**< values refused: damaged segment, or invalid (NaN, Inf, out of range) */
+};
+
+/** Input count slots in the control block (the template's ARFLEX_MAX_INPUTS). */
+#define ARFLEX_CTL_INPUTS 16
+
 struct arflex_ctl {
 	/* header, 64 bytes at 0 */
 	uint64_t magic;          /**< ARFLEX_CTL_MAGIC */
@@ -257,8 +268,10 @@ struct arflex_ctl {
 	struct arflex_stats stats;
 	/* parameter table at 32576 */
 	struct arflex_param_slot params[ARFLEX_PARAM_SLOTS];
+	/* rejected values per input at 40768 (ABI 1.2; RT process) */
+	struct arflex_input_count inputs[ARFLEX_CTL_INPUTS];
 	/* padding to ARFLEX_CTL_SIZE */
-	uint8_t tail_pad[40960 - 32576 - ARFLEX_PARAM_SLOTS * 128];
+	uint8_t tail_pad[40960 - 32576 - ARFLEX_PARAM_SLOTS * 128 - ARFLEX_CTL_INPUTS * 8];
 };
 
 #define ARFLEX_CTL_SIZE 40960u
@@ -276,6 +289,7 @@ ARFLEX_STATIC_ASSERT(offsetof(struct arflex_ctl, config) == 64, "ctl.config");
 ARFLEX_STATIC_ASSERT(offsetof(struct arflex_ctl, warnings) == 128, "ctl.warnings");
 ARFLEX_STATIC_ASSERT(offsetof(struct arflex_ctl, stats) == 256, "ctl.stats");
 ARFLEX_STATIC_ASSERT(offsetof(struct arflex_ctl, params) == 32576, "ctl.params");
+ARFLEX_STATIC_ASSERT(offsetof(struct arflex_ctl, inputs) == 40768, "ctl.inputs");
 ARFLEX_STATIC_ASSERT(sizeof(struct arflex_ctl) == ARFLEX_CTL_SIZE, "ctl size");
 
 /* ---- API ---------------------------------------------------------------------------- */

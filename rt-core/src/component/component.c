@@ -132,11 +132,21 @@ int arflex_input_age(const struct arflex_input *in, uint64_t now_ns, uint64_t *a
 	return in->cur ? arflex_port_age(in->cur, now_ns, age_ns) : -ENOTCONN;
 }
 
-/* A damaged input header (-EPROTO) is counted as an input warning, whatever the method. */
+_Static_assert(ARFLEX_MAX_INPUTS <= ARFLEX_CTL_INPUTS, "every input has a count slot");
+
+void arflex_input_reject(struct arflex_input *in)
+{
+	if (in->warnings)
+		__atomic_add_fetch(&in->warnings[ARFLEX_WARN_INPUT], 1, __ATOMIC_RELAXED);
+	if (in->count)
+		__atomic_add_fetch(&in->count->rejects, 1, __ATOMIC_RELAXED);
+}
+
+/* A damaged input header (-EPROTO) is a rejected value of that input, whatever the method. */
 static int counted(struct arflex_input *in, int r)
 {
-	if (r == -EPROTO && in->warnings)
-		__atomic_add_fetch(&in->warnings[ARFLEX_WARN_INPUT], 1, __ATOMIC_RELAXED);
+	if (r == -EPROTO)
+		arflex_input_reject(in);
 	return r;
 }
 
@@ -223,6 +233,11 @@ int arflex_component_input(struct arflex_component *c, const char *port,
 	in->type.name = in->type_name;
 	in->method = method;
 	in->warnings = c->ctl->warnings;
+	if (c->ninputs <= ARFLEX_CTL_INPUTS) {
+		in->count = &c->ctl->inputs[c->ninputs - 1];
+		STORE(&in->count->rejects, 0);
+		STORE(&in->count->name_hash, (uint32_t)arflex_port_type_hash(port));
+	}
 	*out = in;
 	return 0;
 }

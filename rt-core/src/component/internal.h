@@ -30,6 +30,7 @@ struct arflex_input {
 	uint32_t binding;             /* RT: providers taken (arflex_input_binding) */
 	bool bound;                   /* mailbox thread's view */
 	uint64_t *warnings;           /* the control block's warning counters */
+	struct arflex_input_count *count; /* its rejected-value counter in the control block */
 };
 
 struct arflex_component {

@@ -499,9 +499,9 @@ TEST_F(SimComponents, RobotAcquiresOnlyAReferenceNearTheArm) {
 }
 
 // Validated data (docs/safety.md): a joint reference that is NaN, infinite or outside the
-// joint limits never reaches the servo. Each one is counted (update_errors), the arm holds the
-// last valid reference and the hold word says REFERENCE / invalid on the joint_ref input; the
-// next valid value is followed again and the hold word clears.
+// joint limits never reaches the servo. Each one is counted (update_errors, and on its input),
+// the arm holds the last valid reference and the hold word says REFERENCE / invalid on the
+// joint_ref input; the next valid value is followed again and the hold word clears.
 TEST_F(SimComponents, RobotRejectsAnInvalidReference) {
   CreateRobot(1 * kMs, 1, false);
   CreateReference();
@@ -558,6 +558,20 @@ TEST_F(SimComponents, RobotRejectsAnInvalidReference) {
     EXPECT_LT(worst, 1e-4) << "the arm moved on an invalid reference";
     EXPECT_EQ(errors(), e0 + 1) << "one error per invalid value";
   }
+  // ... and each is counted on its input (ctl.inputs, ABI 1.2): joint_ref 3, safety none.
+  const uint32_t ref_hash = static_cast<uint32_t>(arflex_port_type_hash("joint_ref"));
+  const uint32_t safety_hash = static_cast<uint32_t>(arflex_port_type_hash("safety"));
+  bool ref_seen = false, safety_seen = false;
+  for (const arflex_input_count& in : robot_.ctl->inputs) {
+    if (in.name_hash == ref_hash) {
+      ref_seen = true;
+      EXPECT_EQ(__atomic_load_n(&in.rejects, __ATOMIC_ACQUIRE), 3u) << "rejected references counted on joint_ref";
+    } else if (in.name_hash == safety_hash) {
+      safety_seen = true;
+      EXPECT_EQ(__atomic_load_n(&in.rejects, __ATOMIC_ACQUIRE), 0u);
+    }
+  }
+  EXPECT_TRUE(ref_seen && safety_seen) << "sim-robot's inputs have count slots";
   // A valid value afterwards is followed again and the hold word clears.
   const double next[6] = {0.1, 0.5, 0.3, 0.0, 0.8, 0.0};
   WriteReference(next);

@@ -165,6 +165,7 @@ int Update(arflex_component* c, void*, uint64_t) {
   if (arflex_input_state_read(g.reference, &ref, sizeof(ref), nullptr) == 1 && ref.seq != 0) {
     g.ref_invalid = !arflex_joint_ref_valid(&ref);
     if (g.ref_invalid) {
+      arflex_input_reject(g.reference);
       err = -EINVAL;  // never passed on: the output holds (below)
     } else {
       g.ref = ref;
@@ -190,10 +191,12 @@ int Update(arflex_component* c, void*, uint64_t) {
   arflex_joint_state js{};
   if (arflex_input_state_read(g.robot, &js, sizeof(js), nullptr) == 1 && js.seq != 0) {
     g.js_invalid = !arflex_joint_state_valid(&js);
-    if (g.js_invalid)
+    if (g.js_invalid) {
+      arflex_input_reject(g.robot);
       err = -EINVAL;
-    else
+    } else {
       g.js = js;
+    }
   }
   if (!arflex_input_bound(g.robot)) {  // no robot: no interlock
     g.js.seq = 0;
@@ -205,6 +208,7 @@ int Update(arflex_component* c, void*, uint64_t) {
       arflex_input_state_read(g.pose, &m, sizeof(m), &seq) == 1 && m.seq != 0 && m.seq != g.pose_seq;
   if (fresh && !PoseWellFormed(m)) {
     g.pose_seq = m.seq;  // a malformed measurement: held (the correction stays), counted
+    arflex_input_reject(g.pose);
     err = -EINVAL;
   } else if (fresh) {
     g.pose_seq = m.seq;

@@ -267,6 +267,8 @@ int Update(arflex_component* c, void*, uint64_t) {
           f.header = h;
           f.present = true;
         }
+      } else {
+        arflex_input_reject(g.cam[i]);
       }
     }
     any = any || f.present;
@@ -282,10 +284,12 @@ int Update(arflex_component* c, void*, uint64_t) {
   const int got = arflex_input_state_read(g.joints, &js, sizeof(js), nullptr);
   if (got == 1) {
     g.joints_invalid = !arflex_joint_state_valid(&js);
-    if (g.joints_invalid)
+    if (g.joints_invalid) {
+      arflex_input_reject(g.joints);
       err = -EINVAL;
-    else
+    } else {
       g.joint_state = js;
+    }
   }
   g.have_joints = got >= 0 && !g.joints_invalid && g.joint_state.seq != 0;
   g.fovy_deg = ParamF64(c, g.p_fovy, 50.0);

@@ -37,7 +37,9 @@
     const ports = (c.ports || []).map(p => el('tr', {}, el('td', {}, p.direction), el('td', {}, p.name),
       el('td', {}, p.type + ' ' + p.typeVersion), el('td', {}, p.method), el('td', {}, p.binding || (p.direction === 'IN' ? 'any' : '')),
       el('td', {}, p.optional ? 'optional' : '')));
-    const bindings = (i.bindings || []).map(b => el('li', {}, b.provider + '.' + b.output + ' → ' + b.consumer + '.' + b.input));
+    // values the consumer refused on an input (damaged segment, invalid values) name their provider
+    const bindings = (i.bindings || []).map(b => el('li', {}, b.provider + '.' + b.output + ' → ' + b.consumer + '.' + b.input,
+      b.rejected ? el('span', {class: 'arflex-rejected', 'data-input': b.input}, ' (' + b.rejected + ' values refused)') : null));
     summary.replaceChildren(
       el('div', {}, 'State ', stateBadge(i.state), ' target ', i.targetState || '', ' ',
         i.failureReason ? el('span', {class: 'arflex-reason'}, '— ' + i.failureReason) : '',

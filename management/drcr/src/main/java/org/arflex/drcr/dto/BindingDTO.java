@@ -10,4 +10,9 @@ public class BindingDTO {
     public String provider;
     /** Provider output port. */
     public String output;
+    /**
+     * Values the consumer refused on this input in its current run: a damaged segment, or
+     * values its validator rejected (NaN, Inf, out of range). Since 0.8.0.
+     */
+    public long rejected;
 }

@@ -16,7 +16,7 @@ public final class ControlBlock implements AutoCloseable {
 
     public static final long MAGIC = 0x4C5443584C465241L; // "ARFLXCTL"
     public static final int ABI_MAJOR = 1;
-    public static final int ABI_MINOR = 1;
+    public static final int ABI_MINOR = 2;
     public static final int SIZE = 40960;
 
     // header
@@ -79,6 +79,9 @@ public final class ControlBlock implements AutoCloseable {
     public static final int HIST_BINS = 2000;
     // parameters
     public static final int OFF_PARAMS = 32576;
+    /** ABI 1.2: rejected values per input, 16 slots of (uint32 name hash, uint32 count). */
+    public static final int OFF_INPUTS = 40768;
+    public static final int INPUT_SLOTS = 16;
     public static final int PARAM_SLOTS = 64;
     public static final int SLOT_SIZE = 128;
     public static final int SLOT_NAME = 0;
@@ -286,6 +289,29 @@ public final class ControlBlock implements AutoCloseable {
     /** The hold word (0: the component does not hold the arm by itself). */
     public int hold() {
         return shm.getIntAcquire(OFF_HOLD);
+    }
+
+    /**
+     * Rejected values per input (ABI 1.2), as the RT half counted them in this run: input name
+     * (the names the RT half declared; those of {@code names} whose hash matches a slot) to count.
+     */
+    public java.util.Map<String, Long> inputRejects(java.util.Collection<String> names) {
+        java.util.Map<String, Long> out = new java.util.TreeMap<>();
+        for (String n : names) {
+            int hash = inputHash(n);
+            for (int k = 0; k < INPUT_SLOTS; k++) {
+                if (shm.getIntAcquire(OFF_INPUTS + 8 * k) == hash) {
+                    out.put(n, Integer.toUnsignedLong(shm.getIntAcquire(OFF_INPUTS + 8 * k + 4)));
+                    break;
+                }
+            }
+        }
+        return out;
+    }
+
+    /** The name hash of an input's count slot: the low 32 bits of FNV-1a 64 of its name. */
+    public static int inputHash(String name) {
+        return (int) PortSegment.typeHash(name);
     }
 
     /** The configuration as written in the block (read-only after the spawn). */

@@ -117,6 +117,8 @@ public final class Snapshots {
         d.evaluationSegments = new java.util.TreeMap<>(i.evaluationSegments);
         d.bundleId = i.bundleId;
         List<BindingDTO> bs = new ArrayList<>();
+        java.util.Map<String, Long> rejects = half == null ? java.util.Map.of()
+                : half.inputRejects(i.contract.inputs().stream().map(org.arflex.contract.PortSpec::name).toList());
         for (var w : cell.planner().wires()) {
             if (w.consumer().equals(i.name)) {
                 BindingDTO b = new BindingDTO();
@@ -124,6 +126,7 @@ public final class Snapshots {
                 b.input = w.inPort();
                 b.provider = w.provider();
                 b.output = w.outPort();
+                b.rejected = rejects.getOrDefault(w.inPort(), 0L);
                 bs.add(b);
             }
         }

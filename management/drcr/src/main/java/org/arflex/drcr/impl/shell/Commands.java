@@ -117,6 +117,11 @@ public final class Commands {
             if (p.binding != null) {
                 sb.append(" from ").append(p.binding);
             }
+            for (BindingDTO b : i.bindings) {
+                if (b.input.equals(p.name) && "IN".equals(p.direction) && b.rejected > 0) {
+                    sb.append(", ").append(b.rejected).append(" values from ").append(b.provider).append(" refused");
+                }
+            }
             sb.append('\n');
         }
         for (ParamDTO p : i.params) {
@@ -134,7 +139,8 @@ public final class Commands {
         }
         StringBuilder sb = new StringBuilder();
         for (BindingDTO b : c.bindings) {
-            sb.append(b.consumer).append('.').append(b.input).append(" <- ").append(b.provider).append('.').append(b.output).append('\n');
+            sb.append(b.consumer).append('.').append(b.input).append(" <- ").append(b.provider).append('.').append(b.output)
+                    .append(b.rejected > 0 ? " (" + b.rejected + " values refused)" : "").append('\n');
         }
         return sb.toString().stripTrailing();
     }

@@ -368,6 +368,14 @@ public final class ProcessLauncher implements RtLauncher {
         }
 
         @Override
+        public synchronized java.util.Map<String, Long> inputRejects(java.util.Collection<String> inputs) {
+            if (cleaned) {
+                return java.util.Map.of();
+            }
+            return ctl.inputRejects(inputs);
+        }
+
+        @Override
         public synchronized int hold() {
             if (cleaned) {
                 return 0;

@@ -66,6 +66,11 @@ public interface RtHalf {
     /** Control block flags. */
     int flags();
 
+    /** Rejected values per input in this run (ControlBlock.inputRejects); empty when gone. */
+    default java.util.Map<String, Long> inputRejects(java.util.Collection<String> inputs) {
+        return java.util.Map.of();
+    }
+
     /** The control block's hold word (ControlBlock.OFF_HOLD); 0 when none or gone. */
     default int hold() {
         return 0;

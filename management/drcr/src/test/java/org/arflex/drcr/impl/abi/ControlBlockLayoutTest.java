@@ -60,6 +60,9 @@ class ControlBlockLayoutTest {
         expect.put("ARFLEX_HIST_BIN_NS", (long) ControlBlock.HIST_BIN_NS);
         expect.put("ARFLEX_HIST_BINS", (long) ControlBlock.HIST_BINS);
         expect.put("offsetof(struct arflex_ctl, params)", (long) ControlBlock.OFF_PARAMS);
+        expect.put("offsetof(struct arflex_ctl, inputs)", (long) ControlBlock.OFF_INPUTS);
+        expect.put("ARFLEX_CTL_INPUTS", (long) ControlBlock.INPUT_SLOTS);
+        expect.put("sizeof(struct arflex_input_count)", 8L);
         expect.put("ARFLEX_PARAM_SLOTS", (long) ControlBlock.PARAM_SLOTS);
         expect.put("sizeof(struct arflex_param_slot)", (long) ControlBlock.SLOT_SIZE);
         expect.put("ARFLEX_NAME_SIZE", (long) ControlBlock.NAME_SIZE);
