@@ -30,9 +30,9 @@ import org.arflex.planner.Wire;
  * {@link org.arflex.contract.Timing#cpus() allowed set} (empty: any capacity CPU). A component
  * that was running keeps its CPU when it still fits there; otherwise CPUs are tried worst-fit
  * (least utilised first, then lowest id). A CPU accepts a task when the total utilisation stays
- * within its cap and the set is schedulable under fixed priorities: first the hyperbolic bound
- * (only when all deadlines are implicit and priorities rate monotonic), then exact response-time
- * analysis of the new task and of every task of lower or equal priority on that CPU. Service
+ * within its cap and the {@link CpuAdmissionTest} accepts it (by default {@link ResponseTimeTest}:
+ * the hyperbolic bound when all deadlines are implicit and priorities rate monotonic, else exact
+ * response-time analysis of the new task and of every task it can delay). Service
  * tasks take no CPU budget. The WCET used is the larger of the declared and the measured one
  * (noted in the reason).
  *
