@@ -9,7 +9,7 @@ import java.util.TreeMap;
 import java.util.TreeSet;
 
 /**
- * The outcome of {@link Admission#admit}: a decision for every candidate, the load of every CPU
+ * The outcome of admission (in {@link Plan#admission()}): a decision for every candidate, the load of every CPU
  * and the budgets used.
  *
  * @param decisions       one decision per candidate component, by name

@@ -12,6 +12,7 @@ import java.util.SortedSet;
 import java.util.TreeMap;
 import java.util.TreeSet;
 import org.arflex.contract.Contract;
+import org.arflex.planner.impl.Text;
 
 /**
  * A proposed change of the cell, immutable. Build one with the static factories or

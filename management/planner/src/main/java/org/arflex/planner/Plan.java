@@ -8,6 +8,7 @@ import java.util.SortedMap;
 import java.util.SortedSet;
 import java.util.TreeMap;
 import java.util.TreeSet;
+import org.arflex.planner.impl.Text;
 
 /**
  * What a {@link Change} does to the cell: the components to stop, start and restart with the

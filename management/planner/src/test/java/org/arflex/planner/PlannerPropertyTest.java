@@ -6,6 +6,7 @@ import static org.junit.jupiter.api.Assertions.assertTrue;
 import java.util.List;
 import java.util.Random;
 import org.arflex.contract.Contract;
+import org.arflex.planner.impl.ResolverPropertyTest;
 import org.arflex.contract.Resources;
 import org.arflex.contract.Timing;
 import org.junit.jupiter.params.ParameterizedTest;

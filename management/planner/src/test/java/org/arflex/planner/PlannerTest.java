@@ -1,6 +1,6 @@
 package org.arflex.planner;
 
-import static org.arflex.planner.C.MIB;
+import static org.arflex.planner.impl.C.MIB;
 import static org.junit.jupiter.api.Assertions.assertEquals;
 import static org.junit.jupiter.api.Assertions.assertFalse;
 import static org.junit.jupiter.api.Assertions.assertThrows;
@@ -12,6 +12,7 @@ import java.util.Set;
 import org.arflex.contract.Contract;
 import org.arflex.contract.PortSpec.Method;
 import org.junit.jupiter.api.Test;
+import org.arflex.planner.impl.C;
 
 class PlannerTest {
 

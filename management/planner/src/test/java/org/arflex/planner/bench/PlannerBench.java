@@ -18,13 +18,13 @@ import org.arflex.contract.PortSpec;
 import org.arflex.contract.Resources;
 import org.arflex.contract.Timing;
 import org.arflex.contract.TypeVersion;
-import org.arflex.planner.Admission;
 import org.arflex.planner.AdmissionResult;
 import org.arflex.planner.Capacities;
 import org.arflex.planner.Change;
 import org.arflex.planner.Planner;
-import org.arflex.planner.ResolveDelta;
-import org.arflex.planner.Resolver;
+import org.arflex.planner.impl.Admission;
+import org.arflex.planner.impl.ResolveDelta;
+import org.arflex.planner.impl.Resolver;
 
 /**
  * Benchmark of the planner on synthetic cells of 100, 1,000 and 10,000 components (not a test).

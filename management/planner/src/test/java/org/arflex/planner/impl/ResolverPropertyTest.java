@@ -1,4 +1,4 @@
-package org.arflex.planner;
+package org.arflex.planner.impl;
 
 import static org.junit.jupiter.api.Assertions.assertEquals;
 import static org.junit.jupiter.api.Assertions.assertTrue;
@@ -17,14 +17,15 @@ import org.arflex.contract.PortSpec.Method;
 import org.junit.jupiter.api.Test;
 import org.junit.jupiter.params.ParameterizedTest;
 import org.junit.jupiter.params.provider.ValueSource;
+import org.arflex.planner.Wire;
 
 /** Incremental resolution equals resolution from scratch, on random change sequences. */
-class ResolverPropertyTest {
+public class ResolverPropertyTest {
 
     private static final String[] TYPES = {"t.A", "t.B", "t.C", "t.D"};
     private static final String[] VERSIONS = {"1.0", "1.1", "2.0"};
 
-    static Contract random(Random rnd, String name, int pool) {
+    public static Contract random(Random rnd, String name, int pool) {
         C c = C.of(name).version("1." + rnd.nextInt(3) + ".0");
         if (rnd.nextInt(3) == 0) {
             c.attr("role", rnd.nextBoolean() ? "robot" : "camera");

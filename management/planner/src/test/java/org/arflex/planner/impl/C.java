@@ -1,4 +1,4 @@
-package org.arflex.planner;
+package org.arflex.planner.impl;
 
 import java.util.ArrayList;
 import java.util.LinkedHashMap;
@@ -14,9 +14,9 @@ import org.arflex.contract.Timing;
 import org.arflex.contract.TypeVersion;
 
 /** Test builder of contracts: {@code C.of("a").out("y", "arflex.Sample").in("x", "arflex.Sample").build()}. */
-final class C {
-    static final long MS = 1_000_000L;
-    static final long MIB = 1L << 20;
+public final class C {
+    public static final long MS = 1_000_000L;
+    public static final long MIB = 1L << 20;
 
     private final String name;
     private String version = "1.0.0";
@@ -32,98 +32,98 @@ final class C {
         this.name = name;
     }
 
-    static C of(String name) {
+    public static C of(String name) {
         return new C(name);
     }
 
-    C version(String v) {
+    public C version(String v) {
         version = v;
         return this;
     }
 
-    C service() {
+    public C service() {
         type = Contract.TaskType.SERVICE;
         return this;
     }
 
-    C sporadic() {
+    public C sporadic() {
         type = Contract.TaskType.SPORADIC;
         return this;
     }
 
-    C attr(String k, String v) {
+    public C attr(String k, String v) {
         attrs.put(k, v);
         return this;
     }
 
-    C out(String port, String type) {
+    public C out(String port, String type) {
         return out(port, type, "1.0", PortSpec.Method.STATE);
     }
 
-    C out(String port, String type, String tv, PortSpec.Method m) {
+    public C out(String port, String type, String tv, PortSpec.Method m) {
         ports.add(new PortSpec(port, PortSpec.Direction.OUT, type, TypeVersion.parse(tv), m, 1,
                 PortSpec.Overflow.DROP_OLDEST, Optional.empty(), false));
         return this;
     }
 
-    C in(String port, String type) {
+    public C in(String port, String type) {
         return in(port, type, "1.0", PortSpec.Method.STATE, Optional.empty(), false);
     }
 
-    C in(String port, String type, String tv, PortSpec.Method m, Optional<Binding> b, boolean optional) {
+    public C in(String port, String type, String tv, PortSpec.Method m, Optional<Binding> b, boolean optional) {
         ports.add(new PortSpec(port, PortSpec.Direction.IN, type, TypeVersion.parse(tv), m, 1,
                 PortSpec.Overflow.DROP_OLDEST, b, optional));
         return this;
     }
 
-    C inFrom(String port, String type, String provider, String providerPort) {
+    public C inFrom(String port, String type, String provider, String providerPort) {
         return in(port, type, "1.0", PortSpec.Method.STATE, Optional.of(Binding.explicit(provider, providerPort)), false);
     }
 
-    C inFilter(String port, String type, String filter) {
+    public C inFilter(String port, String type, String filter) {
         return in(port, type, "1.0", PortSpec.Method.STATE, Optional.of(Binding.filter(filter)), false);
     }
 
     /** A safety input (contracts/SPEC.md §6.8): optional to start, its loss a HOLD. */
-    C inSafety(String port) {
+    public C inSafety(String port) {
         ports.add(new PortSpec(port, PortSpec.Direction.IN, "arflex.SafetyState", TypeVersion.parse("1.0"),
                 PortSpec.Method.STATE, 1, PortSpec.Overflow.DROP_OLDEST, Optional.empty(), true, true));
         return this;
     }
 
-    C inOptional(String port, String type) {
+    public C inOptional(String port, String type) {
         return in(port, type, "1.0", PortSpec.Method.STATE, Optional.empty(), true);
     }
 
     /** Periodic timing in ms (fractions allowed via ns overload). */
-    C timing(double periodMs, double deadlineMs, double wcetMs, int prio, Integer... cpus) {
+    public C timing(double periodMs, double deadlineMs, double wcetMs, int prio, Integer... cpus) {
         timing = new Timing((long) (periodMs * MS), (long) (deadlineMs * MS), (long) (wcetMs * MS), prio, List.of(cpus));
         return this;
     }
 
     /** Makes the timing exclusive (SPEC 8.6), keeping everything else. */
-    C exclusive() {
+    public C exclusive() {
         timing = new Timing(timing.periodNs(), timing.deadlineNs(), timing.wcetNs(), timing.priority(), timing.cpus(),
                 true);
         return this;
     }
 
-    C mem(long bytes) {
+    public C mem(long bytes) {
         mem = bytes;
         return this;
     }
 
-    C net(long bps) {
+    public C net(long bps) {
         net = bps;
         return this;
     }
 
-    C crit(int c) {
+    public C crit(int c) {
         crit = c;
         return this;
     }
 
-    Contract build() {
+    public Contract build() {
         return new Contract(name, version, "", name + "-rt", type, false, attrs, ports, List.of(), timing,
                 new Resources(mem, net), crit,
                 new FaultPolicy(FaultPolicy.Restart.PERMANENT, 3, 10_000, 100, FaultPolicy.SafeOutput.HOLD, 500),

@@ -1,4 +1,4 @@
-package org.arflex.planner;
+package org.arflex.planner.impl;
 
 import static org.junit.jupiter.api.Assertions.assertEquals;
 import static org.junit.jupiter.api.Assertions.assertFalse;
@@ -6,8 +6,8 @@ import static org.junit.jupiter.api.Assertions.assertThrows;
 import static org.junit.jupiter.api.Assertions.assertTrue;
 
 import java.util.List;
-import org.arflex.planner.Schedulability.Task;
 import org.junit.jupiter.api.Test;
+import org.arflex.planner.CpuAdmissionTest.Task;
 
 /** Response-time analysis and bounds against hand-computed textbook examples (units: ticks). */
 class SchedulabilityTest {

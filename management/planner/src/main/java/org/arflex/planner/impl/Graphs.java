@@ -1,4 +1,4 @@
-package org.arflex.planner;
+package org.arflex.planner.impl;
 
 import java.util.ArrayDeque;
 import java.util.ArrayList;
@@ -14,7 +14,7 @@ import java.util.TreeSet;
 import java.util.function.Function;
 
 /** Graph algorithms over component names; iterative so that long chains do not overflow. */
-final class Graphs {
+public final class Graphs {
 
     private Graphs() {
     }
@@ -25,7 +25,7 @@ final class Graphs {
      * is sorted; the list is in no particular order.
      */
     @SuppressWarnings("unchecked")
-    static List<List<String>> sccs(Collection<String> nodes, Function<String, ? extends Collection<String>> providers) {
+    public static List<List<String>> sccs(Collection<String> nodes, Function<String, ? extends Collection<String>> providers) {
         // Iterative Tarjan. Nodes and edges are visited in sorted order for determinism.
         Set<String> all = nodes instanceof Set<?> ? (Set<String>) nodes : new java.util.HashSet<>(nodes);
         List<String> roots = new ArrayList<>(nodes);
@@ -105,7 +105,7 @@ final class Graphs {
     }
 
     /** Cycles: components of more than one member, or one member that provides to itself; sorted. */
-    static List<List<String>> cycles(Map<String, ? extends Collection<String>> providers) {
+    public static List<List<String>> cycles(Map<String, ? extends Collection<String>> providers) {
         List<List<String>> out = new ArrayList<>();
         for (List<String> c : sccs(providers.keySet(), providers::get)) {
             if (c.size() > 1 || providers.get(c.get(0)).contains(c.get(0))) {
@@ -121,7 +121,7 @@ final class Graphs {
      * after the groups that provide to it; among groups ready at the same time, the one with the
      * least member name first.
      */
-    static List<List<String>> dependencyOrder(Collection<String> nodes,
+    public static List<List<String>> dependencyOrder(Collection<String> nodes,
             Function<String, ? extends Collection<String>> providers) {
         List<List<String>> comps = sccs(nodes, providers);
         Map<String, Integer> compOf = new HashMap<>();

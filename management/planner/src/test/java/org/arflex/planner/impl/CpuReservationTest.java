@@ -1,6 +1,6 @@
-package org.arflex.planner;
+package org.arflex.planner.impl;
 
-import static org.arflex.planner.C.MIB;
+import static org.arflex.planner.impl.C.MIB;
 import static org.junit.jupiter.api.Assertions.assertEquals;
 import static org.junit.jupiter.api.Assertions.assertFalse;
 import static org.junit.jupiter.api.Assertions.assertThrows;
@@ -16,6 +16,9 @@ import org.arflex.contract.Contract;
 import org.junit.jupiter.api.Test;
 import org.junit.jupiter.params.ParameterizedTest;
 import org.junit.jupiter.params.provider.ValueSource;
+import org.arflex.planner.AdmissionResult;
+import org.arflex.planner.Capacities;
+import org.arflex.planner.CpuAdmissionTest.Task;
 
 /** Exclusive CPUs (contract, SPEC 8.6) and reserved CPUs (capacities). */
 class CpuReservationTest {
@@ -222,9 +225,9 @@ class CpuReservationTest {
                             + " with " + ks.stream().map(Contract::name).toList());
                 }
             }
-            List<Schedulability.Task> tasks = new ArrayList<>();
+            List<Task> tasks = new ArrayList<>();
             for (Contract k : ks) {
-                tasks.add(new Schedulability.Task(k.name(), k.timing().periodNs(), k.timing().deadlineNs(),
+                tasks.add(new Task(k.name(), k.timing().periodNs(), k.timing().deadlineNs(),
                         k.timing().wcetNs(), k.timing().priority()));
             }
             assertTrue(Schedulability.rtaTest(tasks), "seed " + seed + ": cpu " + e.getKey() + " not schedulable");

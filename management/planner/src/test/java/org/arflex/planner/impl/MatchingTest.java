@@ -1,4 +1,4 @@
-package org.arflex.planner;
+package org.arflex.planner.impl;
 
 import static org.junit.jupiter.api.Assertions.assertEquals;
 import static org.junit.jupiter.api.Assertions.assertFalse;
@@ -10,6 +10,8 @@ import java.util.Optional;
 import org.arflex.contract.Binding;
 import org.arflex.contract.PortSpec.Method;
 import org.junit.jupiter.api.Test;
+import org.arflex.planner.Satisfaction;
+import org.arflex.planner.Wire;
 
 class MatchingTest {
 

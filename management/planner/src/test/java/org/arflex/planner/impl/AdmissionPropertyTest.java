@@ -1,6 +1,6 @@
-package org.arflex.planner;
+package org.arflex.planner.impl;
 
-import static org.arflex.planner.C.MIB;
+import static org.arflex.planner.impl.C.MIB;
 import static org.junit.jupiter.api.Assertions.assertFalse;
 import static org.junit.jupiter.api.Assertions.assertTrue;
 
@@ -11,6 +11,9 @@ import java.util.Random;
 import org.arflex.contract.Contract;
 import org.junit.jupiter.params.ParameterizedTest;
 import org.junit.jupiter.params.provider.ValueSource;
+import org.arflex.planner.AdmissionResult;
+import org.arflex.planner.Capacities;
+import org.arflex.planner.CpuAdmissionTest.Task;
 
 /**
  * Admission on one CPU agrees with brute-force response-time analysis: what it admits is
@@ -39,7 +42,7 @@ class AdmissionPropertyTest {
             r.put(k);
         }
         AdmissionResult a = Admission.admit(r, Capacities.of(1, cap, 512 * MIB, 0), Map.of());
-        List<Schedulability.Task> admitted = new ArrayList<>();
+        List<Task> admitted = new ArrayList<>();
         for (Contract k : all) {
             if (a.admitted().contains(k.name())) {
                 admitted.add(task(k));
@@ -49,7 +52,7 @@ class AdmissionPropertyTest {
         assertTrue(Schedulability.utilisation(admitted) <= cap + 1e-9);
         for (Contract k : all) {
             if (!a.admitted().contains(k.name())) {
-                List<Schedulability.Task> with = new ArrayList<>(admitted);
+                List<Task> with = new ArrayList<>(admitted);
                 with.add(task(k));
                 boolean fits = Schedulability.rtaTest(with) && Schedulability.utilisation(with) <= cap + 1e-9;
                 assertFalse(fits, "seed " + seed + ": '" + k.name() + "' was refused but fits: "
@@ -58,8 +61,8 @@ class AdmissionPropertyTest {
         }
     }
 
-    private static Schedulability.Task task(Contract k) {
-        return new Schedulability.Task(k.name(), k.timing().periodNs(), k.timing().deadlineNs(), k.timing().wcetNs(),
+    private static Task task(Contract k) {
+        return new Task(k.name(), k.timing().periodNs(), k.timing().deadlineNs(), k.timing().wcetNs(),
                 k.timing().priority());
     }
 }

@@ -1,4 +1,4 @@
-package org.arflex.planner;
+package org.arflex.planner.impl;
 
 import static org.junit.jupiter.api.Assertions.assertEquals;
 import static org.junit.jupiter.api.Assertions.assertFalse;

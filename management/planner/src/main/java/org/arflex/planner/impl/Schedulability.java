@@ -1,13 +1,14 @@
-package org.arflex.planner;
+package org.arflex.planner.impl;
 
 import java.util.ArrayList;
 import java.util.Collection;
 import java.util.Comparator;
 import java.util.List;
+import org.arflex.planner.CpuAdmissionTest.Task;
 
 /**
- * Uniprocessor fixed-priority schedulability tests used by {@link Admission}, public so they can
- * be checked against textbook examples.
+ * Uniprocessor fixed-priority schedulability tests used by {@link ResponseTimeTest}, public so they
+ * can be checked against textbook examples.
  *
  * <p>Tasks are periodic or sporadic (period = minimum inter-arrival time) with constrained
  * deadlines ({@code D <= T}), independent, fully preemptive (SCHED_FIFO). Tasks of equal
@@ -17,40 +18,6 @@ import java.util.List;
 public final class Schedulability {
 
     private Schedulability() {
-    }
-
-    /**
-     * One task on one CPU.
-     *
-     * @param name       component name
-     * @param periodNs   period or minimum inter-arrival time, {@code > 0}
-     * @param deadlineNs relative deadline, {@code 0 < D <= T}
-     * @param wcetNs     worst-case execution time used for the analysis, {@code > 0}
-     * @param priority   larger is more urgent
-     */
-    public record Task(String name, long periodNs, long deadlineNs, long wcetNs, int priority) {
-        public Task {
-            if (periodNs <= 0) {
-                throw new IllegalArgumentException("task '" + name + "': period " + periodNs + " ns is not positive");
-            }
-            if (deadlineNs <= 0 || deadlineNs > periodNs) {
-                throw new IllegalArgumentException("task '" + name + "': deadline " + deadlineNs
-                        + " ns is not in (0, period " + periodNs + " ns]");
-            }
-            if (wcetNs <= 0) {
-                throw new IllegalArgumentException("task '" + name + "': WCET " + wcetNs + " ns is not positive");
-            }
-        }
-
-        /** {@code C / T}. */
-        public double utilisation() {
-            return (double) wcetNs / periodNs;
-        }
-
-        /** True when {@code D == T}. */
-        public boolean implicitDeadline() {
-            return deadlineNs == periodNs;
-        }
     }
 
     /** Total utilisation {@code sum C/T}. */
@@ -72,13 +39,13 @@ public final class Schedulability {
      * monotonic (a shorter period never has a lower or equal priority than a longer one).
      */
     public static boolean boundsApply(Collection<Task> tasks) {
-        for (Schedulability.Task t : tasks) {
+        for (Task t : tasks) {
             if (!t.implicitDeadline()) {
                 return false;
             }
         }
-        List<Schedulability.Task> sorted = new ArrayList<>(tasks);
-        sorted.sort(Comparator.comparingLong(Schedulability.Task::periodNs));
+        List<Task> sorted = new ArrayList<>(tasks);
+        sorted.sort(Comparator.comparingLong(Task::periodNs));
         // Every task must have a strictly higher priority than all tasks of longer period.
         int i = 0;
         int minPrioShorter = Integer.MAX_VALUE;

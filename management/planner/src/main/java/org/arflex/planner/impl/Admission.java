@@ -1,4 +1,4 @@
-package org.arflex.planner;
+package org.arflex.planner.impl;
 
 import java.util.ArrayList;
 import java.util.Collection;
@@ -15,6 +15,13 @@ import java.util.TreeSet;
 import org.arflex.contract.Contract;
 import org.arflex.contract.PortSpec;
 import org.arflex.contract.Timing;
+import org.arflex.planner.AdmissionResult;
+import org.arflex.planner.Capacities;
+import org.arflex.planner.CpuAdmissionTest;
+import org.arflex.planner.CpuAdmissionTest.Task;
+import org.arflex.planner.CpuLoad;
+import org.arflex.planner.Decision;
+import org.arflex.planner.Wire;
 
 /**
  * Admission control: decides which of the satisfied components the cell can run.
@@ -23,9 +30,9 @@ import org.arflex.contract.Timing;
  * {@link org.arflex.contract.Timing#cpus() allowed set} (empty: any capacity CPU). A component
  * that was running keeps its CPU when it still fits there; otherwise CPUs are tried worst-fit
  * (least utilised first, then lowest id). A CPU accepts a task when the total utilisation stays
- * within its cap and the set is schedulable under fixed priorities: first the hyperbolic bound
- * (only when all deadlines are implicit and priorities rate monotonic), then exact response-time
- * analysis of the new task and of every task of lower or equal priority on that CPU. Service
+ * within its cap and the {@link CpuAdmissionTest} accepts it (by default {@link ResponseTimeTest}:
+ * the hyperbolic bound when all deadlines are implicit and priorities rate monotonic, else exact
+ * response-time analysis of the new task and of every task it can delay). Service
  * tasks take no CPU budget. The WCET used is the larger of the declared and the measured one
  * (noted in the reason).
  *
@@ -80,7 +87,26 @@ public final class Admission {
     public static AdmissionResult admit(Collection<Contract> candidates, Collection<Wire> wires,
             Capacities capacities, Map<String, Long> measuredWcetNs, Map<String, Integer> previousCpu,
             Set<String> running) {
-        return new Run(candidates, wires, capacities, measuredWcetNs, previousCpu, running).run();
+        return admit(candidates, wires, capacities, measuredWcetNs, previousCpu, running, new ResponseTimeTest());
+    }
+
+    /**
+     * Runs admission, each CPU judged by {@code cpuTest}.
+     *
+     * @param candidates     the satisfied components to consider
+     * @param wires          the resolver's wires (those of required inputs between candidates
+     *                       order the admission)
+     * @param capacities     what the cell offers
+     * @param measuredWcetNs measured WCET by component name, ns (missing or 0: none)
+     * @param previousCpu    CPU of each component currently running (kept when it still fits)
+     * @param running        components currently running (preferred at equal criticality)
+     * @param cpuTest        the schedulability test of one CPU
+     * @return a decision for every candidate
+     */
+    public static AdmissionResult admit(Collection<Contract> candidates, Collection<Wire> wires,
+            Capacities capacities, Map<String, Long> measuredWcetNs, Map<String, Integer> previousCpu,
+            Set<String> running, CpuAdmissionTest cpuTest) {
+        return new Run(candidates, wires, capacities, measuredWcetNs, previousCpu, running, cpuTest).run();
     }
 
     /** Runs admission over the satisfied components of {@code resolver}, with nothing running. */
@@ -92,57 +118,33 @@ public final class Admission {
         return admit(cands, resolver.wires(), capacities, measuredWcetNs, Map.of(), Set.of());
     }
 
-    /** One task placed on a CPU. */
-    private static final class Entry {
-        final Schedulability.Task task;
-        long r; // a lower bound of the response time (exact after final analysis); -1 unknown
-        /**
-         * Processor demand in a window of length D: {@code C + sum ceil(D/Tj) Cj} over the other
-         * tasks of higher or equal priority on the CPU. When it is at most D the response time is
-         * at most D (the iteration cannot pass a point where demand fits), so exact analysis is
-         * only needed for tasks whose demand exceeds their deadline. Kept up to date in O(1) per
-         * task added.
-         */
-        long demand;
-
-        Entry(Schedulability.Task task) {
-            this.task = task;
-            this.r = -1;
-        }
-    }
-
-    /** The outcome of testing one task on one CPU. */
-    private record Fit(boolean ok, String reason, Map<Entry, Long> newR) {
-    }
-
-    private static long ceilDiv(long a, long b) {
-        return (a + b - 1) / b;
-    }
-
+    /** One capacity CPU during a run: placement state here, schedulability in {@link #analysis}. */
     private static final class Cpu {
         final int id;
         final double cap;
-        final List<Entry> tasks = new ArrayList<>();
-        double util;
         final boolean reserved;
+        final CpuAdmissionTest.Cpu analysis;
+        final List<Task> tasks = new ArrayList<>();
+        double util;
         /** The exclusive task placed here, or null. */
         String owner;
 
-        Cpu(Capacities.Cpu c) {
+        Cpu(Capacities.Cpu c, CpuAdmissionTest test) {
             this.id = c.id();
             this.cap = c.utilisationCap();
             this.reserved = c.reserved();
+            this.analysis = test.open(c.id());
         }
 
         /** Why {@code t} may not share this CPU (SPEC §8.6), or null. */
-        String exclusion(Schedulability.Task t, boolean exclusive) {
+        String exclusion(Task t, boolean exclusive) {
             if (owner != null) {
                 return "cpu " + id + ": held exclusively by '" + owner + "' (timing/@exclusive)";
             }
             if (exclusive && !tasks.isEmpty()) {
                 List<String> names = new ArrayList<>();
-                for (Entry e : tasks) {
-                    names.add("'" + e.task.name() + "'");
+                for (Task e : tasks) {
+                    names.add("'" + e.name() + "'");
                 }
                 names.sort(null);
                 return "cpu " + id + ": '" + t.name() + "' asks for a cpu of its own (timing/@exclusive), but cpu "
@@ -151,161 +153,29 @@ public final class Admission {
             return null;
         }
 
-        /** All deadlines implicit and priorities rate monotonic (so the bounds apply). */
-        boolean rmOk = true;
-        /** prod (U_i + 1). */
-        double hyper = 1;
-        /** period -> {min priority, max priority} of the tasks of that period. */
-        final TreeMap<Long, int[]> prioByPeriod = new TreeMap<>();
-
-        /** Whether the bounds still apply with {@code t} added: O(log n) thanks to monotony. */
-        boolean rmOkWith(Schedulability.Task t) {
-            if (!rmOk || !t.implicitDeadline()) {
-                return false;
+        /** Null when {@code t} fits here (cap, then the test), else why not. */
+        String test(Task t) {
+            double u = util + t.utilisation();
+            if (u > cap + 1e-9) {
+                return "cpu " + id + ": utilisation " + Text.util(u) + " with '" + t.name() + "' exceeds cap "
+                        + Text.util(cap);
             }
-            Map.Entry<Long, int[]> shorter = prioByPeriod.lowerEntry(t.periodNs());
-            if (shorter != null && shorter.getValue()[0] <= t.priority()) {
-                return false;
-            }
-            Map.Entry<Long, int[]> longer = prioByPeriod.higherEntry(t.periodNs());
-            return longer == null || longer.getValue()[1] < t.priority();
+            String no = analysis.test(t);
+            return no == null ? null : "cpu " + id + ": " + no;
         }
 
         /** Adds a task that passed {@link #test}; returns the undo step. */
-        Runnable add(Entry e) {
-            Schedulability.Task t = e.task;
-            boolean oldRm = rmOk;
-            double oldHyper = hyper;
+        Runnable add(Task t) {
+            Runnable undo = analysis.add(t);
             double oldUtil = util;
-            int[] oldPrio = prioByPeriod.get(t.periodNs());
-            rmOk = rmOkWith(t);
-            hyper *= t.utilisation() + 1;
             util += t.utilisation();
-            prioByPeriod.put(t.periodNs(), oldPrio == null ? new int[] {t.priority(), t.priority()}
-                    : new int[] {Math.min(oldPrio[0], t.priority()), Math.max(oldPrio[1], t.priority())});
-            long d = t.wcetNs();
-            List<Entry> delayed = new ArrayList<>();
-            for (Entry x : tasks) {
-                if (x.task.priority() >= t.priority()) {
-                    d += ceilDiv(t.deadlineNs(), x.task.periodNs()) * x.task.wcetNs();
-                }
-                if (x.task.priority() <= t.priority()) {
-                    x.demand += ceilDiv(x.task.deadlineNs(), t.periodNs()) * t.wcetNs();
-                    delayed.add(x);
-                }
-            }
-            e.demand = d;
-            tasks.add(e);
+            tasks.add(t);
             return () -> {
-                for (Entry x : delayed) {
-                    x.demand -= ceilDiv(x.task.deadlineNs(), t.periodNs()) * t.wcetNs();
-                }
-                tasks.remove(e);
-                rmOk = oldRm;
-                hyper = oldHyper;
+                tasks.remove(t);
                 util = oldUtil;
-                if (oldPrio == null) {
-                    prioByPeriod.remove(t.periodNs());
-                } else {
-                    prioByPeriod.put(t.periodNs(), oldPrio);
-                }
+                undo.run();
             };
         }
-
-        List<Schedulability.Task> taskList(Schedulability.Task extra) {
-            List<Schedulability.Task> all = new ArrayList<>(tasks.size() + 1);
-            for (Entry e : tasks) {
-                all.add(e.task);
-            }
-            if (extra != null) {
-                all.add(extra);
-            }
-            return all;
-        }
-
-        Fit test(Schedulability.Task t) {
-            double u = util + t.utilisation();
-            if (u > cap + 1e-9) {
-                return new Fit(false, "cpu " + id + ": utilisation " + Text.util(u) + " with '" + t.name()
-                        + "' exceeds cap " + Text.util(cap), Map.of());
-            }
-            if (rmOkWith(t) && hyper * (t.utilisation() + 1) <= 2 + 1e-12) {
-                return new Fit(true, null, Map.of());
-            }
-            List<Schedulability.Task> all = null;
-            Map<Entry, Long> newR = new HashMap<>();
-            // Only tasks whose processor demand in their deadline window exceeds the deadline
-            // need exact analysis: the new task, and those it delays (lower or equal priority).
-            Entry fresh = new Entry(t);
-            long d0 = t.wcetNs();
-            List<Entry> tight = new ArrayList<>();
-            for (Entry e : tasks) {
-                if (e.task.priority() >= t.priority()) {
-                    d0 += ceilDiv(t.deadlineNs(), e.task.periodNs()) * e.task.wcetNs();
-                }
-                if (e.task.priority() <= t.priority()
-                        && e.demand + ceilDiv(e.task.deadlineNs(), t.periodNs()) * t.wcetNs() > e.task.deadlineNs()) {
-                    tight.add(e);
-                }
-            }
-            // Most urgent first, so the first miss reported is the most telling one.
-            tight.sort(Comparator.comparingInt((Entry e) -> -e.task.priority()).thenComparing(e -> e.task.name()));
-            if (d0 > t.deadlineNs()) {
-                tight.add(0, fresh);
-            }
-            for (Entry e : tight) {
-                if (all == null) {
-                    all = taskList(t);
-                }
-                long start = Math.max(e.r, e.task.wcetNs());
-                long r = Schedulability.responseTime(e.task, all, start);
-                if (r < 0) {
-                    long shown = responseTimeForMessage(e.task, all, start);
-                    String rt = shown > 0 ? "response time " + Text.duration(shown) : "response time (unbounded)";
-                    String who = e == fresh ? rt + " of '" + t.name() + "'"
-                            : "adding '" + t.name() + "' gives " + rt + " of '" + e.task.name() + "', which";
-                    return new Fit(false, "cpu " + id + ": " + who + " exceeds deadline "
-                            + Text.duration(e.task.deadlineNs()) + " (U=" + Text.util(u) + ")", Map.of());
-                }
-                newR.put(e, r);
-            }
-            return new Fit(true, null, newR);
-        }
-
-        String testName() {
-            if (tasks.isEmpty()) {
-                return "none";
-            }
-            return rmOk && hyper <= 2 + 1e-12 ? "hyperbolic bound" : "response-time analysis";
-        }
-    }
-
-    /** The exact response time when it is finite and below 100 periods, else the last iterate, else -1. */
-    private static long responseTimeForMessage(Schedulability.Task t, List<Schedulability.Task> all, long start) {
-        double u = 0;
-        for (Schedulability.Task o : all) {
-            if (o != t && o.priority() >= t.priority()) {
-                u += o.utilisation();
-            }
-        }
-        if (u >= 1) {
-            return -1;
-        }
-        long limit = 100 * t.periodNs();
-        long r = Math.max(start, t.wcetNs());
-        for (int iter = 0; iter < 10_000; iter++) {
-            long next = t.wcetNs();
-            for (Schedulability.Task o : all) {
-                if (o != t && o.priority() >= t.priority()) {
-                    next += ((r + o.periodNs() - 1) / o.periodNs()) * o.wcetNs();
-                }
-            }
-            if (next == r || next > limit) {
-                return next;
-            }
-            r = next;
-        }
-        return r;
     }
 
     /** One admission run. */
@@ -319,7 +189,7 @@ public final class Admission {
         final TreeMap<Integer, Cpu> cpus = new TreeMap<>();
         final TreeMap<String, Decision> decisions = new TreeMap<>();
         final Map<String, Cpu> placedOn = new HashMap<>();
-        final Map<String, Entry> entryOf = new HashMap<>();
+        final Map<String, Task> taskOf = new HashMap<>();
         final Map<String, String> notes = new HashMap<>();
         final Set<String> admitted = new HashSet<>();
         /** CPUs named in {@code timing/@cpus} by an exclusive candidate not admitted yet: count per CPU. */
@@ -328,7 +198,7 @@ public final class Admission {
         long netUsed;
 
         Run(Collection<Contract> candidates, Collection<Wire> wires, Capacities caps, Map<String, Long> measured,
-                Map<String, Integer> previousCpu, Set<String> running) {
+                Map<String, Integer> previousCpu, Set<String> running, CpuAdmissionTest cpuTest) {
             for (Contract c : candidates) {
                 if (cands.put(c.name(), c) != null) {
                     throw new IllegalArgumentException("candidate '" + c.name() + "' given twice");
@@ -358,7 +228,7 @@ public final class Admission {
             this.previousCpu = previousCpu;
             this.running = running;
             for (Capacities.Cpu c : caps.cpus()) {
-                cpus.put(c.id(), new Cpu(c));
+                cpus.put(c.id(), new Cpu(c, cpuTest));
             }
             for (Contract c : cands.values()) {
                 if (isExclusive(c)) {
@@ -529,7 +399,6 @@ public final class Admission {
                         + " free";
             }
             Cpu chosen = null;
-            Fit fit = null;
             if (c.taskType() != Contract.TaskType.SERVICE) {
                 Timing t = c.timing();
                 long wcet = wcetOf(c);
@@ -544,9 +413,9 @@ public final class Admission {
                     return "timing: deadline " + Text.duration(t.deadlineNs()) + " is not in (0, period "
                             + Text.duration(t.periodNs()) + "]";
                 }
-                Schedulability.Task task;
+                Task task;
                 try {
-                    task = new Schedulability.Task(n, t.periodNs(), t.deadlineNs(), wcet, t.priority());
+                    task = new Task(n, t.periodNs(), t.deadlineNs(), wcet, t.priority());
                 } catch (IllegalArgumentException e) {
                     return "timing: " + e.getMessage() + (wcet > declared ? " (" + notes.get(n) + ")" : "");
                 }
@@ -600,13 +469,12 @@ public final class Admission {
                         why.add(excl);
                         continue;
                     }
-                    Fit f = cpu.test(task);
-                    if (f.ok()) {
+                    String no = cpu.test(task);
+                    if (no == null) {
                         chosen = cpu;
-                        fit = f;
                         break;
                     }
-                    why.add(f.reason());
+                    why.add(no);
                 }
                 if (chosen == null) {
                     String r = why.size() <= 3 ? String.join("; ", why)
@@ -614,20 +482,9 @@ public final class Admission {
                     return wcet > declared ? r + " (" + notes.get(n) + ")" : r;
                 }
                 Cpu cpu = chosen;
-                Entry e = new Entry(task);
-                Map<Entry, Long> old = new HashMap<>();
-                for (Map.Entry<Entry, Long> nr : fit.newR().entrySet()) {
-                    Entry x = nr.getKey();
-                    if (x.task == task) {
-                        e.r = nr.getValue();
-                    } else {
-                        old.put(x, x.r);
-                        x.r = nr.getValue();
-                    }
-                }
-                Runnable cpuUndo = cpu.add(e);
+                Runnable cpuUndo = cpu.add(task);
                 placedOn.put(n, cpu);
-                entryOf.put(n, e);
+                taskOf.put(n, task);
                 if (exclusive) {
                     cpu.owner = n;
                     for (int id : new TreeSet<>(t.cpus())) {
@@ -642,9 +499,8 @@ public final class Admission {
                         }
                     }
                     cpuUndo.run();
-                    old.forEach((x, r) -> x.r = r);
                     placedOn.remove(n);
-                    entryOf.remove(n);
+                    taskOf.remove(n);
                 });
             }
             memUsed += mem;
@@ -661,31 +517,13 @@ public final class Admission {
         AdmissionResult result() {
             List<CpuLoad> loads = new ArrayList<>();
             for (Cpu cpu : cpus.values()) {
-                String test = cpu.testName();
-                boolean rta = test.equals("response-time analysis");
-                List<Entry> sorted = new ArrayList<>(cpu.tasks);
-                sorted.sort(Comparator.comparingInt((Entry e) -> -e.task.priority()).thenComparing(e -> e.task.name()));
+                List<Task> sorted = new ArrayList<>(cpu.tasks);
+                sorted.sort(Comparator.comparingInt((Task t) -> -t.priority()).thenComparing(Task::name));
                 List<String> names = new ArrayList<>();
-                List<Schedulability.Task> ordered = new ArrayList<>(sorted.size());
-                for (Entry e : sorted) {
-                    ordered.add(e.task);
+                for (Task t : sorted) {
+                    names.add(t.name());
                 }
-                // Exact response times for display; each task only against the tasks of higher or
-                // equal priority (a prefix of the sorted list plus its equals).
-                int k = 0;
-                for (int i = 0; i < sorted.size(); i++) {
-                    Entry e = sorted.get(i);
-                    names.add(e.task.name());
-                    if (!rta) {
-                        e.r = -1;
-                        continue;
-                    }
-                    while (k < sorted.size() && sorted.get(k).task.priority() >= e.task.priority()) {
-                        k++;
-                    }
-                    e.r = Schedulability.responseTime(e.task, ordered.subList(0, k), Math.max(e.r, e.task.wcetNs()));
-                }
-                loads.add(new CpuLoad(cpu.id, cpu.cap, cpu.util, names, test));
+                loads.add(new CpuLoad(cpu.id, cpu.cap, cpu.util, names, cpu.analysis.proof()));
             }
             for (String n : admitted) {
                 Contract c = cands.get(n);
@@ -695,13 +533,13 @@ public final class Admission {
                 if (cpu == null) {
                     reason = "service task: no CPU budget";
                 } else {
-                    Entry e = entryOf.get(n);
-                    r = e.r;
+                    Task task = taskOf.get(n);
+                    r = cpu.analysis.responseTimeNs(n);
                     String where = "cpu " + cpu.id + (n.equals(cpu.owner) ? " (exclusive)" : "");
                     reason = r >= 0
-                            ? where + ": R=" + Text.duration(r) + " <= D=" + Text.duration(e.task.deadlineNs())
+                            ? where + ": R=" + Text.duration(r) + " <= D=" + Text.duration(task.deadlineNs())
                                     + " (U=" + Text.util(cpu.util) + ")"
-                            : where + ": hyperbolic bound holds (U=" + Text.util(cpu.util) + ")";
+                            : where + ": " + cpu.analysis.proof() + " holds (U=" + Text.util(cpu.util) + ")";
                     if (notes.containsKey(n)) {
                         reason += "; " + notes.get(n);
                     }

@@ -1,7 +1,7 @@
-package org.arflex.planner;
+package org.arflex.planner.impl;
 
-import static org.arflex.planner.C.MIB;
-import static org.arflex.planner.C.MS;
+import static org.arflex.planner.impl.C.MIB;
+import static org.arflex.planner.impl.C.MS;
 import static org.junit.jupiter.api.Assertions.assertEquals;
 import static org.junit.jupiter.api.Assertions.assertFalse;
 import static org.junit.jupiter.api.Assertions.assertTrue;
@@ -12,6 +12,9 @@ import java.util.OptionalInt;
 import java.util.Set;
 import org.arflex.contract.Contract;
 import org.junit.jupiter.api.Test;
+import org.arflex.planner.AdmissionResult;
+import org.arflex.planner.Capacities;
+import org.arflex.planner.Decision;
 
 class AdmissionTest {
 

@@ -1,17 +1,18 @@
-package org.arflex.planner;
+package org.arflex.planner.impl;
 
 import java.util.ArrayList;
 import java.util.List;
 import java.util.Locale;
+import org.arflex.planner.Capacities;
 
 /** Formatting of durations, sizes and rates for messages; fixed locale so output is stable. */
-final class Text {
+public final class Text {
 
     private Text() {
     }
 
     /** {@code 1 ms}, {@code 1.20 ms}, {@code 250 us}, {@code 3 s}, {@code 40 ns}. */
-    static String duration(long ns) {
+    public static String duration(long ns) {
         if (ns >= 1_000_000_000L) {
             return trim(ns / 1e9) + " s";
         }
@@ -25,7 +26,7 @@ final class Text {
     }
 
     /** {@code 512 MiB}, {@code 1.50 GiB}, {@code 12 KiB}, {@code 100 B}. */
-    static String bytes(long b) {
+    public static String bytes(long b) {
         if (b >= 1L << 30) {
             return trim(b / (double) (1L << 30)) + " GiB";
         }
@@ -39,7 +40,7 @@ final class Text {
     }
 
     /** {@code 12 MB/s}, {@code 1.50 kB/s} (decimal units, as network rates are quoted). */
-    static String rate(long bps) {
+    public static String rate(long bps) {
         if (bps >= 1_000_000_000L) {
             return trim(bps / 1e9) + " GB/s";
         }
@@ -53,7 +54,7 @@ final class Text {
     }
 
     /** Two decimals, trailing zeros dropped: 1, 1.2, 1.25. */
-    static String trim(double v) {
+    public static String trim(double v) {
         String s = String.format(Locale.ROOT, "%.2f", v);
         if (s.contains(".")) {
             s = s.replaceAll("0+$", "");
@@ -65,12 +66,12 @@ final class Text {
     }
 
     /** Utilisation with two decimals: {@code 0.97}. */
-    static String util(double u) {
+    public static String util(double u) {
         return String.format(Locale.ROOT, "%.2f", u);
     }
 
     /** {@code cpus 0(0.9) 1(0.9), memory 512 MiB, network 10 MB/s}. */
-    static String capacities(Capacities c) {
+    public static String capacities(Capacities c) {
         List<String> cpus = new ArrayList<>();
         for (Capacities.Cpu cpu : c.cpus()) {
             cpus.add(cpu.id() + "(" + trim(cpu.utilisationCap()) + ")");

@@ -1,4 +1,4 @@
-package org.arflex.planner;
+package org.arflex.planner.impl;
 
 import java.util.ArrayDeque;
 import java.util.ArrayList;
@@ -18,6 +18,8 @@ import org.arflex.contract.Binding;
 import org.arflex.contract.Contract;
 import org.arflex.contract.PortSpec;
 import org.arflex.planner.impl.LdapFilter;
+import org.arflex.planner.Satisfaction;
+import org.arflex.planner.Wire;
 
 /**
  * Incremental resolver: matches every input of the installed contracts to at most one output

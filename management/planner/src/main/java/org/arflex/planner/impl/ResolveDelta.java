@@ -1,9 +1,10 @@
-package org.arflex.planner;
+package org.arflex.planner.impl;
 
 import java.util.Collections;
 import java.util.List;
 import java.util.SortedSet;
 import java.util.TreeSet;
+import org.arflex.planner.Wire;
 
 /**
  * What one resolver change did. All sets are sorted and unmodifiable.
