@@ -214,7 +214,18 @@ public final class Activator implements BundleActivator {
         ticker.scheduleAtFixedRate(() -> actor.submit(() -> rm[0].overruns(cell.sample())), SAMPLE_MS, SAMPLE_MS,
                 TimeUnit.MILLISECONDS);
         tracker = new BundleTracker<>(ctx, ContractExtender.MASK, new ContractExtender(cell, reader, ctx,
-                (dir, name, source) -> executables.extract(dir, name, source::open), gateHook::refusal, log));
+                new ContractExtender.Extractor() {
+                    @Override
+                    public java.nio.file.Path extract(java.nio.file.Path dir, String name, ContractExtender.Opener source)
+                            throws java.io.IOException {
+                        return executables.extract(dir, name, source::open);
+                    }
+
+                    @Override
+                    public void forget(java.nio.file.Path exe) {
+                        executables.forget(exe);
+                    }
+                }, gateHook::refusal, log));
         tracker.open();
         log.accept("arflex: DRCR started, runtime id " + rid + ", cpus " + cpus + ", memory " + memory + ", network "
                 + network);

@@ -38,6 +38,8 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
         List<Contract> contracts = List.of();
         /** Names installed into the cell while the bundle is ACTIVE; null when not active. */
         List<String> active;
+        /** Executables extracted from this bundle (released when it is updated or uninstalled). */
+        final java.util.Set<Path> extracted = new java.util.HashSet<>();
     }
 
     private final Cell cell;
@@ -133,6 +135,9 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
     private void forget(Bundle bundle, Tracked t) {
         List<Contract> cs = t.contracts;
         t.contracts = List.of();
+        // the record of each copy holds a way back into this bundle revision: let both go
+        t.extracted.forEach(extractor::forget);
+        t.extracted.clear();
         cell.actor().call(() -> {
             for (Contract c : cs) {
                 cell.unregister(c.name(), bundle.getBundleId());
@@ -162,6 +167,7 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
             Path exe;
             try {
                 exe = extract(bundle, c.executable());
+                t.extracted.add(exe);
             } catch (IOException e) {
                 String p = label + ": cannot extract " + ContractReader.NATIVE_DIR + c.executable() + ": " + e.getMessage();
                 cell.actor().submit(() -> cell.problem(p));
@@ -214,9 +220,14 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
     }
 
     /** Copies an executable out of its bundle into a folder; returns where it is. */
-    @FunctionalInterface
     public interface Extractor {
         Path extract(Path dir, String name, Opener source) throws IOException;
+
+        /**
+         * The bundle {@code exe} came from was updated or uninstalled: its record (and with it
+         * the bundle revision its source reads from) is released; it is never run again.
+         */
+        void forget(Path exe);
     }
 
     /** Opens the bundle's entry again (the extractor may need to re-extract it). */

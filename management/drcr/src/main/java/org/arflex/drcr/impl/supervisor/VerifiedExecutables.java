@@ -79,6 +79,21 @@ public final class VerifiedExecutables {
         return target;
     }
 
+    /**
+     * Drops the record of {@code exe} (its bundle was updated or uninstalled): {@link #verify}
+     * refuses it from now on, and the record's source, which reads from the bundle, no longer
+     * keeps that bundle revision in memory (issue 17 finding 2: one record per install cycle
+     * was never released).
+     */
+    public void forget(Path exe) {
+        extracted.remove(exe.toAbsolutePath().normalize());
+    }
+
+    /** Records held (one per executable extracted and not forgotten). */
+    public int size() {
+        return extracted.size();
+    }
+
     /** The SHA-256 recorded for an extracted executable, or null. */
     public String recorded(Path exe) {
         Entry e = extracted.get(exe.toAbsolutePath().normalize());

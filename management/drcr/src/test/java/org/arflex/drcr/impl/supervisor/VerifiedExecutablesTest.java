@@ -68,6 +68,19 @@ class VerifiedExecutablesTest {
     }
 
     @Test
+    void aForgottenExecutableReleasesItsSourceAndIsNeverRunAgain(@TempDir Path root) throws IOException {
+        VerifiedExecutables v = new VerifiedExecutables(root, log::add);
+        Path a = v.extract(root.resolve("bundle7/native"), "rt", () -> new ByteArrayInputStream(new byte[] {1}));
+        Path b = v.extract(root.resolve("bundle8/native"), "rt", () -> new ByteArrayInputStream(new byte[] {2}));
+        assertEquals(2, v.size());
+        v.forget(a); // bundle 7 uninstalled
+        assertEquals(1, v.size(), "one record per bundle still installed, none per cycle");
+        IOException e = assertThrows(IOException.class, () -> v.verify(a));
+        assertTrue(e.getMessage().contains("not extracted from a bundle"), e.getMessage());
+        assertEquals(b, v.verify(b));
+    }
+
+    @Test
     void aReplacedExecutableIsExtractedAgainBeforeItRuns(@TempDir Path root) throws IOException {
         byte[] exe = script(root.resolve("ran").toString());
         VerifiedExecutables v = new VerifiedExecutables(root, log::add);
