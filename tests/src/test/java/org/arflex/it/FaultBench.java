@@ -48,7 +48,7 @@ class FaultBench {
      * Milliseconds from {@code at} to the first DRCR log line after {@code mark} that contains
      * {@code text} (the log's time of day, same clock); -1 when none comes within 10 s.
      */
-    private static double detection(Runtime rt, int mark, java.time.LocalTime at, String text) {
+    static double detection(Runtime rt, int mark, java.time.LocalTime at, String text) {
         String[] line = {null};
         try {
             rt.waitUntil("the DRCR's line '" + text + "'", 10_000, () -> {

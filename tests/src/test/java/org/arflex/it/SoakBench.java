@@ -1,0 +1,309 @@
+package org.arflex.it;
+
+import java.nio.charset.StandardCharsets;
+import java.nio.file.DirectoryStream;
+import java.nio.file.Files;
+import java.nio.file.Path;
+import java.util.ArrayList;
+import java.util.Collections;
+import java.util.List;
+import java.util.Locale;
+import java.util.Map;
+import java.util.Random;
+import java.util.concurrent.ExecutorService;
+import java.util.concurrent.Executors;
+import java.util.concurrent.Future;
+import java.util.concurrent.atomic.AtomicInteger;
+import java.util.regex.Matcher;
+import java.util.regex.Pattern;
+import org.junit.jupiter.api.Test;
+
+/**
+ * Supervision that never stalls and never leaks, over many cycles (issue 17): while an unrelated
+ * 1 kHz component runs (sample-counter with a 1 ms period), {@code arflex.bench.threads} workers
+ * each churn one component through install, Felix {@code update} and uninstall
+ * ({@code arflex.bench.cycles} cycles in all, over sample-scaler and debug-monitor: one worker
+ * each, at most two), and {@code arflex.bench.kills} kill -9 of a random running RT half of the
+ * churned components are spread over the run (the unrelated component is never killed: its
+ * latency is what is measured).
+ * Every {@code arflex.bench.every} cycles it samples the runtime JVM (heap after a full GC,
+ * threads, fds) and the cell's objects (shm, mq, RT processes). Prints a table, writes
+ * target/bench/soak.json, and ends with
+ * {@code soak: C cycles, K kills, heap slope S KB/1000 cycles, leaks L, max supervision stall X ms}.
+ *
+ * <p>"Supervision stall" is the longest time the DRCR was not answering: the longest
+ * {@code arflex:list} round trip through the shell during the churn, or the longest silence of
+ * its heartbeat round it logged (D17), whichever is longer. The workers share the runtime's one
+ * Gogo session, so their commands interleave but do not run in parallel inside Felix. Not a
+ * test: run by {@code ./arflex bench soak} only.
+ */
+class SoakBench {
+
+    private static final Pattern SILENT = Pattern.compile("heartbeat round was silent for (\\d+) ms");
+    private static final long T = 60_000;
+
+    private final List<Double> detections = Collections.synchronizedList(new ArrayList<>());
+    private final List<long[]> samples = Collections.synchronizedList(new ArrayList<>()); // cycles, heapKB, threads, fds, shm, mq, procs
+    private final AtomicInteger cycles = new AtomicInteger();
+    private volatile long maxShellMs;
+
+    /** The 1 kHz unrelated component. */
+    private static Path counter1kHz() throws Exception {
+        return Jars.withContract(CellIT.COUNTER, Files.createTempDirectory("arflex-soak").resolve("counter-1khz.jar"),
+                xml -> xml.replace("period=\"10ms\" deadline=\"10ms\"", "period=\"1ms\" deadline=\"1ms\""));
+    }
+
+    @Test
+    void soak() throws Exception {
+        int total = Integer.getInteger("arflex.bench.cycles", 300);
+        int kills = Integer.getInteger("arflex.bench.kills", 30);
+        int threads = Math.max(1, Math.min(2, Integer.getInteger("arflex.bench.threads", 2)));
+        int every = Math.max(1, Integer.getInteger("arflex.bench.every", Math.max(1, total / 10)));
+        Path[] churn = {CellIT.SCALER, DebugMonitorIT.DEBUGMON};
+        String[] names = {"sample-scaler", "debug-monitor"};
+        String rid;
+        CellChurnBench.Tally quiet = new CellChurnBench.Tally();
+        CellChurnBench.Tally busy = new CellChurnBench.Tally();
+        int killed = 0;
+        try (Runtime rt = new Runtime("soak")) {
+            rid = rt.rid;
+            rt.installAndStart(counter1kHz());
+            rt.awaitState("ACTIVE", T, "sample-counter");
+            long periodNs = 1_000_000L;
+            long jvm = rt.jvmPid();
+            sample(rt, jvm, rid);
+            // a quiet window as long as one sampling interval would take, at least 5 s
+            CellChurnBench.Snap q0 = snap(rt);
+            long quietEnd = System.nanoTime() + 5_000_000_000L;
+            rt.waitUntil("the quiet window", T, () -> System.nanoTime() > quietEnd);
+            CellChurnBench.Snap q1 = snap(rt);
+            quiet.add(q0, q1, periodNs, false);
+
+            Random rnd = new Random(Long.getLong("arflex.bench.seed", System.nanoTime()));
+            ExecutorService pool = Executors.newFixedThreadPool(threads);
+            List<Future<?>> workers = new ArrayList<>();
+            CellChurnBench.Snap b0 = snap(rt);
+            for (int w = 0; w < threads; w++) {
+                int k = w;
+                workers.add(pool.submit(() -> {
+                    while (cycles.get() < total) {
+                        cycle(rt, churn[k], names[k]);
+                        int c = cycles.incrementAndGet();
+                        if (c % every == 0) {
+                            sample(rt, jvm, rid);
+                        }
+                    }
+                    return null;
+                }));
+            }
+            // kills spread over the run, from this thread, with the shell answering in between
+            int killEvery = kills == 0 ? Integer.MAX_VALUE : Math.max(1, total / kills);
+            int nextKill = killEvery;
+            while (workers.stream().anyMatch(f -> !f.isDone())) {
+                long t0 = System.nanoTime();
+                rt.cmd("arflex:list");
+                maxShellMs = Math.max(maxShellMs, (System.nanoTime() - t0) / 1_000_000L);
+                if (killed < kills && cycles.get() >= nextKill) {
+                    if (killRandom(rt, rnd)) {
+                        killed++;
+                    }
+                    nextKill += killEvery;
+                }
+            }
+            for (Future<?> f : workers) {
+                f.get(); // a worker's failure is the bench's failure
+            }
+            pool.shutdown();
+            CellChurnBench.Snap b1 = snap(rt);
+            busy.add(b0, b1, periodNs, false);
+            sample(rt, jvm, rid);
+            long silence = 0;
+            for (String l : rt.logSince(0)) {
+                Matcher m = SILENT.matcher(l);
+                if (m.find()) {
+                    silence = Math.max(silence, Long.parseLong(m.group(1)));
+                }
+            }
+            maxShellMs = Math.max(maxShellMs, silence);
+        }
+        int leaks = leftovers(rid);
+        report(total, killed, quiet, busy, leaks);
+    }
+
+    /** One install -> update -> uninstall of one component. */
+    private void cycle(Runtime rt, Path jar, String name) {
+        long id = rt.installAndStart(jar);
+        rt.awaitState("ACTIVE", T, name);
+        long pid = rt.pid(name);
+        String u = rt.cmd("update " + id);
+        if (!u.isBlank()) {
+            throw new AssertionError("update " + id + ": " + u);
+        }
+        rt.waitUntil(name + " back after the update", T, () -> rt.activeWithNewPid(name, pid));
+        String r = rt.cmd("uninstall " + id);
+        if (!r.isBlank()) {
+            throw new AssertionError("uninstall " + id + ": " + r);
+        }
+        rt.waitUntil(name + " gone", T, () -> rt.instance(name) == null);
+    }
+
+    /** kill -9 of a random running RT half; the detection time is from the kill to the DRCR's line. */
+    private boolean killRandom(Runtime rt, Random rnd) throws Exception {
+        List<Map<String, Object>> live = new ArrayList<>();
+        for (Map<String, Object> i : Runtime.list(rt.dto(), "instances")) {
+            if (!"sample-counter".equals(i.get("name")) && "ACTIVE".equals(i.get("state"))
+                    && ((Number) i.get("pid")).longValue() > 0) {
+                live.add(i);
+            }
+        }
+        if (live.isEmpty()) {
+            return false;
+        }
+        Map<String, Object> victim = live.get(rnd.nextInt(live.size()));
+        String name = (String) victim.get("name");
+        long pid = ((Number) victim.get("pid")).longValue();
+        int mark = rt.logMark();
+        java.time.LocalTime at = java.time.LocalTime.now();
+        if (!Signals.tryToSend(pid, "9")) {
+            return false; // it went away by itself (an uninstall) in between
+        }
+        double d = FaultBench.detection(rt, mark, at, name + " (pid " + pid + ") ");
+        if (d >= 0) {
+            detections.add(d);
+        }
+        return true;
+    }
+
+    private static CellChurnBench.Snap snap(Runtime rt) {
+        return CellChurnBench.Snap.of(rt.instance("sample-counter"), System.nanoTime());
+    }
+
+    /** Heap after a full GC (KB), threads and fds of the JVM; the cell's shm, mq and RT processes. */
+    private void sample(Runtime rt, long jvm, String rid) throws Exception {
+        Path jcmd = Path.of(ProcessHandle.current().info().command().orElseThrow()).resolveSibling("jcmd");
+        run(jcmd.toString(), Long.toString(jvm), "GC.run");
+        String info = run(jcmd.toString(), Long.toString(jvm), "GC.heap_info");
+        Matcher m = Pattern.compile("used (\\d+)K").matcher(info);
+        long heapKb = m.find() ? Long.parseLong(m.group(1)) : -1;
+        long threads = 0;
+        for (String l : Files.readAllLines(Path.of("/proc/" + jvm + "/status"))) {
+            if (l.startsWith("Threads:")) {
+                threads = Long.parseLong(l.substring(8).trim());
+            }
+        }
+        long fds;
+        try (var s = Files.list(Path.of("/proc/" + jvm + "/fd"))) {
+            fds = s.count();
+        }
+        long shm = count("/dev/shm", rid);
+        long mq = count("/dev/mqueue", rid);
+        long procs = Runtime.rtProcesses(rid).size();
+        long c = cycles.get();
+        samples.add(new long[] {c, heapKb, threads, fds, shm, mq, procs});
+        System.out.printf(Locale.ROOT, "soak: %6d cycles  heap %7d KB  threads %4d  fds %4d  shm %3d  mq %3d  procs %2d%n", c,
+                heapKb, threads, fds, shm, mq, procs);
+    }
+
+    private static long count(String dir, String rid) throws Exception {
+        if (!Files.isDirectory(Path.of(dir))) {
+            return 0;
+        }
+        long n = 0;
+        try (DirectoryStream<Path> ds = Files.newDirectoryStream(Path.of(dir), "arflex." + rid + ".*")) {
+            for (Path ignored : ds) {
+                n++;
+            }
+        }
+        return n;
+    }
+
+    private static String run(String... cmd) throws Exception {
+        Process p = new ProcessBuilder(cmd).redirectErrorStream(true).start();
+        String out = new String(p.getInputStream().readAllBytes(), StandardCharsets.UTF_8);
+        if (p.waitFor() != 0) {
+            throw new AssertionError(String.join(" ", cmd) + ": " + out);
+        }
+        return out;
+    }
+
+    private static int leftovers(String rid) throws Exception {
+        int n = Runtime.rtProcesses(rid).size();
+        n += (int) count("/dev/shm", rid);
+        n += (int) count("/dev/mqueue", rid);
+        return n;
+    }
+
+    /** Least-squares slope of heap-after-GC against cycles, in KB per 1000 cycles (first sample dropped: warm-up). */
+    static double slopeKbPer1000(List<long[]> s) {
+        List<long[]> use = s.size() > 2 ? s.subList(1, s.size()) : s;
+        double n = use.size();
+        if (n < 2) {
+            return Double.NaN;
+        }
+        double sx = 0;
+        double sy = 0;
+        double sxx = 0;
+        double sxy = 0;
+        for (long[] v : use) {
+            sx += v[0];
+            sy += v[1];
+            sxx += (double) v[0] * v[0];
+            sxy += (double) v[0] * v[1];
+        }
+        double den = n * sxx - sx * sx;
+        return den == 0 ? Double.NaN : (n * sxy - sx * sy) / den * 1000.0;
+    }
+
+    private void report(int total, int killed, CellChurnBench.Tally quiet, CellChurnBench.Tally busy, int leaks)
+            throws Exception {
+        List<Double> d = new ArrayList<>(detections);
+        Collections.sort(d);
+        double slope = slopeKbPer1000(samples);
+        long[] first = samples.get(0);
+        long[] last = samples.get(samples.size() - 1);
+        System.out.println("soak: quantity              first      last");
+        String[] label = {"heap after GC (KB)", "JVM threads", "JVM fds", "shm objects", "mq objects", "RT processes"};
+        for (int i = 0; i < label.length; i++) {
+            System.out.printf(Locale.ROOT, "soak: %-20s %8d  %8d%n", label[i], first[i + 1], last[i + 1]);
+        }
+        System.out.printf(Locale.ROOT, "soak: 1 kHz counter      quiet p99 %s us, overruns %d | churn p99 %s us, overruns %d%n",
+                us(quiet.quantileUs(0.99)), quiet.overruns, us(busy.quantileUs(0.99)), busy.overruns);
+        System.out.printf(Locale.ROOT, "soak: exit detection     p50 %s ms, p99 %s ms, max %s ms (%d kills)%n", ms(pct(d, 50)),
+                ms(pct(d, 99)), ms(d.isEmpty() ? Double.NaN : d.get(d.size() - 1)), d.size());
+        StringBuilder js = new StringBuilder();
+        for (long[] v : samples) {
+            js.append(js.length() == 0 ? "" : ",").append(String.format(Locale.ROOT,
+                    "{\"cycles\":%d,\"heap_kb\":%d,\"threads\":%d,\"fds\":%d,\"shm\":%d,\"mq\":%d,\"procs\":%d}", v[0], v[1], v[2],
+                    v[3], v[4], v[5], v[6]));
+        }
+        Path out = Path.of(System.getProperty("arflex.bench.out", "target/bench/soak.json"));
+        Files.createDirectories(out.toAbsolutePath().getParent());
+        Files.writeString(out, String.format(Locale.ROOT,
+                "{\"cycles\":%d,\"kills\":%d,\"heap_slope_kb_per_1000\":%s,\"leaks\":%d,\"max_supervision_stall_ms\":%d,"
+                        + "\"detect_ms\":{\"p50\":%s,\"p99\":%s},\"quiet\":%s,\"churn\":%s,\"samples\":[%s]}%n",
+                cycles.get(), killed, num(slope), leaks, maxShellMs, num(pct(d, 50)), num(pct(d, 99)), quiet.json(), busy.json(), js));
+        System.out.println("JSON: " + out.toAbsolutePath());
+        System.out.printf(Locale.ROOT, "soak: %d cycles, %d kills, heap slope %.0f KB/1000 cycles, leaks %d, max supervision stall %d ms%n",
+                cycles.get(), killed, slope, leaks, maxShellMs);
+    }
+
+    private static double pct(List<Double> sorted, double p) {
+        if (sorted.isEmpty()) {
+            return Double.NaN;
+        }
+        int i = (int) Math.ceil(p / 100.0 * sorted.size()) - 1;
+        return sorted.get(Math.max(0, Math.min(sorted.size() - 1, i)));
+    }
+
+    private static String ms(double v) {
+        return Double.isNaN(v) ? "-" : String.format(Locale.ROOT, "%.1f", v);
+    }
+
+    private static String us(double v) {
+        return Double.isNaN(v) ? "-" : String.format(Locale.ROOT, "%.0f", v);
+    }
+
+    private static String num(double v) {
+        return Double.isNaN(v) || Double.isInfinite(v) ? "null" : String.format(Locale.ROOT, "%.2f", v);
+    }
+}
