@@ -154,6 +154,9 @@ struct arflex_port {
  *  @name without its NUL. The Java side computes the same hash. */
 ARFLEX_API uint64_t arflex_port_type_hash(const char *name);
 
+/** A port name as contracts and the ABI allow it: [a-z0-9_]{1,31}. Predicate. */
+ARFLEX_API bool arflex_port_name_valid(const char *name);
+
 /** Segment size for @spec (header + depth slots, rounded up to 4096). 0 if invalid. */
 ARFLEX_API size_t arflex_port_segment_size(const struct arflex_port_spec *spec);
 

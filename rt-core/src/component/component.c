@@ -167,21 +167,6 @@ int arflex_input_frame_acquire(struct arflex_input *in, struct arflex_frame_view
 
 /* ---- port declaration (configure) ---------------------------------------------------- */
 
-static bool port_name_valid(const char *s)
-{
-	size_t n = 0;
-
-	for (; s && s[n]; n++) {
-		char ch = s[n];
-
-		if (n >= ARFLEX_NAME_SIZE - 1)
-			return false;
-		if (!((ch >= 'a' && ch <= 'z') || (ch >= '0' && ch <= '9') || ch == '_'))
-			return false;
-	}
-	return n > 0;
-}
-
 int arflex_component_output(struct arflex_component *c, const char *port,
 			    enum arflex_port_method method, const struct arflex_port_type *type,
 			    struct arflex_port **out)
@@ -189,7 +174,7 @@ int arflex_component_output(struct arflex_component *c, const char *port,
 	char chan[ARFLEX_NAME_SIZE + 8], name[ARFLEX_OBJ_NAME_SIZE];
 	int r;
 
-	if (!c->configuring || !port_name_valid(port) || !type || !type->name)
+	if (!c->configuring || !arflex_port_name_valid(port) || !type || !type->name)
 		return -EINVAL;
 	for (unsigned i = 0; i < c->noutputs; i++)
 		if (!strcmp(c->output_names[i], port))
@@ -216,7 +201,7 @@ int arflex_component_input(struct arflex_component *c, const char *port,
 {
 	struct arflex_input *in;
 
-	if (!c->configuring || !port_name_valid(port) || !type || !type->name ||
+	if (!c->configuring || !arflex_port_name_valid(port) || !type || !type->name ||
 	    strlen(type->name) >= ARFLEX_TYPE_NAME_SIZE || method < ARFLEX_PORT_STATE ||
 	    method > ARFLEX_PORT_FRAME)
 		return -EINVAL;

@@ -12,21 +12,6 @@
 
 #define LOAD(p) __atomic_load_n((p), __ATOMIC_ACQUIRE)
 
-static bool port_name_valid(const char *s)
-{
-	size_t n = 0;
-
-	for (; s && s[n]; n++) {
-		char ch = s[n];
-
-		if (n >= ARFLEX_NAME_SIZE - 1)
-			return false;
-		if (!((ch >= 'a' && ch <= 'z') || (ch >= '0' && ch <= '9') || ch == '_'))
-			return false;
-	}
-	return n > 0;
-}
-
 static int create_ctl(struct arflex_host *h, const struct arflex_host_opts *o)
 {
 	void *base;
@@ -79,7 +64,7 @@ int arflex_host_create(struct arflex_host *h, const struct arflex_host_opts *o)
 		return -EINVAL;
 	}
 	for (unsigned i = 0; i < o->noutputs; i++) {
-		if (!port_name_valid(o->outputs[i].port) ||
+		if (!arflex_port_name_valid(o->outputs[i].port) ||
 		    !arflex_port_segment_size(&o->outputs[i].spec)) {
 			fprintf(stderr, "arflex host: %s: output port %u ('%s') has a bad name "
 				"([a-z0-9_]{1,31}) or spec\n", o->instance, i,

@@ -12,6 +12,21 @@
 #define STORE(p, v) __atomic_store_n((p), (v), __ATOMIC_RELEASE)
 #define STORER(p, v) __atomic_store_n((p), (v), __ATOMIC_RELAXED)
 
+bool arflex_port_name_valid(const char *s)
+{
+	size_t n = 0;
+
+	for (; s && s[n]; n++) {
+		char ch = s[n];
+
+		if (n >= ARFLEX_NAME_SIZE - 1)
+			return false;
+		if (!((ch >= 'a' && ch <= 'z') || (ch >= '0' && ch <= '9') || ch == '_'))
+			return false;
+	}
+	return n > 0;
+}
+
 uint64_t arflex_port_type_hash(const char *name)
 {
 	uint64_t h = UINT64_C(0xcbf29ce484222325);
