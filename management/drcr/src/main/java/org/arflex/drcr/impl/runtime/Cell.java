@@ -104,7 +104,6 @@ public final class Cell {
         plans.stopped(b);
     }
 
-
     /** Completes when every stop handed to the stop threads so far is recorded (any thread). */
     public CompletableFuture<Void> stopsDone() {
         return stops.idle();
