@@ -43,7 +43,7 @@ public class InstanceDTO {
     public StatsDTO stats;
     /**
      * Since 0.2.0: evaluation-only segments the DRCR created for this instance (port name ->
-     * shm object name, e.g. truth -> /arflex.rt1.sim-robot.out.truth), only when the runtime
+     * shm object name, e.g. truth -> /arflex.rt1.robot.out.truth), only when the runtime
      * runs with arflex.evaluation=true; never bound to a component, for evaluation tools to map
      * read-only. Empty otherwise.
      */

@@ -33,9 +33,9 @@ public final class Instance {
     /** Output port name -> segment; created at the first start, kept until destroyed. */
     final Map<String, RtLauncher.Output> outputs = new LinkedHashMap<>();
     /**
-     * Evaluation-only segments (not contract ports, never named in a BIND; simulator README
-     * "Ground truth"): port name -> segment, created with the outputs when the cell runs with
-     * arflex.evaluation, removed with them.
+     * Evaluation-only segments (not contract ports, never named in a BIND; {@link EvaluationSegments}):
+     * port name -> segment, created with the outputs when the cell runs with arflex.evaluation,
+     * removed with them.
      */
     final Map<String, RtLauncher.Output> evaluationOutputs = new LinkedHashMap<>();
     /** Read-only copy of {@link #evaluationOutputs}' names for snapshots: port -> shm name. */
@@ -51,7 +51,7 @@ public final class Instance {
     volatile String hangReason;
     Actor.Cancellable restartTimer;
     volatile long measuredWcetNs;
-    /** Execution-time counters at the previous sampling of this RT half (Cell.sample). */
+    /** Execution-time counters at the previous sampling of this RT half ({@link WcetMonitor}). */
     long sampledExecCount, sampledExecSum, sampledExecOver;
     /** An isolated WCET exceedance of this instance was logged already. */
     boolean transientWcetLogged;

@@ -11,7 +11,7 @@ import org.arflex.drcr.impl.supervisor.RtLauncher;
  * On an operator reset of a FAILED component, and when its RT half ends (a crash, or the kill
  * that follows damage seen while it ran, {@link #probe}): finds its damaged output segments (truncated,
  * header overwritten; {@link RtLauncher.Output#damage}) and removes them (unlink), so that the
- * restart the reset plans creates them anew (Cell.ensureOutputs) instead of failing the
+ * restart the reset plans creates them anew ({@link Segments#ensure}) instead of failing the
  * producer again on the same damaged segment. Consumers are rebound to the new segment by the
  * plan that restarts the producer.
  */

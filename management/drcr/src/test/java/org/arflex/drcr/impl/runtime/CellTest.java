@@ -152,15 +152,15 @@ class CellTest {
 
     @Test
     void sustainedMeansAtLeastOnePercentOfAWindowOrAMeanAboveTheWcet() {
-        assertFalse(Cell.sustainedOverWcet(50_000, 1000, 1000 * 20_000L, 9));
-        assertTrue(Cell.sustainedOverWcet(50_000, 1000, 1000 * 20_000L, 10));
-        assertFalse(Cell.sustainedOverWcet(50_000, 30, 30 * 20_000L, 2));   // a 30 Hz task: 3 cycles at least
-        assertTrue(Cell.sustainedOverWcet(50_000, 30, 30 * 20_000L, 3));
-        assertTrue(Cell.sustainedOverWcet(50_000, 1000, 1000 * 60_000L, 0)); // mean above
+        assertFalse(WcetMonitor.sustainedOverWcet(50_000, 1000, 1000 * 20_000L, 9));
+        assertTrue(WcetMonitor.sustainedOverWcet(50_000, 1000, 1000 * 20_000L, 10));
+        assertFalse(WcetMonitor.sustainedOverWcet(50_000, 30, 30 * 20_000L, 2));   // a 30 Hz task: 3 cycles at least
+        assertTrue(WcetMonitor.sustainedOverWcet(50_000, 30, 30 * 20_000L, 3));
+        assertTrue(WcetMonitor.sustainedOverWcet(50_000, 1000, 1000 * 60_000L, 0)); // mean above
         // above the histogram's 200 us the over count is an upper bound: only the mean decides
-        assertFalse(Cell.sustainedOverWcet(300_000, 1000, 1000 * 250_000L, 1000));
-        assertTrue(Cell.sustainedOverWcet(300_000, 1000, 1000 * 310_000L, 1000));
-        assertFalse(Cell.sustainedOverWcet(50_000, 0, 0, 0));
+        assertFalse(WcetMonitor.sustainedOverWcet(300_000, 1000, 1000 * 250_000L, 1000));
+        assertTrue(WcetMonitor.sustainedOverWcet(300_000, 1000, 1000 * 310_000L, 1000));
+        assertFalse(WcetMonitor.sustainedOverWcet(50_000, 0, 0, 0));
     }
 
     @Test
@@ -426,10 +426,10 @@ class CellTest {
         Contract p = parse(periodic);
         Contract s = parse(periodic.replace("task=\"periodic\"", "task=\"service\"").replace(" priority=\"80\"", ""));
         assertEquals(Contract.TaskType.SERVICE, s.taskType());
-        assertEquals(0, Cell.controlConfig(p, 1, false).cfgFlags() & ControlBlock.CFG_NO_MLOCK);
-        assertEquals(ControlBlock.CFG_NO_MLOCK, Cell.controlConfig(s, 1, false).cfgFlags() & ControlBlock.CFG_NO_MLOCK);
-        assertEquals(0, Cell.controlConfig(s, 1, false).priority());
-        assertEquals(ControlBlock.CFG_NO_MLOCK, Cell.controlConfig(p, 1, true).cfgFlags() & ControlBlock.CFG_NO_MLOCK);
+        assertEquals(0, ControlSetup.config(p, 1, false).cfgFlags() & ControlBlock.CFG_NO_MLOCK);
+        assertEquals(ControlBlock.CFG_NO_MLOCK, ControlSetup.config(s, 1, false).cfgFlags() & ControlBlock.CFG_NO_MLOCK);
+        assertEquals(0, ControlSetup.config(s, 1, false).priority());
+        assertEquals(ControlBlock.CFG_NO_MLOCK, ControlSetup.config(p, 1, true).cfgFlags() & ControlBlock.CFG_NO_MLOCK);
     }
 
     @Test
