@@ -1,16 +1,14 @@
 package org.arflex.webconsole.impl;
 
 import jakarta.servlet.Servlet;
-import jakarta.servlet.http.HttpServletRequest;
-import java.io.IOException;
-import java.util.LinkedHashMap;
-import java.util.Map;
+import org.osgi.service.component.annotations.Activate;
 import org.osgi.service.component.annotations.Component;
 import org.osgi.service.component.annotations.Reference;
 
 /**
  * Audit page: the newest entries of the console's audit log ({@link AuditLog}, written by
- * {@link AuditFilter}) and the bundles {@link MarkupGate} keeps from resolving.
+ * {@link AuditFilter}) and the bundles {@link MarkupGate} keeps from resolving; its endpoint,
+ * {@code api/audit} ({@link AuditBackend}), is served by this page only.
  */
 @Component(service = Servlet.class, property = {
     "felix.webconsole.label=arflex-audit",
@@ -18,8 +16,6 @@ import org.osgi.service.component.annotations.Reference;
     "felix.webconsole.category=ARFLEX"})
 public class AuditPlugin extends PluginBase {
     private static final long serialVersionUID = 1L;
-    /** Most entries one answer carries. */
-    static final int MAX_ENTRIES = 500;
 
     @Reference
     private Backend backend;
@@ -27,10 +23,21 @@ public class AuditPlugin extends PluginBase {
     private AuditFilter audit;
     @Reference
     private MarkupGate gate;
+    private Routes routes;
+
+    @Activate
+    void activate() {
+        routes = new Routes().add(backend.routes()).add(new AuditBackend(audit, gate).routes());
+    }
 
     @Override
     Backend backend() {
         return backend;
+    }
+
+    @Override
+    Routes routes() {
+        return routes;
     }
 
     @Override
@@ -41,27 +48,5 @@ public class AuditPlugin extends PluginBase {
     @Override
     String label() {
         return "arflex-audit";
-    }
-
-    @Override
-    Object pageGet(String what, HttpServletRequest req) throws HttpError, IOException {
-        if (!what.equals("audit")) {
-            return super.pageGet(what, req);
-        }
-        int max = MAX_ENTRIES;
-        String n = req.getParameter("max");
-        if (n != null) {
-            try {
-                max = Math.max(1, Math.min(MAX_ENTRIES, Integer.parseInt(n)));
-            } catch (NumberFormatException e) {
-                throw new HttpError(400, "max: '" + n + "' is not a number");
-            }
-        }
-        AuditLog log = audit.log();
-        Map<String, Object> m = new LinkedHashMap<>();
-        m.put("file", log.file().toString());
-        m.put("entries", log.recent(max));
-        m.put("refusedBundles", gate.refusals());
-        return m;
     }
 }

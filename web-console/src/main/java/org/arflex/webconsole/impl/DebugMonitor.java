@@ -98,7 +98,7 @@ final class DebugMonitor {
             }
             String c = t.substring(0, dot);
             String p = t.substring(dot + 1);
-            Backend.checkName(c);
+            Names.checkName(c);
             if (!PORT.matcher(p).matches()) {
                 throw new HttpError(400, "targets: '" + p + "' is not a port name ([a-z0-9_]{1,31})");
             }

@@ -9,4 +9,10 @@ final class HttpError extends Exception {
         super(message);
         this.status = status;
     }
+
+    /** An exception's message, or its class when it has none. */
+    static String reason(RuntimeException e) {
+        String m = e.getMessage();
+        return m == null || m.isBlank() ? e.getClass().getSimpleName() : m;
+    }
 }

@@ -4,7 +4,6 @@ import jakarta.servlet.ServletException;
 import jakarta.servlet.http.HttpServletRequest;
 import jakarta.servlet.http.HttpServletResponse;
 import java.io.IOException;
-import java.io.InputStream;
 import java.io.OutputStream;
 import java.io.PrintWriter;
 import java.nio.charset.StandardCharsets;
@@ -36,6 +35,11 @@ abstract class PluginBase extends AbstractServlet {
     private static final AtomicInteger STREAMS = new AtomicInteger();
 
     abstract Backend backend();
+
+    /** The JSON endpoints this page serves: every page backend's (see {@link Backend}). */
+    Routes routes() {
+        return backend().routes();
+    }
 
     /** The page name, also the name of its script ({@code res/arflex/<page>.js}). */
     abstract String page();
@@ -77,7 +81,7 @@ abstract class PluginBase extends AbstractServlet {
             return;
         }
         if (r.startsWith("/api/")) {
-            handle(req, resp, () -> get(r.substring(5), req));
+            new ApiCall(req, resp, backend().json).answer(call -> routes().answerGet(r.substring(5), call));
             return;
         }
         // Anything else: leave the response untouched, the Web Console renders the page.
@@ -86,108 +90,15 @@ abstract class PluginBase extends AbstractServlet {
     @Override
     protected void doPost(HttpServletRequest req, HttpServletResponse resp) throws IOException {
         String r = route(req);
-        String why = Csrf.refusal(req);
-        if (why != null) {
-            req.setAttribute(AuditFilter.REASON, why);
-            send(resp, 403, Map.of("error", why));
+        ApiCall api = new ApiCall(req, resp, backend().json);
+        if (api.refusedCrossSite()) {
             return;
         }
         if (!r.startsWith("/api/")) {
-            req.setAttribute(AuditFilter.REASON, "no endpoint " + r);
-            send(resp, 404, Map.of("error", "no endpoint " + r));
+            api.refuse(404, "no endpoint " + r);
             return;
         }
-        handle(req, resp, () -> post(r.substring(5), req));
-    }
-
-    private interface Action {
-        Object run() throws HttpError, IOException;
-    }
-
-    private void handle(HttpServletRequest req, HttpServletResponse resp, Action a) throws IOException {
-        try {
-            send(resp, 200, a.run());
-        } catch (HttpError e) {
-            req.setAttribute(AuditFilter.REASON, e.getMessage());
-            send(resp, e.status, Map.of("error", e.getMessage()));
-        } catch (RuntimeException e) {
-            String why = e.getClass().getSimpleName() + ": " + e.getMessage();
-            req.setAttribute(AuditFilter.REASON, why);
-            send(resp, 500, Map.of("error", why));
-        }
-    }
-
-    private void send(HttpServletResponse resp, int status, Object body) throws IOException {
-        setNoCache(resp);
-        resp.setStatus(status);
-        resp.setContentType("application/json");
-        resp.setCharacterEncoding("UTF-8");
-        resp.setHeader("X-Content-Type-Options", "nosniff");
-        byte[] b = backend().json.writeValueAsBytes(body);
-        resp.setContentLength(b.length);
-        try (OutputStream out = resp.getOutputStream()) {
-            out.write(b);
-        }
-    }
-
-    /** The JSON read endpoints (shared by all pages). */
-    private Object get(String what, HttpServletRequest req) throws HttpError, IOException {
-        Backend b = backend();
-        String name = req.getParameter("name");
-        return switch (what) {
-            case "cell" -> b.cell();
-            case "component" -> b.component(name);
-            case "histogram" -> b.histogram(name);
-            case "contracts" -> Map.of("saved", b.savedContracts());
-            case "contract" -> Map.of("name", name, "xml", b.loadContract(name));
-            case "plan-uninstall" -> b.planUninstall(name);
-            case "port" -> b.portValue(name, req.getParameter("port"));
-            case "ports" -> b.watchablePorts();
-            case "debug" -> b.debugStatus();
-            default -> pageGet(what, req);
-        };
-    }
-
-    /** A read endpoint of one page only; none by default. */
-    Object pageGet(String what, HttpServletRequest req) throws HttpError, IOException {
-        throw new HttpError(404, "no endpoint /api/" + what);
-    }
-
-    /** The state-changing endpoints (CSRF already checked). */
-    private Object post(String what, HttpServletRequest req) throws HttpError, IOException {
-        Backend b = backend();
-        String name = req.getParameter("name");
-        return switch (what) {
-            case "param" -> b.setParam(name, req.getParameter("param"), req.getParameter("value"));
-            case "command" -> b.command(name, req.getParameter("cmd"));
-            case "reset-cell" -> Map.of("result", b.resetCell());
-            case "stage-url" -> b.stageUrl(req.getParameter("url"), req.getParameter("sha256"));
-            case "stage-upload" -> {
-                try (InputStream in = req.getInputStream()) {
-                    yield b.stageUpload(in, req.getParameter("file"));
-                }
-            }
-            case "install" -> b.installStaged(req.getParameter("id"));
-            case "discard" -> b.discard(req.getParameter("id"));
-            case "uninstall" -> b.uninstall(name);
-            // A dry run, but it makes the DRCR download the update: CSRF-checked like stage-url.
-            case "plan-update" -> b.planUpdate(name);
-            case "update" -> b.update(name, req.getParameter("sha256"));
-            case "validate" -> Map.of("problems", b.validate(body(req), "editor.xml"));
-            case "save" -> b.saveContract(name, body(req));
-            case "debug-stage" -> b.debugStage(req.getParameter("targets"));
-            default -> throw new HttpError(404, "no endpoint /api/" + what);
-        };
-    }
-
-    private static String body(HttpServletRequest req) throws IOException, HttpError {
-        try (InputStream in = req.getInputStream()) {
-            byte[] b = in.readNBytes((1 << 20) + 1);
-            if (b.length > 1 << 20) {
-                throw new HttpError(413, "contract larger than 1 MiB refused");
-            }
-            return new String(b, StandardCharsets.UTF_8);
-        }
+        api.answer(call -> routes().answerPost(r.substring(5), call));
     }
 
     /**
@@ -197,17 +108,18 @@ abstract class PluginBase extends AbstractServlet {
      */
     private void stream(HttpServletRequest req, HttpServletResponse resp) throws IOException {
         String name = req.getParameter("name");
+        ApiCall api = new ApiCall(req, resp, backend().json);
         Sampler.Key key;
         try {
-            Backend.checkName(name);
-            key = new Sampler.Key(name, Backend.portList(req.getParameter("ports")));
+            Names.checkName(name);
+            key = new Sampler.Key(name, Names.portList(req.getParameter("ports")));
         } catch (HttpError e) {
-            send(resp, 400, Map.of("error", e.getMessage()));
+            api.send(400, Map.of("error", e.getMessage()));
             return;
         }
         if (STREAMS.incrementAndGet() > MAX_STREAMS) {
             STREAMS.decrementAndGet();
-            send(resp, 503, Map.of("error", "too many live streams open (" + MAX_STREAMS + ")"));
+            api.send(503, Map.of("error", "too many live streams open (" + MAX_STREAMS + ")"));
             return;
         }
         Sampler s = backend().sampler;
@@ -215,7 +127,7 @@ abstract class PluginBase extends AbstractServlet {
             s.subscribe(key);
         } catch (IllegalStateException e) {
             STREAMS.decrementAndGet();
-            send(resp, 503, Map.of("error", e.getMessage()));
+            api.send(503, Map.of("error", e.getMessage()));
             return;
         }
         try {

@@ -30,11 +30,12 @@ import org.junit.jupiter.api.io.TempDir;
  * The Deploy page's dry runs: a plan the DRCR could not make is an error naming why, never a
  * plan text that could be confirmed (update and staged installs alike).
  */
-class BackendPlanTest {
+class DeployBackendPlanTest {
     @TempDir
     Path dir;
 
     private final Backend backend = new Backend();
+    private DeployBackend deploy;
     private final List<String> updated = new ArrayList<>();
     private ContractDTO scaler;
     private Function<String, String> planUpdate;
@@ -47,7 +48,8 @@ class BackendPlanTest {
         scaler.version = "1.0.0";
         scaler.updateUrl = "file:/tmp/scaler-v2.jar";
         scaler.updateSha256 = "ab".repeat(32);
-        backend.dataDir = dir;
+        deploy = new DeployBackend(backend, new StagingArea(backend, dir.resolve("staging")), dir.resolve("installed"),
+                StagingSources.parse(null));
         backend.drcr = new DrcrService() {
             @Override
             public CellDTO cell() {
@@ -101,7 +103,7 @@ class BackendPlanTest {
     @Test
     void anUpdatePlanCarriesTheDrcrTextAndThePinItWasMadeFor() throws Exception {
         planUpdate = n -> "update of " + n + " from file:/tmp/scaler-v2.jar (sha256 verified)\nactions:\n  RESTART  " + n;
-        Map<String, Object> m = backend.planUpdate("sample-scaler");
+        Map<String, Object> m = deploy.planUpdate("sample-scaler");
         assertEquals("sample-scaler", m.get("component"));
         assertEquals("1.0.0", m.get("version"));
         assertEquals(scaler.updateUrl, m.get("updateUrl"));
@@ -115,7 +117,7 @@ class BackendPlanTest {
         planUpdate = n -> {
             throw new IllegalStateException(n + ": its contract has no update URL");
         };
-        HttpError e = assertThrows(HttpError.class, () -> backend.planUpdate("sample-scaler"));
+        HttpError e = assertThrows(HttpError.class, () -> deploy.planUpdate("sample-scaler"));
         assertEquals(409, e.status);
         assertEquals("cannot plan the update of sample-scaler: its contract has no update URL", e.getMessage());
 
@@ -123,7 +125,7 @@ class BackendPlanTest {
             throw new IllegalStateException(n + ": update not installed, the old version keeps running: SHA-256 of"
                     + " file:/tmp/scaler-v2.jar is 00, the contract pins ab");
         };
-        e = assertThrows(HttpError.class, () -> backend.planUpdate("sample-scaler"));
+        e = assertThrows(HttpError.class, () -> deploy.planUpdate("sample-scaler"));
         assertEquals(409, e.status);
         assertTrue(e.getMessage().startsWith("cannot plan the update of sample-scaler: update not installed")
                 && e.getMessage().contains("SHA-256"), e.getMessage());
@@ -131,25 +133,25 @@ class BackendPlanTest {
         planUpdate = n -> {
             throw new NullPointerException();
         };
-        e = assertThrows(HttpError.class, () -> backend.planUpdate("sample-scaler"));
+        e = assertThrows(HttpError.class, () -> deploy.planUpdate("sample-scaler"));
         assertEquals("cannot plan the update of sample-scaler: NullPointerException", e.getMessage());
 
-        e = assertThrows(HttpError.class, () -> backend.planUpdate("nope"));
+        e = assertThrows(HttpError.class, () -> deploy.planUpdate("nope"));
         assertEquals(404, e.status);
         assertTrue(e.getMessage().contains("no component named 'nope'"), e.getMessage());
-        assertEquals(400, assertThrows(HttpError.class, () -> backend.planUpdate("<b>")).status);
+        assertEquals(400, assertThrows(HttpError.class, () -> deploy.planUpdate("<b>")).status);
         assertTrue(updated.isEmpty());
     }
 
     @Test
     void anUpdateIsRefusedWhenTheContractPinsSomethingElseThanThePlanShown() throws Exception {
-        HttpError e = assertThrows(HttpError.class, () -> backend.update("sample-scaler", "cd".repeat(32)));
+        HttpError e = assertThrows(HttpError.class, () -> deploy.update("sample-scaler", "cd".repeat(32)));
         assertEquals(409, e.status);
         assertTrue(e.getMessage().contains("plan the update again") && e.getMessage().contains(scaler.updateSha256),
                 e.getMessage());
         assertTrue(updated.isEmpty());
         assertEquals("sample-scaler: updated to 1.1.0",
-                backend.update("sample-scaler", scaler.updateSha256.toUpperCase()).get("report"));
+                deploy.update("sample-scaler", scaler.updateSha256.toUpperCase()).get("report"));
         assertEquals(List.of("sample-scaler"), updated);
     }
 
@@ -176,7 +178,7 @@ class BackendPlanTest {
         };
         HttpError e;
         try (InputStream in = bundle("org.example.unplannable")) {
-            e = assertThrows(HttpError.class, () -> backend.stageUpload(in, "unplannable.jar"));
+            e = assertThrows(HttpError.class, () -> deploy.stageUpload(in, "unplannable.jar"));
         }
         assertEquals(409, e.status);
         assertTrue(e.getMessage().startsWith("the DRCR could not plan the install of org.example.unplannable 1.0.0")
@@ -186,7 +188,7 @@ class BackendPlanTest {
         planInstall = loc -> "plan: install\nactions:\n  START    x";
         Map<String, Object> ok;
         try (InputStream in = bundle("org.example.fine")) {
-            ok = backend.stageUpload(in, "fine.jar");
+            ok = deploy.stageUpload(in, "fine.jar");
         }
         assertFalse(((String) ok.get("id")).isBlank(), "a real plan gets an id to confirm");
         assertTrue(((String) ok.get("plan")).contains("START"));
