@@ -113,6 +113,7 @@ final class CellPorts {
     /** ctl.flags bits (rt-core/include/arflex/control.h): safe hook running, operator reset needed. */
     static final int FLAG_SAFE_ACTIVE = 1 << 2;
     static final int FLAG_RESET_REQUIRED = 1 << 3;
+    static final int FLAG_SUPERVISOR_LOST = 1 << 6;
 
     /** The RT half's flags word of a control block segment (offset 28), or 0 when it is gone. */
     static int ctlFlags(Path ctl) {

@@ -273,14 +273,18 @@ class FaultBench {
                 List<Path> ctls = ctlFiles(r18);
                 long t0 = System.nanoTime();
                 rt.crash();
-                try {
-                    rt.waitUntil("every RT half flagged SUPERVISOR_LOST and safe", 10_000, () -> ctls.stream().allMatch(p -> {
-                        int f = CellPorts.ctlFlags(p);
-                        return (f & 64) != 0 && (f & 4) != 0;
-                    }));
+                // polled every millisecond (not the 50 ms of waitUntil): the time is the figure
+                long deadline = t0 + 10_000_000_000L;
+                while (!ctls.stream().allMatch(p -> {
+                    int f = CellPorts.ctlFlags(p);
+                    return (f & CellPorts.FLAG_SUPERVISOR_LOST) != 0 && (f & CellPorts.FLAG_SAFE_ACTIVE) != 0;
+                }) && System.nanoTime() < deadline) {
+                    java.util.concurrent.locks.LockSupport.parkNanos(1_000_000L);
+                }
+                if (System.nanoTime() < deadline) {
                     safeMs = (System.nanoTime() - t0) / 1e6;
-                } catch (AssertionError e) {
-                    System.out.println("faults: S18 " + e.getMessage().lines().findFirst().orElse(""));
+                } else {
+                    System.out.println("faults: S18 not every RT half flagged SUPERVISOR_LOST and safe within 10 s");
                 }
                 try {
                     rt.waitUntil("the orphans gone with their objects", 30_000,
