@@ -117,7 +117,7 @@ public final class PortReader {
                 Thread.onSpinWait();
                 continue;
             }
-            long stamp = b.getLong(at + 8);
+            long stamp = b.getLong(at + Layout.OFF_SLOT_HDR_STAMP_NS);
             b.get(at + PortSegment.SLOT_HDR_SIZE, out, 0, bytes);
             VarHandle.acquireFence();
             long s2 = (long) LONGS.getAcquire(b, at);
