@@ -18,8 +18,8 @@ import java.nio.ByteOrder;
 public final class PortReader {
 
     private static final VarHandle LONGS = MethodHandles.byteBufferViewVarHandle(long[].class, ByteOrder.LITTLE_ENDIAN);
-    /** Seqlock attempts per read, as the C reader. */
-    static final int ATTEMPTS = 16;
+    /** Seqlock attempts per read, as the C reader (ARFLEX_STATE_READ_RETRIES). */
+    static final int ATTEMPTS = Layout.STATE_READ_RETRIES;
 
     /** A copied value: element index, producer stamp, payload bytes, and the header's head. */
     public record Value(long index, long stampNs, byte[] payload, long published) {
