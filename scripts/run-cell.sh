@@ -18,6 +18,8 @@ set -euo pipefail
 umask 077
 RUNTIME_DIR=${1:?runtime directory}
 HEADLESS=${2:-}
+# rt-core's shared-memory offsets for the summary below, generated from its headers.
+LAYOUT_ENV=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)/layout.env
 cd "$RUNTIME_DIR"
 
 if [ -n "$HEADLESS" ] && ! [[ "$HEADLESS" =~ ^[0-9]+$ ]]; then
@@ -83,32 +85,37 @@ done < conf/system.properties
 LOG=$(mktemp "$ARFLEX_HOME/runtime.XXXXXX.log")
 trap 'rm -f "$LOG" "$CONF" ${CREDS_TMP:+"$CREDS_TMP"} ${TLS_PASS:+"$TLS_PASS"}' EXIT
 
-# The cell's summary, read straight from the ports in shared memory (state seqlock, rt-core
-# ABI 1.0: value seq at byte 256, payload at 320). The TRUE error is |true TCP - nominal FK of
+# The cell's summary, read straight from the ports in shared memory (state seqlock of slot 0,
+# rt-core ABI.md §4) at the offsets of scripts/layout.env, generated from rt-core's headers
+# (docs/DECISIONS.md D22). The TRUE error is |true TCP - nominal FK of
 # the program's reference| at rest (the same definition as the accuracy benchmark); the nominal
 # forward kinematics are the simulator's default arm (simulator/README.md, "The arm").
 summary() {
   local rid
   rid=$(sed -n 's/.*arflex: DRCR started, runtime id \([a-z0-9-]*\),.*/\1/p' "$LOG" | head -1)
   [ -n "$rid" ] || return 0
-  python3 - "$rid" <<'PY' >&2 || true
+  python3 - "$rid" "$LAYOUT_ENV" <<'PY' >&2 || true
 import glob, math, mmap, struct, sys
 rid = sys.argv[1]
+with open(sys.argv[2]) as f:
+    L = {k: int(v, 0) for k, v in (l.strip().split("=", 1) for l in f if "=" in l and not l.startswith("#"))}
+SEQ = L["PORT_HDR_SIZE"] + L["OFF_SLOT_HDR_SEQ"]  # slot 0's seqlock word
+VAL = L["PORT_HDR_SIZE"] + L["SLOT_HDR_SIZE"]     # slot 0's value
 def port(inst, name, size):
     path = "/dev/shm/arflex.%s.%s.out.%s" % (rid, inst, name)
     try:
         with open(path, "rb") as f:
-            m = mmap.mmap(f.fileno(), 320 + size, prot=mmap.PROT_READ)
+            m = mmap.mmap(f.fileno(), VAL + size, prot=mmap.PROT_READ)
     except OSError:
         return None
     for _ in range(100):
-        s1 = struct.unpack_from("<Q", m, 256)[0]
+        s1 = struct.unpack_from("<Q", m, SEQ)[0]
         if s1 == 0:
             return None
         if s1 & 1:
             continue
-        v = m[320:320 + size]
-        if struct.unpack_from("<Q", m, 256)[0] == s1:
+        v = m[VAL:VAL + size]
+        if struct.unpack_from("<Q", m, SEQ)[0] == s1:
             return v
     return None
 def fk(q):
@@ -132,11 +139,11 @@ waiting = []
 for c in sorted(ctls):
     try:
         with open(c, "rb") as f:
-            f.seek(28)
+            f.seek(L["OFF_CTL_FLAGS"])
             flags = struct.unpack("<I", f.read(4))[0]
     except OSError:
         continue
-    if flags & 8:  # ARFLEX_FLAG_RESET_REQUIRED: safe mode until the operator's reset
+    if flags & L["FLAG_RESET_REQUIRED"]:  # safe mode until the operator's reset
         waiting.append(c.split("/arflex.%s." % rid, 1)[1][:-4])
 if waiting:
     parts.append("WAITING FOR AN OPERATOR RESET (safe mode): %s (arflex:reset <name>)" % " ".join(waiting))

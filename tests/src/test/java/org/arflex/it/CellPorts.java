@@ -7,11 +7,12 @@ import java.nio.MappedByteBuffer;
 import java.nio.channels.FileChannel;
 import java.nio.file.Path;
 import java.nio.file.StandardOpenOption;
+import org.arflex.drcr.impl.abi.Layout;
 
 /**
- * Read-only views of the cell's state ports in shared memory (rt-core ABI 1.0: segment header
- * 256 bytes, slot 0 with its 64-byte slot header whose first word is the seqlock, odd while the
- * writer writes; the value from byte 320). Records of the port types used by CellE2EIT: the
+ * Read-only views of the cell's state ports in shared memory (rt-core ABI: slot 0 after the segment
+ * header, its slot header's first word the seqlock, odd while the writer writes, then the value;
+ * offsets from the generated {@link Layout}, see Ports). Records of the port types used by CellE2EIT: the
  * field offsets are those of contracts/types (arflex.JointRef, arflex.JointState, arflex.Sample)
  * and of the simulator's evaluation-only eval.GroundTruth (simulator/README.md, "Ground truth").
  */
@@ -29,7 +30,7 @@ final class CellPorts {
         State(Path segment, int size) throws IOException {
             this.size = size;
             ch = FileChannel.open(segment, StandardOpenOption.READ);
-            b = ch.map(FileChannel.MapMode.READ_ONLY, 0, 320 + size);
+            b = ch.map(FileChannel.MapMode.READ_ONLY, 0, Ports.SLOT0_VALUE + size);
             b.order(ByteOrder.LITTLE_ENDIAN);
         }
 
@@ -37,7 +38,7 @@ final class CellPorts {
         ByteBuffer read() {
             byte[] v = new byte[size];
             for (int attempt = 0; attempt < 1000; attempt++) {
-                long s1 = b.getLong(256);
+                long s1 = b.getLong(Ports.SLOT0_SEQ);
                 if (s1 == 0) {
                     return null;
                 }
@@ -45,8 +46,8 @@ final class CellPorts {
                     Thread.onSpinWait();
                     continue;
                 }
-                b.get(320, v);
-                if (b.getLong(256) == s1) {
+                b.get(Ports.SLOT0_VALUE, v);
+                if (b.getLong(Ports.SLOT0_SEQ) == s1) {
                     return ByteBuffer.wrap(v).order(ByteOrder.LITTLE_ENDIAN);
                 }
             }
@@ -111,15 +112,15 @@ final class CellPorts {
     }
 
     /** ctl.flags bits (rt-core/include/arflex/control.h): safe hook running, operator reset needed. */
-    static final int FLAG_SAFE_ACTIVE = 1 << 2;
-    static final int FLAG_RESET_REQUIRED = 1 << 3;
-    static final int FLAG_SUPERVISOR_LOST = 1 << 6;
+    static final int FLAG_SAFE_ACTIVE = Layout.FLAG_SAFE_ACTIVE;
+    static final int FLAG_RESET_REQUIRED = Layout.FLAG_RESET_REQUIRED;
+    static final int FLAG_SUPERVISOR_LOST = Layout.FLAG_SUPERVISOR_LOST;
 
-    /** The RT half's flags word of a control block segment (offset 28), or 0 when it is gone. */
+    /** The RT half's flags word of a control block segment (ctl.flags), or 0 when it is gone. */
     static int ctlFlags(Path ctl) {
         try (FileChannel ch = FileChannel.open(ctl, StandardOpenOption.READ)) {
             ByteBuffer b = ByteBuffer.allocate(4).order(ByteOrder.LITTLE_ENDIAN);
-            if (ch.read(b, 28) != 4) {
+            if (ch.read(b, Layout.OFF_CTL_FLAGS) != 4) {
                 return 0;
             }
             return b.getInt(0);

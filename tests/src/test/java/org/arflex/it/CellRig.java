@@ -352,8 +352,8 @@ final class CellRig {
     }
 
     /**
-     * One state port mapped read-only (rt-core ABI 1.0 §4: slot 0 header at 256, its seq odd
-     * while the writer writes, the value at 320). Every cell type starts with t_ns/seq (or
+     * One state port mapped read-only (rt-core ABI.md §4: slot 0's seq at Ports.SLOT0_SEQ, odd
+     * while the writer writes, the value at Ports.SLOT0_VALUE). Every cell type starts with t_ns/seq (or
      * seq/t_ns for arflex.Sample) followed by f64/u32 fields read by offset.
      */
     static final class Port implements AutoCloseable {
@@ -374,7 +374,7 @@ final class CellRig {
         java.nio.ByteBuffer read() {
             byte[] v = new byte[size];
             for (int attempt = 0; attempt < 100; attempt++) {
-                long s1 = b.getLong(256);
+                long s1 = b.getLong(Ports.SLOT0_SEQ);
                 if (s1 == 0) {
                     return null;
                 }
@@ -382,8 +382,8 @@ final class CellRig {
                     Thread.onSpinWait();
                     continue;
                 }
-                b.get(320, v);
-                if (b.getLong(256) == s1) {
+                b.get(Ports.SLOT0_VALUE, v);
+                if (b.getLong(Ports.SLOT0_SEQ) == s1) {
                     return java.nio.ByteBuffer.wrap(v).order(ByteOrder.LITTLE_ENDIAN);
                 }
             }

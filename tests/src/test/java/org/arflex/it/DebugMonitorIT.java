@@ -39,7 +39,7 @@ class DebugMonitorIT {
     static final long T = 30_000;
     static final String[] PAIR = {"sample-counter", "sample-scaler"};
 
-    /** A state port of arflex.Sample mapped once (ABI 1.0 §4: slot 0 at 256, payload at 320). */
+    /** A state port of arflex.Sample mapped once (ABI.md §4: slot 0 and its value at Ports.SLOT0_SEQ/SLOT0_VALUE). */
     static final class StatePort implements AutoCloseable {
         private final FileChannel ch;
         private final MappedByteBuffer b;
@@ -53,15 +53,16 @@ class DebugMonitorIT {
         /** The current value, or null (never written, or torn on every attempt). */
         Ports.Sample read() {
             for (int attempt = 0; attempt < 100; attempt++) {
-                long s1 = b.getLong(256);
+                long s1 = b.getLong(Ports.SLOT0_SEQ);
                 if (s1 == 0) {
                     return null;
                 }
                 if ((s1 & 1) != 0) {
                     continue;
                 }
-                Ports.Sample v = new Ports.Sample(b.getLong(320), b.getLong(328), b.getDouble(336));
-                if (b.getLong(256) == s1) {
+                Ports.Sample v = new Ports.Sample(b.getLong(Ports.SLOT0_VALUE), b.getLong(Ports.SLOT0_VALUE + 8),
+                        b.getDouble(Ports.SLOT0_VALUE + 16));
+                if (b.getLong(Ports.SLOT0_SEQ) == s1) {
                     return v;
                 }
             }

@@ -6,13 +6,19 @@ import java.nio.MappedByteBuffer;
 import java.nio.channels.FileChannel;
 import java.nio.file.Path;
 import java.nio.file.StandardOpenOption;
+import org.arflex.drcr.impl.abi.Layout;
 
 /**
- * Reads an arflex.Sample state port straight from its shared-memory segment (rt-core ABI 1.0:
- * 256-byte header, slot 0 with a 64-byte slot header whose seq is odd while the writer writes,
- * then the 24-byte value: seq u64, t_ns i64, value f64).
+ * Reads an arflex.Sample state port straight from its shared-memory segment (rt-core ABI: the
+ * segment header, then slot 0 with its slot header whose seq is odd while the writer writes,
+ * then the 24-byte value: seq u64, t_ns i64, value f64). The offsets are rt-core's, generated
+ * from its headers ({@link Layout}, DECISIONS.md D22).
  */
 final class Ports {
+
+    /** Slot 0 of a state port: its seqlock word and the first byte of its value. */
+    static final int SLOT0_SEQ = Layout.PORT_HDR_SIZE + Layout.OFF_SLOT_HDR_SEQ;
+    static final int SLOT0_VALUE = Layout.PORT_HDR_SIZE + Layout.SLOT_HDR_SIZE;
 
     record Sample(long seq, long tNs, double value) {
     }
@@ -26,15 +32,15 @@ final class Ports {
             MappedByteBuffer b = ch.map(FileChannel.MapMode.READ_ONLY, 0, 4096);
             b.order(ByteOrder.LITTLE_ENDIAN);
             for (int attempt = 0; attempt < 100; attempt++) {
-                long s1 = b.getLong(256);
+                long s1 = b.getLong(SLOT0_SEQ);
                 if (s1 == 0) {
                     return null;
                 }
                 if ((s1 & 1) != 0) {
                     continue;
                 }
-                Sample v = new Sample(b.getLong(320), b.getLong(328), b.getDouble(336));
-                long s2 = b.getLong(256);
+                Sample v = new Sample(b.getLong(SLOT0_VALUE), b.getLong(SLOT0_VALUE + 8), b.getDouble(SLOT0_VALUE + 16));
+                long s2 = b.getLong(SLOT0_SEQ);
                 if (s1 == s2) {
                     return v;
                 }

@@ -5,8 +5,9 @@ import java.util.List;
 
 /**
  * The control block segment {@code /arflex.<rid>.<inst>.ctl}: Java side of
- * rt-core/include/arflex/control.h (struct arflex_ctl). The offsets below are that layout;
- * ControlBlockLayoutTest compiles a C program against the header and compares them.
+ * rt-core/include/arflex/control.h (struct arflex_ctl). The offsets below are that layout, taken
+ * from {@link Layout}, which is generated from the header (DECISIONS.md D22); ControlBlockLayoutTest
+ * checks that each name here is the C member it says.
  *
  * <p>Who writes what (control.h): the manager writes header, config and parameter descriptors
  * before the spawn, then only {@code runtime_hb_ns} and the parameter request words; everything
@@ -14,117 +15,117 @@ import java.util.List;
  */
 public final class ControlBlock implements AutoCloseable {
 
-    public static final long MAGIC = 0x4C5443584C465241L; // "ARFLXCTL"
-    public static final int ABI_MAJOR = 1;
-    public static final int ABI_MINOR = 2;
-    public static final int SIZE = 40960;
+    public static final long MAGIC = Layout.CTL_MAGIC; // "ARFLXCTL"
+    public static final int ABI_MAJOR = Layout.ABI_MAJOR;
+    public static final int ABI_MINOR = Layout.ABI_MINOR;
+    public static final int SIZE = Layout.CTL_SIZE;
 
     // header
-    public static final int OFF_MAGIC = 0;
-    public static final int OFF_ABI_MAJOR = 8;
-    public static final int OFF_ABI_MINOR = 10;
-    public static final int OFF_HEADER_SIZE = 12;
-    public static final int OFF_SIZE = 16;
-    public static final int OFF_STATE = 24;
-    public static final int OFF_FLAGS = 28;
-    public static final int OFF_PID = 32;
-    public static final int OFF_EXIT_STATUS = 36;
-    public static final int OFF_RUNTIME_HB = 40;
-    public static final int OFF_RT_HB = 48;
+    public static final int OFF_MAGIC = Layout.OFF_CTL_MAGIC;
+    public static final int OFF_ABI_MAJOR = Layout.OFF_CTL_ABI_MAJOR;
+    public static final int OFF_ABI_MINOR = Layout.OFF_CTL_ABI_MINOR;
+    public static final int OFF_HEADER_SIZE = Layout.OFF_CTL_HEADER_SIZE;
+    public static final int OFF_SIZE = Layout.OFF_CTL_SIZE;
+    public static final int OFF_STATE = Layout.OFF_CTL_STATE;
+    public static final int OFF_FLAGS = Layout.OFF_CTL_FLAGS;
+    public static final int OFF_PID = Layout.OFF_CTL_PID;
+    public static final int OFF_EXIT_STATUS = Layout.OFF_CTL_EXIT_STATUS;
+    public static final int OFF_RUNTIME_HB = Layout.OFF_CTL_RUNTIME_HB_NS;
+    public static final int OFF_RT_HB = Layout.OFF_CTL_RT_HB_NS;
     /** ctl.hold (uint32): why the component holds the arm by itself; cause | detail << 8 | input << 16. */
-    public static final int OFF_HOLD = 56;
-    public static final int HOLD_NONE = 0;
-    public static final int HOLD_SAFETY_INPUT = 1;
-    public static final int HOLD_AWAIT_COMMAND = 2;
-    public static final int HOLD_REFERENCE = 3;
+    public static final int OFF_HOLD = Layout.OFF_CTL_HOLD;
+    public static final int HOLD_NONE = Layout.HOLD_NONE;
+    public static final int HOLD_SAFETY_INPUT = Layout.HOLD_SAFETY_INPUT;
+    public static final int HOLD_AWAIT_COMMAND = Layout.HOLD_AWAIT_COMMAND;
+    public static final int HOLD_REFERENCE = Layout.HOLD_REFERENCE;
     /** Detail of HOLD_REFERENCE: the newest reference value was rejected (arflex_hold_reference_detail). */
-    public static final int HOLD_REF_INVALID = 1;
+    public static final int HOLD_REF_INVALID = Layout.HOLD_REF_INVALID;
     // config (struct arflex_ctl_config at 64)
-    public static final int OFF_CONFIG = 64;
-    public static final int OFF_CFG_PERIOD = 64;
-    public static final int OFF_CFG_DEADLINE = 72;
-    public static final int OFF_CFG_HB_TIMEOUT = 80;
-    public static final int OFF_CFG_CPU_MASK = 88;
-    public static final int OFF_CFG_PRIORITY = 96;
-    public static final int OFF_CFG_TASK_TYPE = 100;
-    public static final int OFF_CFG_SAFE_MODE = 104;
-    public static final int OFF_CFG_FLAGS = 108;
-    public static final int OFF_CFG_PARAM_COUNT = 112;
+    public static final int OFF_CONFIG = Layout.OFF_CTL_CONFIG;
+    public static final int OFF_CFG_PERIOD = Layout.OFF_CTL_CONFIG_PERIOD_NS;
+    public static final int OFF_CFG_DEADLINE = Layout.OFF_CTL_CONFIG_DEADLINE_NS;
+    public static final int OFF_CFG_HB_TIMEOUT = Layout.OFF_CTL_CONFIG_HB_TIMEOUT_NS;
+    public static final int OFF_CFG_CPU_MASK = Layout.OFF_CTL_CONFIG_CPU_MASK;
+    public static final int OFF_CFG_PRIORITY = Layout.OFF_CTL_CONFIG_PRIORITY;
+    public static final int OFF_CFG_TASK_TYPE = Layout.OFF_CTL_CONFIG_TASK_TYPE;
+    public static final int OFF_CFG_SAFE_MODE = Layout.OFF_CTL_CONFIG_SAFE_MODE;
+    public static final int OFF_CFG_FLAGS = Layout.OFF_CTL_CONFIG_CFG_FLAGS;
+    public static final int OFF_CFG_PARAM_COUNT = Layout.OFF_CTL_CONFIG_PARAM_COUNT;
     /** config.orphan_hold_ns (ABI 1.1, ABI.md 6.2). */
-    public static final int OFF_CFG_ORPHAN_HOLD = 120;
-    public static final int OFF_WARNINGS = 128;
-    public static final int WARN_KINDS = 16;
+    public static final int OFF_CFG_ORPHAN_HOLD = Layout.OFF_CTL_CONFIG_ORPHAN_HOLD_NS;
+    public static final int OFF_WARNINGS = Layout.OFF_CTL_WARNINGS;
+    public static final int WARN_KINDS = Layout.WARN_KINDS;
     /** enum arflex_warn_kind ARFLEX_WARN_FORGED: mailbox requests with a wrong token ignored. */
-    public static final int WARN_FORGED = 11;
+    public static final int WARN_FORGED = Layout.WARN_FORGED;
     // stats (struct arflex_stats at 256)
-    public static final int OFF_STATS = 256;
-    public static final int OFF_STATS_SEQ = 256;
-    public static final int OFF_STATS_CYCLES = 264;
-    public static final int OFF_STATS_OVERRUNS = 272;
-    public static final int OFF_STATS_MISSED = 280;
-    public static final int OFF_STATS_DEADLINE_MISSES = 288;
-    public static final int OFF_STATS_UPDATE_ERRORS = 296;
-    public static final int OFF_STATS_SAFE_CYCLES = 304;
-    public static final int OFF_STATS_LAST_RELEASE = 312;
-    public static final int OFF_STATS_LATENCY = 320;
-    public static final int METRIC_SIZE = 16128;
-    public static final int OFF_STATS_EXEC = OFF_STATS_LATENCY + METRIC_SIZE;
+    public static final int OFF_STATS = Layout.OFF_CTL_STATS;
+    public static final int OFF_STATS_SEQ = Layout.OFF_CTL_STATS_SEQ;
+    public static final int OFF_STATS_CYCLES = Layout.OFF_CTL_STATS_CYCLES;
+    public static final int OFF_STATS_OVERRUNS = Layout.OFF_CTL_STATS_OVERRUNS;
+    public static final int OFF_STATS_MISSED = Layout.OFF_CTL_STATS_MISSED_PERIODS;
+    public static final int OFF_STATS_DEADLINE_MISSES = Layout.OFF_CTL_STATS_DEADLINE_MISSES;
+    public static final int OFF_STATS_UPDATE_ERRORS = Layout.OFF_CTL_STATS_UPDATE_ERRORS;
+    public static final int OFF_STATS_SAFE_CYCLES = Layout.OFF_CTL_STATS_SAFE_CYCLES;
+    public static final int OFF_STATS_LAST_RELEASE = Layout.OFF_CTL_STATS_LAST_RELEASE_NS;
+    public static final int OFF_STATS_LATENCY = Layout.OFF_CTL_STATS_LATENCY;
+    public static final int METRIC_SIZE = Layout.SIZEOF_METRIC;
+    public static final int OFF_STATS_EXEC = Layout.OFF_CTL_STATS_EXEC;
     // within struct arflex_metric
-    public static final int METRIC_COUNT = 0;
-    public static final int METRIC_MIN = 8;
-    public static final int METRIC_MAX = 16;
-    public static final int METRIC_SUM = 24;
-    public static final int METRIC_HIST = 64;
-    public static final int HIST_BIN_NS = 100;
-    public static final int HIST_BINS = 2000;
+    public static final int METRIC_COUNT = Layout.OFF_METRIC_COUNT;
+    public static final int METRIC_MIN = Layout.OFF_METRIC_MIN_NS;
+    public static final int METRIC_MAX = Layout.OFF_METRIC_MAX_NS;
+    public static final int METRIC_SUM = Layout.OFF_METRIC_SUM_NS;
+    public static final int METRIC_HIST = Layout.OFF_METRIC_HIST;
+    public static final int HIST_BIN_NS = Layout.HIST_BIN_NS;
+    public static final int HIST_BINS = Layout.HIST_BINS;
     // parameters
-    public static final int OFF_PARAMS = 32576;
+    public static final int OFF_PARAMS = Layout.OFF_CTL_PARAMS;
     /** ABI 1.2: rejected values per input, 16 slots of (uint32 name hash, uint32 count). */
-    public static final int OFF_INPUTS = 40768;
-    public static final int INPUT_SLOTS = 16;
-    public static final int PARAM_SLOTS = 64;
-    public static final int SLOT_SIZE = 128;
-    public static final int SLOT_NAME = 0;
-    public static final int NAME_SIZE = 32;
-    public static final int SLOT_TYPE = 32;
-    public static final int SLOT_FLAGS = 36;
-    public static final int SLOT_MIN = 40;
-    public static final int SLOT_MAX = 48;
-    public static final int SLOT_DEFAULT = 56;
-    public static final int SLOT_REQ_SEQ = 64;
-    public static final int SLOT_REQ_VALUE = 72;
-    public static final int SLOT_APPLIED_SEQ = 80;
-    public static final int SLOT_APPLIED_VALUE = 88;
-    public static final int SLOT_APPLIED_STATUS = 96;
+    public static final int OFF_INPUTS = Layout.OFF_CTL_INPUTS;
+    public static final int INPUT_SLOTS = Layout.CTL_INPUTS;
+    public static final int PARAM_SLOTS = Layout.PARAM_SLOTS;
+    public static final int SLOT_SIZE = Layout.SIZEOF_PARAM_SLOT;
+    public static final int SLOT_NAME = Layout.OFF_PARAM_SLOT_NAME;
+    public static final int NAME_SIZE = Layout.NAME_SIZE;
+    public static final int SLOT_TYPE = Layout.OFF_PARAM_SLOT_TYPE;
+    public static final int SLOT_FLAGS = Layout.OFF_PARAM_SLOT_FLAGS;
+    public static final int SLOT_MIN = Layout.OFF_PARAM_SLOT_MIN_BITS;
+    public static final int SLOT_MAX = Layout.OFF_PARAM_SLOT_MAX_BITS;
+    public static final int SLOT_DEFAULT = Layout.OFF_PARAM_SLOT_DEFAULT_BITS;
+    public static final int SLOT_REQ_SEQ = Layout.OFF_PARAM_SLOT_REQ_SEQ;
+    public static final int SLOT_REQ_VALUE = Layout.OFF_PARAM_SLOT_REQ_VALUE;
+    public static final int SLOT_APPLIED_SEQ = Layout.OFF_PARAM_SLOT_APPLIED_SEQ;
+    public static final int SLOT_APPLIED_VALUE = Layout.OFF_PARAM_SLOT_APPLIED_VALUE;
+    public static final int SLOT_APPLIED_STATUS = Layout.OFF_PARAM_SLOT_APPLIED_STATUS;
 
     // enum arflex_rt_state
-    public static final int STATE_CREATED = 0;
-    public static final int STATE_CONFIGURING = 1;
-    public static final int STATE_READY = 2;
-    public static final int STATE_RUNNING = 3;
-    public static final int STATE_STOPPING = 4;
-    public static final int STATE_EXITED = 5;
-    public static final int STATE_FAILED = 6;
+    public static final int STATE_CREATED = Layout.STATE_CREATED;
+    public static final int STATE_CONFIGURING = Layout.STATE_CONFIGURING;
+    public static final int STATE_READY = Layout.STATE_READY;
+    public static final int STATE_RUNNING = Layout.STATE_RUNNING;
+    public static final int STATE_STOPPING = Layout.STATE_STOPPING;
+    public static final int STATE_EXITED = Layout.STATE_EXITED;
+    public static final int STATE_FAILED = Layout.STATE_FAILED;
     private static final String[] STATE_NAMES = {"CREATED", "CONFIGURING", "READY", "RUNNING", "STOPPING", "EXITED", "FAILED"};
 
     // flags / cfg flags / enums
-    public static final int FLAG_SCHED_FIFO = 1;
-    public static final int FLAG_MLOCKALL = 2;
-    public static final int FLAG_SAFE_ACTIVE = 4;
-    public static final int FLAG_RESET_REQUIRED = 8;
+    public static final int FLAG_SCHED_FIFO = Layout.FLAG_SCHED_FIFO;
+    public static final int FLAG_MLOCKALL = Layout.FLAG_MLOCKALL;
+    public static final int FLAG_SAFE_ACTIVE = Layout.FLAG_SAFE_ACTIVE;
+    public static final int FLAG_RESET_REQUIRED = Layout.FLAG_RESET_REQUIRED;
     /** The RT half saw EOF on its supervisor pipe (fd 0): it is an orphan (ABI.md 6.2). */
-    public static final int FLAG_SUPERVISOR_LOST = 64;
-    public static final int CFG_MOVES_HARDWARE = 1;
-    public static final int CFG_NO_MLOCK = 2;
-    public static final int CFG_NO_DMA_LATENCY = 4;
+    public static final int FLAG_SUPERVISOR_LOST = Layout.FLAG_SUPERVISOR_LOST;
+    public static final int CFG_MOVES_HARDWARE = Layout.CFG_MOVES_HARDWARE;
+    public static final int CFG_NO_MLOCK = Layout.CFG_NO_MLOCK;
+    public static final int CFG_NO_DMA_LATENCY = Layout.CFG_NO_DMA_LATENCY;
     /** fd 0 of the RT half is a pipe the supervisor holds open for the half's life (ABI.md 6.2). */
-    public static final int CFG_SUPERVISOR_PIPE = 8;
+    public static final int CFG_SUPERVISOR_PIPE = Layout.CFG_SUPERVISOR_PIPE;
     /** The contract's default {@code fault/@orphanHold}. */
     public static final long DEFAULT_ORPHAN_HOLD_NS = 2_000_000_000L;
-    public static final int PARAM_BOOL = 1;
-    public static final int PARAM_INT64 = 2;
-    public static final int PARAM_DOUBLE = 3;
-    public static final int PARAM_MUTABLE = 1;
+    public static final int PARAM_BOOL = Layout.PARAM_BOOL;
+    public static final int PARAM_INT64 = Layout.PARAM_INT64;
+    public static final int PARAM_DOUBLE = Layout.PARAM_DOUBLE;
+    public static final int PARAM_MUTABLE = Layout.PARAM_MUTABLE;
 
     /**
      * Configuration written before spawn. {@code orphanHoldNs}: how long an RT half that lost its
@@ -300,8 +301,9 @@ public final class ControlBlock implements AutoCloseable {
         for (String n : names) {
             int hash = inputHash(n);
             for (int k = 0; k < INPUT_SLOTS; k++) {
-                if (shm.getIntAcquire(OFF_INPUTS + 8 * k) == hash) {
-                    out.put(n, Integer.toUnsignedLong(shm.getIntAcquire(OFF_INPUTS + 8 * k + 4)));
+                int at = OFF_INPUTS + Layout.SIZEOF_INPUT_COUNT * k;
+                if (shm.getIntAcquire(at + Layout.OFF_INPUT_COUNT_NAME_HASH) == hash) {
+                    out.put(n, Integer.toUnsignedLong(shm.getIntAcquire(at + Layout.OFF_INPUT_COUNT_REJECTS)));
                     break;
                 }
             }

@@ -16,46 +16,51 @@ import java.util.Optional;
  * <p>Every request carries the instance's token (ABI.md 5, DECISIONS.md D13), which the RT half
  * got as the first 8 bytes on its supervisor pipe; it ignores requests with another token, and
  * a reply with another token is not from it and is discarded here.
+ *
+ * <p>The offsets and codes below come from {@link Layout}, generated from the header
+ * (DECISIONS.md D22).
  */
 public final class Mailbox implements AutoCloseable {
 
-    public static final int MSG_MAGIC = 0x534D4641; // "AFMS"
-    public static final int MSG_SIZE = 512;
-    public static final int MQ_MAXMSG = 8;
-    public static final int OFF_MAGIC = 0;
-    public static final int OFF_ABI_MAJOR = 4;
-    public static final int OFF_ABI_MINOR = 6;
-    public static final int OFF_SEQ = 8;
-    public static final int OFF_CMD = 12;
-    public static final int OFF_FLAGS = 14;
-    public static final int OFF_STATUS = 16;
-    public static final int OFF_PAYLOAD_LEN = 20;
-    public static final int OFF_TOKEN = 24;
-    public static final int OFF_PAYLOAD = 32;
-    public static final int FLAG_REPLY = 1;
+    public static final int MSG_MAGIC = Layout.MSG_MAGIC; // "AFMS"
+    public static final int MSG_SIZE = Layout.MSG_SIZE;
+    public static final int MQ_MAXMSG = Layout.MQ_MAXMSG;
+    public static final int OFF_MAGIC = Layout.OFF_MSG_MAGIC;
+    public static final int OFF_ABI_MAJOR = Layout.OFF_MSG_ABI_MAJOR;
+    public static final int OFF_ABI_MINOR = Layout.OFF_MSG_ABI_MINOR;
+    public static final int OFF_SEQ = Layout.OFF_MSG_SEQ;
+    public static final int OFF_CMD = Layout.OFF_MSG_CMD;
+    public static final int OFF_FLAGS = Layout.OFF_MSG_FLAGS;
+    public static final int OFF_STATUS = Layout.OFF_MSG_STATUS;
+    public static final int OFF_PAYLOAD_LEN = Layout.OFF_MSG_PAYLOAD_LEN;
+    public static final int OFF_TOKEN = Layout.OFF_MSG_TOKEN;
+    public static final int OFF_PAYLOAD = Layout.OFF_MSG_U;
+    public static final int FLAG_REPLY = Layout.MSG_REPLY;
     // struct arflex_msg_param, relative to the payload
-    public static final int PARAM_INDEX = 0;
-    public static final int PARAM_TYPE = 4;
-    public static final int PARAM_VALUE = 8;
-    public static final int PARAM_APPLIED_SEQ = 16;
-    public static final int PARAM_NAME = 24;
-    public static final int PARAM_SIZE = 56;
+    public static final int PARAM_INDEX = Layout.OFF_MSG_PARAM_INDEX;
+    public static final int PARAM_TYPE = Layout.OFF_MSG_PARAM_TYPE;
+    public static final int PARAM_VALUE = Layout.OFF_MSG_PARAM_VALUE;
+    public static final int PARAM_APPLIED_SEQ = Layout.OFF_MSG_PARAM_APPLIED_SEQ;
+    public static final int PARAM_NAME = Layout.OFF_MSG_PARAM_NAME;
+    public static final int PARAM_SIZE = Layout.SIZEOF_MSG_PARAM;
     // struct arflex_msg_bind
-    public static final int BIND_PORT = 0;
-    public static final int BIND_SHM_NAME = 32;
-    public static final int BIND_SIZE = 160;
-    public static final int OBJ_NAME_SIZE = 128;
+    public static final int BIND_PORT = Layout.OFF_MSG_BIND_PORT;
+    public static final int BIND_SHM_NAME = Layout.OFF_MSG_BIND_SHM_NAME;
+    public static final int BIND_SIZE = Layout.SIZEOF_MSG_BIND;
+    public static final int OBJ_NAME_SIZE = Layout.OBJ_NAME_SIZE;
     // struct arflex_msg_state
-    public static final int STATE_STATE = 0;
-    public static final int STATE_FLAGS = 4;
-    public static final int STATE_PID = 8;
-    public static final int STATE_BOUND = 12;
-    public static final int STATE_CYCLES = 16;
+    public static final int STATE_STATE = Layout.OFF_MSG_STATE_STATE;
+    public static final int STATE_FLAGS = Layout.OFF_MSG_STATE_FLAGS;
+    public static final int STATE_PID = Layout.OFF_MSG_STATE_PID;
+    public static final int STATE_BOUND = Layout.OFF_MSG_STATE_BOUND_INPUTS;
+    public static final int STATE_CYCLES = Layout.OFF_MSG_STATE_CYCLES;
 
     /** enum arflex_cmd. */
     public enum Cmd {
-        START(1), STOP(2), SET_PARAM(3), GET_PARAM(4), BIND(5), UNBIND(6), GET_STATE(7), GET_STATS(8),
-        RESET(9), SHUTDOWN(10), PING(11);
+        START(Layout.CMD_START), STOP(Layout.CMD_STOP), SET_PARAM(Layout.CMD_SET_PARAM),
+        GET_PARAM(Layout.CMD_GET_PARAM), BIND(Layout.CMD_BIND), UNBIND(Layout.CMD_UNBIND),
+        GET_STATE(Layout.CMD_GET_STATE), GET_STATS(Layout.CMD_GET_STATS), RESET(Layout.CMD_RESET),
+        SHUTDOWN(Layout.CMD_SHUTDOWN), PING(Layout.CMD_PING);
 
         public final int code;
 

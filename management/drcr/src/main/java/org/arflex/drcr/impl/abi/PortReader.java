@@ -18,8 +18,8 @@ import java.nio.ByteOrder;
 public final class PortReader {
 
     private static final VarHandle LONGS = MethodHandles.byteBufferViewVarHandle(long[].class, ByteOrder.LITTLE_ENDIAN);
-    /** Seqlock attempts per read, as the C reader. */
-    static final int ATTEMPTS = 16;
+    /** Seqlock attempts per read, as the C reader (ARFLEX_STATE_READ_RETRIES). */
+    static final int ATTEMPTS = Layout.STATE_READ_RETRIES;
 
     /** A copied value: element index, producer stamp, payload bytes, and the header's head. */
     public record Value(long index, long stampNs, byte[] payload, long published) {
@@ -117,7 +117,7 @@ public final class PortReader {
                 Thread.onSpinWait();
                 continue;
             }
-            long stamp = b.getLong(at + 8);
+            long stamp = b.getLong(at + Layout.OFF_SLOT_HDR_STAMP_NS);
             b.get(at + PortSegment.SLOT_HDR_SIZE, out, 0, bytes);
             VarHandle.acquireFence();
             long s2 = (long) LONGS.getAcquire(b, at);

@@ -10,40 +10,41 @@ import java.nio.file.Path;
  * An output port segment {@code /arflex.<rid>.<inst>.out.<port>}: Java side of struct
  * arflex_port_hdr in rt-core/include/arflex/port.h. The manager creates and formats it (as
  * arflex_port_create does) before the producer starts, and removes it when the producer is
- * destroyed; it survives restarts of its producer, so consumers keep their mapping.
+ * destroyed; it survives restarts of its producer, so consumers keep their mapping. The offsets
+ * below come from {@link Layout}, generated from the header (DECISIONS.md D22).
  */
 public final class PortSegment implements AutoCloseable {
 
-    public static final long MAGIC = 0x545250584C465241L; // "ARFLXPRT"
-    public static final int HDR_SIZE = 256;
-    public static final int SLOT_HDR_SIZE = 64;
-    public static final int TYPE_NAME_SIZE = 64;
-    public static final int OFF_MAGIC = 0;
-    public static final int OFF_ABI_MAJOR = 8;
-    public static final int OFF_ABI_MINOR = 10;
-    public static final int OFF_HEADER_SIZE = 12;
-    public static final int OFF_SIZE = 16;
-    public static final int OFF_METHOD = 24;
-    public static final int OFF_ELEM_SIZE = 28;
-    public static final int OFF_DEPTH = 32;
-    public static final int OFF_OVERFLOW = 36;
-    public static final int OFF_SLOT_STRIDE = 40;
-    public static final int OFF_TYPE_MAJOR = 44;
-    public static final int OFF_TYPE_MINOR = 46;
-    public static final int OFF_TYPE_HASH = 48;
-    public static final int OFF_TYPE_NAME = 56;
-    public static final int OFF_HEAD = 128;
-    public static final int OFF_WRITTEN = 136;
-    public static final int OFF_WRITER_PID = 152;
-    public static final int OFF_TAIL = 192;
-    public static final int METHOD_STATE = 1;
-    public static final int METHOD_STREAM = 2;
-    public static final int METHOD_FRAME = 3;
-    public static final int OVERFLOW_NONE = 0;
-    public static final int OVERFLOW_DROP_OLDEST = 1;
-    public static final int OVERFLOW_DROP_NEWEST = 2;
-    public static final int MAX_DEPTH = 65536;
-    public static final long MAX_ELEM = 64L << 20;
+    public static final long MAGIC = Layout.PORT_MAGIC; // "ARFLXPRT"
+    public static final int HDR_SIZE = Layout.PORT_HDR_SIZE;
+    public static final int SLOT_HDR_SIZE = Layout.SLOT_HDR_SIZE;
+    public static final int TYPE_NAME_SIZE = Layout.TYPE_NAME_SIZE;
+    public static final int OFF_MAGIC = Layout.OFF_PORT_HDR_MAGIC;
+    public static final int OFF_ABI_MAJOR = Layout.OFF_PORT_HDR_ABI_MAJOR;
+    public static final int OFF_ABI_MINOR = Layout.OFF_PORT_HDR_ABI_MINOR;
+    public static final int OFF_HEADER_SIZE = Layout.OFF_PORT_HDR_HEADER_SIZE;
+    public static final int OFF_SIZE = Layout.OFF_PORT_HDR_SIZE;
+    public static final int OFF_METHOD = Layout.OFF_PORT_HDR_METHOD;
+    public static final int OFF_ELEM_SIZE = Layout.OFF_PORT_HDR_ELEM_SIZE;
+    public static final int OFF_DEPTH = Layout.OFF_PORT_HDR_DEPTH;
+    public static final int OFF_OVERFLOW = Layout.OFF_PORT_HDR_OVERFLOW;
+    public static final int OFF_SLOT_STRIDE = Layout.OFF_PORT_HDR_SLOT_STRIDE;
+    public static final int OFF_TYPE_MAJOR = Layout.OFF_PORT_HDR_TYPE_MAJOR;
+    public static final int OFF_TYPE_MINOR = Layout.OFF_PORT_HDR_TYPE_MINOR;
+    public static final int OFF_TYPE_HASH = Layout.OFF_PORT_HDR_TYPE_HASH;
+    public static final int OFF_TYPE_NAME = Layout.OFF_PORT_HDR_TYPE_NAME;
+    public static final int OFF_HEAD = Layout.OFF_PORT_HDR_HEAD;
+    public static final int OFF_WRITTEN = Layout.OFF_PORT_HDR_WRITTEN;
+    public static final int OFF_WRITER_PID = Layout.OFF_PORT_HDR_WRITER_PID;
+    public static final int OFF_TAIL = Layout.OFF_PORT_HDR_TAIL;
+    public static final int METHOD_STATE = Layout.PORT_STATE;
+    public static final int METHOD_STREAM = Layout.PORT_STREAM;
+    public static final int METHOD_FRAME = Layout.PORT_FRAME;
+    public static final int OVERFLOW_NONE = Layout.OVERFLOW_NONE;
+    public static final int OVERFLOW_DROP_OLDEST = Layout.OVERFLOW_DROP_OLDEST;
+    public static final int OVERFLOW_DROP_NEWEST = Layout.OVERFLOW_DROP_NEWEST;
+    public static final int MAX_DEPTH = Layout.PORT_MAX_DEPTH;
+    public static final long MAX_ELEM = Layout.PORT_MAX_ELEM;
 
     private final ShmSegment shm;
     private final int method;

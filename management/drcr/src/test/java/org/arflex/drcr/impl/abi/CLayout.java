@@ -26,12 +26,20 @@ final class CLayout {
     }
 
     static Map<String, Long> probe(String header, List<String> exprs) throws IOException, InterruptedException {
+        return probe(List.of(header), exprs);
+    }
+
+    /** As {@link #probe(String, List)}, with every header of {@code headers} included. */
+    static Map<String, Long> probe(List<String> headers, List<String> exprs) throws IOException, InterruptedException {
         Path inc = includeDir();
-        assumeTrue(Files.isRegularFile(inc.resolve("arflex").resolve(header)), "header " + header + " not present");
+        StringBuilder c = new StringBuilder("#include <stdio.h>\n#include <stddef.h>\n");
+        for (String header : headers) {
+            assumeTrue(Files.isRegularFile(inc.resolve("arflex").resolve(header)), "header " + header + " not present");
+            c.append("#include \"arflex/").append(header).append("\"\n");
+        }
+        c.append("int main(void) {\n");
         Path dir = Files.createTempDirectory("arflex-layout");
         try {
-            StringBuilder c = new StringBuilder("#include <stdio.h>\n#include <stddef.h>\n#include \"arflex/")
-                    .append(header).append("\"\nint main(void) {\n");
             for (String e : exprs) {
                 c.append("  printf(\"%s %lld\\n\", \"").append(e.replace("\"", "\\\"")).append("\", (long long)(")
                         .append(e).append("));\n");
