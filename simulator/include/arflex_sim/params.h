@@ -1,6 +1,6 @@
-// Parametrisation of the simulated robot cell: arm geometry and dynamics, the seeded error
-// set that makes the TRUE arm differ from the NOMINAL one, joint compliance, cameras, AprilTag
-// markers and scripted disturbances. Both MJCF models are generated from one CellConfig
+// Parametrisation of the simulated robot cell: the arm, cameras and AprilTag markers (the
+// cell model's, cellmodel/include/arflex_cellmodel/{arm,layout}.h), the seeded error set that
+// makes the TRUE arm differ from the NOMINAL one, joint compliance and scripted disturbances. Both MJCF models are generated from one CellConfig
 // (see mjcf.h), so the true and nominal models cannot drift apart by hand editing.
 //
 // Units: metres, kilograms, radians, seconds, newtons, newton-metres.
@@ -14,51 +14,20 @@
 #include <string>
 #include <vector>
 
+#include "arflex_cellmodel/arm.h"
+#include "arflex_cellmodel/layout.h"
+
 namespace arflex {
 namespace sim {
 
-inline constexpr int kNumJoints = 6;
-using JointVector = std::array<double, kNumJoints>;
-using Vec3 = std::array<double, 3>;
-
-// One link of the serial chain. Body i (i = 0..5) carries joint i+1; `offset` is the origin
-// of body i in the frame of its parent (body i-1, or the world for i = 0) at q = 0; `axis`
-// is the joint axis in body i's frame. Inertial data is about the link's centre of mass,
-// with principal axes aligned to the body frame.
-struct LinkParams {
-  std::string name;
-  Vec3 offset;
-  Vec3 axis;
-  double mass;
-  Vec3 com;           // centre of mass in the body frame
-  Vec3 inertia;       // principal moments of inertia at the com (kg m^2)
-  double lower, upper;  // joint limits (rad)
-  double armature;    // reflected rotor inertia of the drive (kg m^2)
-  double damping;     // viscous friction at the motor (N m s/rad)
-  double max_torque;  // drive torque limit (N m)
-  // Series compliance between gear and link (0 = rigid). Modelled in the TRUE model as a
-  // passive hinge on the same axis as the joint with this stiffness (N m/rad).
-  double stiffness;
-  double compliance_damping;  // damping of the passive hinge (N m s/rad)
-  // Geometry used for rendering and contacts: a capsule from `geom_from` to `geom_to`
-  // (body frame) with radius `geom_radius`.
-  Vec3 geom_from, geom_to;
-  double geom_radius;
-};
-
-// The arm: six links, the tool centre point in the flange (body 5) frame and the tool mass.
-struct ArmParams {
-  std::array<LinkParams, kNumJoints> links;
-  Vec3 tcp_offset;       // TCP position in the flange frame (orientation = flange frame)
-  double tool_mass;      // gripper/tool rigidly mounted on the flange (kg)
-  Vec3 tool_com;         // tool com in the flange frame
-  Vec3 payload_com;      // where the payload sits, in the flange frame
-  double base_height;    // height of the fixed pedestal geometry (visual only)
-};
-
-// KR 210 R2700-class arm (2.7 m wrist-centre reach, 210 kg payload); dimensions follow the
-// published geometry of that class, masses and inertias are plausible estimates.
-ArmParams DefaultArm();
+// The arm and the cell layout are the cell model's (cellmodel/, no MuJoCo); the simulator
+// uses them under their old names.
+using cellmodel::ArmParams;
+using cellmodel::DefaultArm;
+using cellmodel::JointVector;
+using cellmodel::kNumJoints;
+using cellmodel::LinkParams;
+using cellmodel::Vec3;
 
 // Bounds of the error distributions. Each error is drawn from a normal distribution with the
 // given standard deviation, truncated (redrawn) at `clip_sigma` standard deviations.
@@ -85,29 +54,8 @@ ErrorSet DrawErrorSet(uint64_t seed, const ErrorModel& model);
 // the MJCF generator applies them as a rotation of the body about its joint axis).
 ArmParams ApplyGeometryErrors(const ArmParams& arm, const ErrorSet& errors);
 
-// A fixed camera. The pose is given as position and a point it looks at with an up hint;
-// intrinsics are MuJoCo's: vertical field of view, square pixels, principal point at the
-// image centre.
-struct CameraSpec {
-  std::string name;
-  Vec3 pos;
-  Vec3 look_at;
-  Vec3 up = {0, 0, 1};
-  double fovy_deg = 45.0;
-};
-
-// An AprilTag tag36h11 marker rendered as a textured square. `size` is the edge of the
-// black border square (AprilTag's "tag size"); the rendered square is 10/8 of that because
-// of the white quiet zone. `body` is "world" or one of the arm bodies ("link6", ...). The
-// tag faces the +z axis of its frame, given as position and a rotation (quaternion w x y z)
-// in the body frame.
-struct TagSpec {
-  int id;
-  double size;
-  std::string body;
-  Vec3 pos;
-  std::array<double, 4> quat = {1, 0, 0, 0};
-};
+using cellmodel::CameraSpec;
+using cellmodel::TagSpec;
 
 // An obstacle box (a mocap body: it can be moved at run time). Placed far away when
 // disabled.

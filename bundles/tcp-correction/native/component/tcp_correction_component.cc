@@ -37,7 +37,7 @@
 extern "C" {
 #include "arflex/component.h"
 }
-#include "arflex_sim/kinematics.h"
+#include "arflex_cellmodel/kinematics.h"
 #include "arflex_tcpcorr/correction.h"
 #include "arflex_types/joint_ref.h"
 #include "arflex_types/joint_state.h"
@@ -60,7 +60,7 @@ struct TcpCorrection {
       p_track = -1;
   double track_tol = 2e-3;  // rad: a robot further than this from our output is not following
   double max_sigma = 2e-4;  // m: a measurement less certain than this is treated as invalid
-  arflex::sim::NominalKinematics kinematics{arflex::sim::DefaultArm()};
+  arflex::cellmodel::NominalKinematics kinematics{arflex::cellmodel::DefaultArm()};
   CorrectionLaw law{CorrectionOptions{}};
   arflex_joint_ref ref{};
   bool have_ref = false;
@@ -186,7 +186,7 @@ int Update(arflex_component* c, void*, uint64_t) {
     const int w = arflex_state_write(g.out, &out, sizeof(out));
     return w < 0 ? w : err;
   }
-  arflex::sim::JointVector q;
+  arflex::cellmodel::JointVector q;
   for (int i = 0; i < 6; ++i) q[i] = g.ref.q[i];
   arflex_joint_state js{};
   if (arflex_input_state_read(g.robot, &js, sizeof(js), nullptr) == 1 && js.seq != 0) {

@@ -20,7 +20,7 @@
 extern "C" {
 #include "arflex/host.h"
 }
-#include "arflex_sim/kinematics.h"
+#include "arflex_cellmodel/kinematics.h"
 #include "arflex_types/joint_ref.h"
 #include "arflex_types/joint_state.h"
 #include "arflex_types/pose.h"
@@ -95,7 +95,7 @@ bool Leaked() {
   return any;
 }
 
-const arflex::sim::JointVector kRef = {0.2, 0.5, 0.3, 0.1, 0.8, -0.2};
+const arflex::cellmodel::JointVector kRef = {0.2, 0.5, 0.3, 0.1, 0.8, -0.2};
 const Eigen::Vector3d kPlantError(1.2e-3, -0.8e-3, 0.6e-3);  // true arm vs nominal, at the TCP
 
 struct Rig {
@@ -106,7 +106,7 @@ struct Rig {
   double last_error_mm = -1;   // the newest one
   double last_size_mrad = -1;  // the newest `correction` value
   double meas_var = 0;         // position variance the plant's measurements report (m^2)
-  arflex::sim::NominalKinematics kin{arflex::sim::DefaultArm()};
+  arflex::cellmodel::NominalKinematics kin{arflex::cellmodel::DefaultArm()};
   arflex_joint_ref last{};
   uint64_t pose_seq = 0;
   double max_jump_excess = 0;  // largest step beyond max_rate * period * cycles
@@ -216,7 +216,7 @@ struct Rig {
 
   // The plant: the measurement of the corrected output (nominal TCP + the plant's error).
   void Measure(bool valid, const Eigen::Vector3d& extra) {
-    arflex::sim::JointVector q;
+    arflex::cellmodel::JointVector q;
     for (int i = 0; i < 6; ++i) q[i] = last.q[i];
     const Eigen::Isometry3d t = kin.Tcp(q);
     arflex_pose p;
@@ -238,7 +238,7 @@ struct Rig {
   // Writes a measurement of the last output (as Measure) made malformed: 1 position NaN,
   // 2 quaternion not unit, 3 a negative variance, 4 validity flag 2, 5 orientation Inf.
   void MeasureMalformed(int how, const Eigen::Vector3d& extra) {
-    arflex::sim::JointVector q;
+    arflex::cellmodel::JointVector q;
     for (int i = 0; i < 6; ++i) q[i] = last.q[i];
     const Eigen::Isometry3d t = kin.Tcp(q);
     arflex_pose p;
@@ -279,7 +279,7 @@ struct Rig {
     double err = 1.0;
     while (arflex_sys_now_ns() < deadline) {
       if (!Read()) continue;
-      arflex::sim::JointVector q;
+      arflex::cellmodel::JointVector q;
       for (int i = 0; i < 6; ++i) q[i] = last.q[i];
       err = (kin.Tcp(q).translation() + kPlantError - kin.Tcp(kRef).translation()).norm();
       if (err < tol) break;

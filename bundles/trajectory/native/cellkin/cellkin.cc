@@ -15,13 +15,13 @@ namespace arflex {
 namespace cellkin {
 namespace {
 
-sim::JointVector ToArray(const Q& q) {
-  sim::JointVector a;
+cellmodel::JointVector ToArray(const Q& q) {
+  cellmodel::JointVector a;
   for (int i = 0; i < 6; ++i) a[i] = q[i];
   return a;
 }
 
-Eigen::Vector3d V3(const sim::Vec3& v) { return Eigen::Vector3d(v[0], v[1], v[2]); }
+Eigen::Vector3d V3(const cellmodel::Vec3& v) { return Eigen::Vector3d(v[0], v[1], v[2]); }
 
 // Rotation error as a rotation vector: the rotation that takes `have` to `want` (world).
 Eigen::Vector3d RotError(const Eigen::Matrix3d& want, const Eigen::Matrix3d& have) {
@@ -31,11 +31,11 @@ Eigen::Vector3d RotError(const Eigen::Matrix3d& want, const Eigen::Matrix3d& hav
 
 }  // namespace
 
-Model::Model() : arm_(sim::DefaultArm()), kin_(arm_) {}
+Model::Model() : arm_(cellmodel::DefaultArm()), kin_(arm_) {}
 
 Eigen::Isometry3d Model::Tcp(const Q& q) const { return kin_.Tcp(ToArray(q)); }
 Eigen::Isometry3d Model::Flange(const Q& q) const { return kin_.Flange(ToArray(q)); }
-sim::Jacobian6 Model::Jacobian(const Q& q) const { return kin_.TcpJacobian(ToArray(q)); }
+cellmodel::Jacobian6 Model::Jacobian(const Q& q) const { return kin_.TcpJacobian(ToArray(q)); }
 
 Eigen::Isometry3d Model::NominalTool() const {
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
@@ -47,10 +47,10 @@ Eigen::Isometry3d Model::TcpOf(const Q& q, const Eigen::Isometry3d& tool) const 
   return Flange(q) * tool;
 }
 
-sim::Jacobian6 Model::JacobianOf(const Q& q, const Eigen::Isometry3d& tool) const {
+cellmodel::Jacobian6 Model::JacobianOf(const Q& q, const Eigen::Isometry3d& tool) const {
   // The nominal TCP Jacobian moved to another point of the same body: the angular rows stay,
   // the linear velocity of a point p is v_tcp + w x (p - p_tcp).
-  sim::Jacobian6 j = Jacobian(q);
+  cellmodel::Jacobian6 j = Jacobian(q);
   const Eigen::Vector3d d = TcpOf(q, tool).translation() - Tcp(q).translation();
   Eigen::Matrix3d skew;
   skew << 0, -d.z(), d.y(), d.z(), 0, -d.x(), -d.y(), d.x(), 0;
@@ -68,7 +68,7 @@ double Model::IkTool(const Eigen::Isometry3d& target, const Eigen::Isometry3d& t
     e.tail<3>() = RotError(target.linear(), t.linear());
     err = e.head<3>().norm() + e.tail<3>().norm();
     if (it == iters || err < 1e-12) break;
-    const sim::Jacobian6 j = JacobianOf(*q, tool);
+    const cellmodel::Jacobian6 j = JacobianOf(*q, tool);
     // Damped least squares: dq = J^T (J J^T + l^2 I)^-1 e; the damping only matters near
     // singularities (l = 1e-3).
     Eigen::Matrix<double, 6, 6> a = j * j.transpose();
@@ -85,13 +85,13 @@ double Model::Ik(const Eigen::Isometry3d& target, Q* q, int iters) const {
 
 Q Model::GravityTorque(const Q& q, double payload_kg) const {
   // Body frames: body i = parent * Trans(offset_i) * Rot(axis_i, q_i), aligned with the
-  // world at q = 0 (as sim::DefaultArm() has them).
+  // world at q = 0 (as cellmodel::DefaultArm() has them).
   Eigen::Isometry3d frame[6];
   Eigen::Vector3d axis[6], com[6];
   double mass[6];
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
   for (int i = 0; i < 6; ++i) {
-    const sim::LinkParams& l = arm_.links[i];
+    const cellmodel::LinkParams& l = arm_.links[i];
     const Eigen::Vector3d a = V3(l.axis).normalized();
     t = t * Eigen::Translation3d(V3(l.offset)) * Eigen::AngleAxisd(q[i], a);
     frame[i] = t;

@@ -1,8 +1,8 @@
 // cellkin - what the cell's motion components know about the robot: the NOMINAL arm only.
 //
-// Kinematics come from the simulator's NominalKinematics (product of exponentials from
-// simulator/src/{params,kinematics}.cc, compiled in here without MuJoCo, so this library also
-// builds in the sanitizer build). Added here: damped-least-squares IK, the nominal static
+// The arm and its kinematics come from the cell model (cellmodel/: DefaultArm and
+// NominalKinematics, a product of exponentials; no MuJoCo, so this library also builds in the
+// sanitizer build). Added here: damped-least-squares IK, the nominal static
 // gravity torques (link masses, tool, payload), the tool's weight as the wrist sensor sees it,
 // and the program file format shared by trajectory (reader) and teach (writer).
 //
@@ -17,8 +17,8 @@
 #include <string>
 #include <vector>
 
-#include "arflex_sim/kinematics.h"
-#include "arflex_sim/params.h"
+#include "arflex_cellmodel/kinematics.h"
+#include "arflex_cellmodel/arm.h"
 
 namespace arflex {
 namespace cellkin {
@@ -28,11 +28,11 @@ constexpr double kGravity = 9.81;
 
 class Model {
  public:
-  Model();  // the default (nominal) arm of the cell: sim::DefaultArm()
+  Model();  // the default (nominal) arm of the cell: cellmodel::DefaultArm()
 
   Eigen::Isometry3d Tcp(const Q& q) const;
   Eigen::Isometry3d Flange(const Q& q) const;
-  sim::Jacobian6 Jacobian(const Q& q) const;
+  cellmodel::Jacobian6 Jacobian(const Q& q) const;
 
   // Moves *q towards the joint angles whose TCP pose is `target` by at most `iters` damped
   // least-squares Newton steps (starting from *q: pass the previous solution for continuity).
@@ -43,7 +43,7 @@ class Model {
   // arflex.ToolState: tcp_p, tcp_quat; Identity = the flange itself). TcpOf is the TCP pose,
   // JacobianOf its geometric Jacobian (world: linear velocity of the TCP point, angular).
   Eigen::Isometry3d TcpOf(const Q& q, const Eigen::Isometry3d& tool) const;
-  sim::Jacobian6 JacobianOf(const Q& q, const Eigen::Isometry3d& tool) const;
+  cellmodel::Jacobian6 JacobianOf(const Q& q, const Eigen::Isometry3d& tool) const;
   double IkTool(const Eigen::Isometry3d& target, const Eigen::Isometry3d& tool, Q* q,
                 int iters) const;
   // The nominal model's own tool (tcp_offset, orientation of the flange): TcpOf(q,
@@ -51,7 +51,7 @@ class Model {
   Eigen::Isometry3d NominalTool() const;
 
   // Joint torques (N m) the drives must deliver to hold the arm still at q: link masses,
-  // the tool (sim::ArmParams::tool_mass at tool_com) and a payload of `payload_kg` at
+  // the tool (cellmodel::ArmParams::tool_mass at tool_com) and a payload of `payload_kg` at
   // payload_com. Same sign convention as the measured drive torques of arflex.JointState.
   Q GravityTorque(const Q& q, double payload_kg) const;
 
@@ -66,13 +66,13 @@ class Model {
   Eigen::Vector3d ContactForceWorld(const Q& q, const Eigen::Vector3d& f_sensor,
                                     double payload_kg) const;
 
-  const sim::ArmParams& arm() const { return arm_; }
+  const cellmodel::ArmParams& arm() const { return arm_; }
   double lower(int j) const { return arm_.links[j].lower; }
   double upper(int j) const { return arm_.links[j].upper; }
 
  private:
-  sim::ArmParams arm_;
-  sim::NominalKinematics kin_;
+  cellmodel::ArmParams arm_;
+  cellmodel::NominalKinematics kin_;
 };
 
 // ---- program files ----------------------------------------------------------------------

@@ -383,7 +383,7 @@ static void TestTool() {
   spindle.translation() = Eigen::Vector3d(0.35, 0, 0);
   for (const Eigen::Isometry3d& tool : {spindle, Eigen::Isometry3d(Eigen::Isometry3d::Identity())}) {
     // Jacobian against finite differences of the TCP position
-    const arflex::sim::Jacobian6 j = m.JacobianOf(q, tool);
+    const arflex::cellmodel::Jacobian6 j = m.JacobianOf(q, tool);
     for (int k = 0; k < 6; ++k) {
       Q a = q, b = q;
       a[k] += 1e-7;

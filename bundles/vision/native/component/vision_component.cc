@@ -38,7 +38,7 @@
 extern "C" {
 #include "arflex/component.h"
 }
-#include "arflex_sim/kinematics.h"
+#include "arflex_cellmodel/kinematics.h"
 #include "arflex_types/image_frame.h"
 #include "arflex_types/joint_state.h"
 #include "arflex_types/pose.h"
@@ -94,7 +94,7 @@ struct Vision {
   std::vector<vision::Camera> cameras{kCameras};
   std::vector<vision::TagModel> board = vision::CellBoardTags();
   std::vector<vision::TagModel> tool = vision::CellToolTags();
-  arflex::sim::NominalKinematics kinematics{arflex::sim::DefaultArm()};
+  arflex::cellmodel::NominalKinematics kinematics{arflex::cellmodel::DefaultArm()};
   bool have_last = false;
   Eigen::Isometry3d last_marker = Eigen::Isometry3d::Identity();
   vision::EstimatorOptions options;
@@ -122,7 +122,7 @@ void Process() {
   Eigen::Isometry3d predicted;
   bool have_prediction = false;
   if (v.have_joints) {
-    arflex::sim::JointVector q;
+    arflex::cellmodel::JointVector q;
     for (int i = 0; i < 6; ++i) q[i] = v.joint_state.q[i];
     predicted = v.kinematics.Flange(q);
     have_prediction = true;

@@ -21,7 +21,7 @@
 extern "C" {
 #include "arflex/host.h"
 }
-#include "arflex_sim/kinematics.h"
+#include "arflex_cellmodel/kinematics.h"
 #include "arflex_types/image_frame.h"
 #include "arflex_types/joint_state.h"
 #include "arflex_types/pose.h"
@@ -108,11 +108,11 @@ bool Leaked() {
   return any;
 }
 
-const arflex::sim::JointVector kQ = {0.1, 0.45, 0.35, 0.2, 0.7, 0.3};
+const arflex::cellmodel::JointVector kQ = {0.1, 0.45, 0.35, 0.2, 0.7, 0.3};
 
 // The expected TCP: nominal flange at kQ and the TCP 0.3 m along the flange x axis.
 Eigen::Isometry3d TrueTcp() {
-  arflex::sim::NominalKinematics kin(arflex::sim::DefaultArm());
+  arflex::cellmodel::NominalKinematics kin(arflex::cellmodel::DefaultArm());
   Eigen::Isometry3d t = kin.Flange(kQ);
   t.translate(Eigen::Vector3d(0.3, 0, 0));
   return t;
@@ -154,7 +154,7 @@ class Feeder {
   // Draws the frames of the scene once (it is static): with and without the tags.
   void Draw() {
     const auto cams = vision::testing::CellCameras(kW, kH);
-    arflex::sim::NominalKinematics kin(arflex::sim::DefaultArm());
+    arflex::cellmodel::NominalKinematics kin(arflex::cellmodel::DefaultArm());
     const Eigen::Isometry3d flange = kin.Flange(kQ);
     for (int c = 0; c < 4; ++c) {
       blank_[c] = cv::Mat(kH, kW, CV_8UC1, cv::Scalar(140));

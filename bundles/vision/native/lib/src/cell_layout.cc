@@ -1,35 +1,38 @@
 #include "arflex_vision/cell_layout.h"
 
+#include <string>
+
+#include "arflex_cellmodel/layout.h"
+
 namespace arflex {
 namespace vision {
 namespace {
 
-TagModel Tag(int id, double size, const Eigen::Vector3d& pos, const Eigen::Quaterniond& q) {
+TagModel Tag(const cellmodel::TagSpec& spec) {
   TagModel t;
-  t.id = id;
-  t.size = size;
+  t.id = spec.id;
+  t.size = spec.size;
   t.pose = Eigen::Isometry3d::Identity();
-  t.pose.linear() = q.toRotationMatrix();
-  t.pose.translation() = pos;
+  t.pose.linear() =
+      Eigen::Quaterniond(spec.quat[0], spec.quat[1], spec.quat[2], spec.quat[3]).toRotationMatrix();
+  t.pose.translation() = Eigen::Vector3d(spec.pos[0], spec.pos[1], spec.pos[2]);
   t.pose.translate(Eigen::Vector3d(0, 0, 0.0005));  // printed on the top face of the box
   return t;
 }
 
+std::vector<TagModel> TagsOn(const std::string& body) {
+  std::vector<TagModel> tags;
+  for (const cellmodel::TagSpec& spec : cellmodel::DefaultTags()) {
+    if (spec.body == body) tags.push_back(Tag(spec));
+  }
+  return tags;
+}
+
 }  // namespace
 
-std::vector<TagModel> CellBoardTags() {
-  const Eigen::Quaterniond up = Eigen::Quaterniond::Identity();
-  return {Tag(0, 0.24, {1.40, 0.70, 0.002}, up), Tag(1, 0.24, {2.30, 0.70, 0.002}, up),
-          Tag(2, 0.24, {1.40, -0.70, 0.002}, up), Tag(3, 0.24, {2.30, -0.70, 0.002}, up)};
-}
+std::vector<TagModel> CellBoardTags() { return TagsOn("world"); }
 
-std::vector<TagModel> CellToolTags() {
-  const double s = 0.7071067811865476;
-  return {Tag(10, 0.13, {0.13, 0.0, 0.0915}, Eigen::Quaterniond(1, 0, 0, 0)),
-          Tag(11, 0.13, {0.13, 0.0915, 0.0}, Eigen::Quaterniond(s, -s, 0, 0)),
-          Tag(12, 0.13, {0.13, -0.0915, 0.0}, Eigen::Quaterniond(s, s, 0, 0)),
-          Tag(13, 0.13, {0.13, 0.0, -0.0915}, Eigen::Quaterniond(0, 1, 0, 0))};
-}
+std::vector<TagModel> CellToolTags() { return TagsOn("link6"); }
 
 }  // namespace vision
 }  // namespace arflex

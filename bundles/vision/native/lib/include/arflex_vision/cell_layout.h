@@ -1,5 +1,6 @@
-// The marker layout of the showcase cell (simulator/src/params.cc, DefaultCellConfig): four
-// 0.24 m reference-board tags on the floor (ids 0-3, poses in the cell frame) and four
+// The marker layout of the showcase cell as vision's tag models, from the cell model
+// (cellmodel/include/arflex_cellmodel/layout.h, DefaultTags; the simulator renders the same
+// tags): four 0.24 m reference-board tags on the floor (ids 0-3, poses in the cell frame) and four
 // 0.13 m tags on the faces of the tool block (ids 10-13, poses in the flange frame). The
 // printed face of each tag is 0.5 mm above its box centre.
 #ifndef ARFLEX_VISION_CELL_LAYOUT_H_

@@ -1,9 +1,9 @@
-#include "arflex_sim/kinematics.h"
+#include "arflex_cellmodel/kinematics.h"
 
 #include <cmath>
 
 namespace arflex {
-namespace sim {
+namespace cellmodel {
 namespace {
 
 Eigen::Matrix3d Skew(const Eigen::Vector3d& w) {
@@ -71,5 +71,5 @@ Jacobian6 NominalKinematics::TcpJacobian(const JointVector& q) const {
   return jac;
 }
 
-}  // namespace sim
+}  // namespace cellmodel
 }  // namespace arflex
