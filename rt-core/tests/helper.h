@@ -1,5 +1,6 @@
 /* Shared test helpers: unique ids and the no-leak check every test ends with. Everything but
- * th_assert_clean is in arflex_testkit (no test framework); th_assert_clean needs cmocka
+ * th_assert_clean is in arflex_testkit (no test framework), the one kit of every native test,
+ * C or C++ (rt-core, bundles/<name>/native, simulator); th_assert_clean needs cmocka
  * (arflex_test_helper). */
 #ifndef ARFLEX_TEST_HELPER_H
 #define ARFLEX_TEST_HELPER_H
@@ -7,6 +8,10 @@
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
 
 /* Writes "t<tag>-<pid>" (a valid runtime id, unique per test process) into @buf. */
 void th_rid(char *buf, size_t size, const char *tag);
@@ -33,5 +38,9 @@ void th_sweep(const char *rid);
 
 /* Reads a whole small file into @buf (NUL-terminated). Returns bytes or -1. */
 long th_read_file(const char *path, char *buf, size_t size);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -35,6 +35,7 @@
 #include "arflex_sim/ground_truth.h"
 #include "arflex_sim/params.h"
 #include "arflex_sim/render.h"
+#include "helper.h" /* rt-core test kit: leak checks */
 
 namespace {
 
@@ -207,25 +208,9 @@ class SimComponents : public ::testing::Test {
     if (robot_used_) arflex_host_destroy(&robot_);
     guard_.Destroy();
     if (ref_used_) arflex_port_destroy(&ref_);
-    EXPECT_EQ(Leftovers(), "") << "objects or children left behind";
-  }
-
-  // Every /dev/shm and /dev/mqueue object of this test's runtime id, and child processes.
-  std::string Leftovers() {
-    std::string left;
-    const std::string prefix = std::string("arflex.") + rid_ + ".";
-    for (const char* dir : {"/dev/shm", "/dev/mqueue"}) {
-      DIR* d = opendir(dir);
-      if (!d) continue;
-      while (dirent* e = readdir(d)) {
-        if (std::strncmp(e->d_name, prefix.c_str(), prefix.size()) == 0) {
-          left += std::string(dir) + "/" + e->d_name + " ";
-        }
-      }
-      closedir(d);
-    }
-    if (waitpid(-1, nullptr, WNOHANG) != -1 || errno != ECHILD) left += "child-process ";
-    return left;
+    // rt-core's test kit (arflex_testkit) prints each object it finds.
+    EXPECT_EQ(th_leftovers(rid_), 0) << "objects of runtime " << rid_ << " left behind";
+    EXPECT_TRUE(th_no_children()) << "child process left behind";
   }
 
   // The robot, with its safety input bound to a fresh NORMAL guard unless @guarded is false.

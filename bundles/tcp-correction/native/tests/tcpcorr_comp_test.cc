@@ -19,6 +19,7 @@
 
 extern "C" {
 #include "arflex/host.h"
+#include "helper.h" /* rt-core test kit: leak checks */
 }
 #include "arflex_cellmodel/kinematics.h"
 #include "arflex_types/joint_ref.h"
@@ -73,22 +74,10 @@ arflex_ctl_config Config() {
   return c;
 }
 
+// rt-core's test kit (arflex_testkit): /dev/shm and /dev/mqueue objects of rid, children.
 bool Leaked() {
-  static const char* const dirs[] = {"/dev/shm", "/dev/mqueue"};
-  const std::string prefix = std::string("arflex.") + rid + ".";
-  bool any = false;
-  for (const char* dir : dirs) {
-    DIR* d = opendir(dir);
-    if (!d) continue;
-    while (dirent* e = readdir(d)) {
-      if (std::strncmp(e->d_name, prefix.c_str(), prefix.size()) == 0) {
-        std::fprintf(stderr, "leak: %s/%s\n", dir, e->d_name);
-        any = true;
-      }
-    }
-    closedir(d);
-  }
-  if (waitpid(-1, nullptr, WNOHANG) != -1 || errno != ECHILD) {
+  bool any = th_leftovers(rid) > 0;
+  if (!th_no_children()) {
     std::fprintf(stderr, "leak: a child process is left\n");
     any = true;
   }

@@ -28,6 +28,7 @@
 #include "arflex_types/tool_state.h"
 #include "arflex_types/wrench.h"
 #include "cellkin.h"
+#include "helper.h" /* rt-core test kit: leak checks */
 
 using arflex::cellkin::Model;
 using arflex::cellkin::Q;
@@ -138,23 +139,10 @@ void DestroyAll() {
   hosts.clear();
 }
 
+// rt-core's test kit (arflex_testkit): /dev/shm and /dev/mqueue objects of rid, children.
 bool Leaked() {
-  const char* dirs[] = {"/dev/shm", "/dev/mqueue"};
-  char prefix[64];
-  bool any = false;
-  snprintf(prefix, sizeof(prefix), "arflex.%s.", rid);
-  for (const char* dn : dirs) {
-    DIR* d = opendir(dn);
-    if (!d) continue;
-    while (struct dirent* e = readdir(d)) {
-      if (strncmp(e->d_name, prefix, strlen(prefix)) == 0) {
-        fprintf(stderr, "leak: %s/%s\n", dn, e->d_name);
-        any = true;
-      }
-    }
-    closedir(d);
-  }
-  if (waitpid(-1, nullptr, WNOHANG) != -1 || errno != ECHILD) {
+  bool any = th_leftovers(rid) > 0;
+  if (!th_no_children()) {
     fprintf(stderr, "leak: a child process is left\n");
     any = true;
   }

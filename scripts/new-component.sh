@@ -1,0 +1,86 @@
+#!/usr/bin/env bash
+# new-component.sh NAME [--dest DIR]: create the component bundle DIR/NAME (default DIR:
+# bundles/) from rt-core/template/component: pom.xml, contract, RT half in C, its unit test
+# (CTest rt.NAME.cycle), README.md. Called by `./arflex new component NAME`.
+#
+# The native superbuild finds bundles/*/native by itself. Maven cannot glob modules, so the
+# one line outside the folder, <module>NAME</module> in DIR/pom.xml, is added here (only if
+# that pom exists and does not list the module yet). Nothing else outside DIR/NAME is edited.
+set -euo pipefail
+ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+TEMPLATE="$ROOT/rt-core/template/component"
+
+usage() {
+  echo "usage: ./arflex new component NAME [--dest DIR]   (NAME: [a-z][a-z0-9-]{0,39})" >&2
+  exit 2
+}
+
+name="" dest="$ROOT/bundles"
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --dest) dest="${2:?--dest needs a directory}"; shift 2 ;;
+    -h|--help) usage ;;
+    -*) echo "new component: unknown option '$1'" >&2; usage ;;
+    *) [ -z "$name" ] || usage; name="$1"; shift ;;
+  esac
+done
+[ -n "$name" ] || usage
+# A contract name, an executable, a CMake target and a Maven module at once: lower case,
+# digits and dashes, starting with a letter, at most 40 characters (ARFLEX_ID_MAX).
+if ! [[ "$name" =~ ^[a-z][a-z0-9-]{0,39}$ ]]; then
+  echo "new component: '$name' is not a valid name: a lower-case letter, then up to 39" \
+       "lower-case letters, digits or dashes" >&2
+  exit 2
+fi
+[ -d "$dest" ] || { echo "new component: no directory '$dest'" >&2; exit 2; }
+dest=$(cd "$dest" && pwd)
+target="$dest/$name"
+if [ -e "$target" ]; then
+  echo "new component: $target already exists; nothing changed (pick another name, or" \
+       "remove that folder first)" >&2
+  exit 1
+fi
+c_name=${name//-/_}
+# The CMake targets NAME and test_C_NAME share one namespace with every other target of the
+# superbuild: refuse a name that is already taken there (the configure step would fail).
+clash=$(cd "$ROOT" && grep -rlE --include=CMakeLists.txt \
+  "add_(executable|library)\((test_)?($name|$c_name)[ )]" rt-core bundles simulator contracts 2>/dev/null || true)
+if [ -n "$clash" ]; then
+  echo "new component: '$name' clashes with a CMake target defined in:" $clash >&2
+  exit 1
+fi
+
+tmp=$(mktemp -d "$dest/.new-$name.XXXXXX")
+trap 'rm -rf "$tmp"' EXIT
+(cd "$TEMPLATE" && find . -type f) | while read -r rel; do
+  out=${rel#./}
+  case "$out" in
+    native/test_NAME.c) out="native/test_$c_name.c" ;;
+    native/NAME.c) out="native/$c_name.c" ;;
+    *) out=${out//NAME/$name} ;;
+  esac
+  mkdir -p "$tmp/$(dirname "$out")"
+  sed -e "s/@NAME@/$name/g" -e "s/@C_NAME@/$c_name/g" "$TEMPLATE/$rel" >"$tmp/$out"
+done
+mv "$tmp" "$target"
+trap - EXIT
+echo "created $target"
+
+pom="$dest/pom.xml"
+if [ -f "$pom" ]; then
+  if grep -q "<module>$name</module>" "$pom"; then
+    echo "$pom already lists <module>$name</module>"
+  elif grep -q '</modules>' "$pom"; then
+    awk -v m="    <module>$name</module>" '/<\/modules>/ && !done { print m; done = 1 } { print }' \
+      "$pom" >"$pom.tmp" && mv "$pom.tmp" "$pom"
+    echo "added <module>$name</module> to $pom (Maven cannot find modules by itself)"
+  else
+    echo "new component: $pom has no <modules>; add <module>$name</module> yourself" >&2
+  fi
+fi
+cat <<MSG
+next:
+  configure again (the superbuild finds bundles/*/native when CMake runs), build, test:
+    cmake -S . -B build && cmake --build build && (cd build && ctest -R 'rt\\.$name\\.')
+  see $target/README.md
+MSG
