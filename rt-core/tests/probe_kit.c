@@ -51,6 +51,7 @@ void setup_ids(const char *tag)
 int probe_prio;
 uint64_t probe_cpus;
 uint64_t probe_hold;
+uint32_t probe_task_type;
 
 int probe_host(struct arflex_host *h, const char *inst, uint64_t hb_timeout,
 		      uint32_t cfg_flags, bool with_out)
@@ -66,7 +67,7 @@ int probe_host(struct arflex_host *h, const char *inst, uint64_t hb_timeout,
 		.config = { .period_ns = 1000000, .hb_timeout_ns = hb_timeout,
 			    .cfg_flags = cfg_flags | ARFLEX_CFG_NO_MLOCK | ARFLEX_CFG_NO_DMA_LATENCY,
 			    .priority = probe_prio, .cpu_mask = probe_cpus,
-			    .orphan_hold_ns = probe_hold },
+			    .orphan_hold_ns = probe_hold, .task_type = probe_task_type },
 		.params = p, .nparams = 2, .outputs = &out, .noutputs = with_out ? 1 : 0,
 	};
 

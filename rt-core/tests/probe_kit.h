@@ -26,6 +26,7 @@ extern char *envp[256];
 extern int probe_prio;
 extern uint64_t probe_cpus;
 extern uint64_t probe_hold;
+extern uint32_t probe_task_type; /* enum arflex_task_type */
 
 void make_env(const char *extra);
 void setup_ids(const char *tag);

@@ -98,8 +98,11 @@ enum arflex_safe_mode {
 	ARFLEX_SAFE_ZERO = 1, /**< drive outputs to zero / neutral */
 };
 
-/** Task type, config.task_type (informative; rt-core runs every type as a periodic loop,
- *  a sporadic task at its minimum inter-arrival time). */
+/** Task type, config.task_type. Periodic and service tasks run a periodic loop. A sporadic
+ *  task is released by new samples on its first declared input, at most once per period (the
+ *  minimum inter-arrival time; samples in between are coalesced and counted in
+ *  stats.missed_periods, the releases that coalesced in stats.overruns); a sporadic task that
+ *  declares no input runs the periodic loop at its minimum inter-arrival (DECISIONS.md D27). */
 enum arflex_task_type {
 	ARFLEX_TASK_PERIODIC = 0,
 	ARFLEX_TASK_SPORADIC = 1,
@@ -161,8 +164,10 @@ struct arflex_metric {
 struct arflex_stats {
 	uint64_t seq;            /**< seqlock word: odd while the writer updates */
 	uint64_t cycles;         /**< completed cycles */
-	uint64_t overruns;       /**< cycles whose next release was already in the past */
-	uint64_t missed_periods; /**< periods skipped by catch-up after overruns */
+	uint64_t overruns;       /**< cycles whose next release was already in the past
+				  *   (sporadic: releases that coalesced samples) */
+	uint64_t missed_periods; /**< periods skipped by catch-up after overruns
+				  *   (sporadic: samples coalesced, not run on their own) */
 	uint64_t deadline_misses;/**< cycles that ended later than release + deadline */
 	uint64_t update_errors;  /**< update hook returned < 0 */
 	uint64_t safe_cycles;    /**< cycles run through the safe hook */

@@ -10,6 +10,15 @@
  * period; if the next release is already past (overrun) count it and skip whole periods to
  * catch up. After the loop it calls opts.on_stop and releases what it held.
  *
+ * Sporadic mode (opts.poll set): the loop is released by events instead of the clock. After
+ * each cycle it sleeps until the earliest next release (last release + period: the period is
+ * the minimum inter-arrival time), then calls opts.poll at absolute ticks every opts.poll_ns;
+ * the first tick at which poll reports new events is the release (the event's arrival as the
+ * RT thread sees it: latency = actual wake - that tick, the deadline counts from it). Events
+ * that came in while the task waited for its minimum inter-arrival are coalesced into one
+ * release: poll reports how many; the extra ones count as stats.missed_periods, and a release
+ * that coalesced counts as one stats.overrun (DECISIONS.md D27).
+ *
  * The RT thread never blocks (besides its sleep), allocates or prints after start: problems
  * are counted per enum arflex_warn_kind; a non-RT thread calls arflex_task_report() to print
  * the first of each kind once.
@@ -35,6 +44,11 @@ typedef int (*arflex_task_cycle_fn)(void *arg, uint64_t release_ns);
 /** Start/stop callbacks on the RT thread (optional). on_start returning < 0 aborts the task
  *  (arflex_task_wait_started reports that error). */
 typedef int (*arflex_task_hook_fn)(void *arg);
+/** Sporadic release test, on the RT thread at every poll tick @now_ns (between cycles: a
+ *  cycle boundary). Returns > 0 to release a cycle now, with *@events set to the number of
+ *  events it covers (>= 1; more than 1 means events were coalesced); 0 to keep waiting. Must
+ *  not block. */
+typedef int (*arflex_task_poll_fn)(void *arg, uint64_t now_ns, uint64_t *events);
 
 /** Options of a task. */
 struct arflex_task_opts {
@@ -48,6 +62,9 @@ struct arflex_task_opts {
 	arflex_task_cycle_fn cycle;  /**< required */
 	arflex_task_hook_fn on_start;/**< optional */
 	arflex_task_hook_fn on_stop; /**< optional; called even if a cycle asked to stop */
+	arflex_task_poll_fn poll;    /**< optional: sporadic mode (see above); NULL: periodic */
+	uint64_t poll_ns;            /**< poll interval in sporadic mode; 0: derived from the
+				      *   period, ARFLEX_TASK_POLL_NS(period) */
 	void *arg;                   /**< passed to the callbacks */
 	struct arflex_stats *stats;  /**< where to record (e.g. &ctl->stats); NULL: internal */
 	uint64_t *warnings;          /**< ARFLEX_WARN_KINDS counters (e.g. ctl->warnings);
@@ -57,7 +74,13 @@ struct arflex_task_opts {
 	const char *name;            /**< for reports; may be NULL */
 };
 
-/** A periodic task. Caller-owned storage; fields are private. */
+/** Default poll interval of a sporadic task: a tenth of its minimum inter-arrival time, kept
+ *  within 50 us .. 1 ms (a release is seen at most that late; polling costs a wake-up). */
+#define ARFLEX_TASK_POLL_NS(period_ns)                                                  \
+	((period_ns) / 10 < 50000u ? 50000u : (period_ns) / 10 > 1000000u ? 1000000u \
+									    : (period_ns) / 10)
+
+/** A periodic (or sporadic) task. Caller-owned storage; fields are private. */
 struct arflex_task {
 	struct arflex_task_opts o;
 	struct arflex_stats own_stats;

@@ -300,12 +300,11 @@ static void check_heartbeat(struct arflex_component *c, uint64_t now)
 	}
 }
 
-static int rt_cycle(void *arg, uint64_t release_ns)
+/* The work of every cycle boundary: own heartbeat, bindings, parameter requests, the runtime
+ * heartbeat (safe mode). */
+static void rt_boundary(struct arflex_component *c, uint64_t now)
 {
-	struct arflex_component *c = arg;
 	struct arflex_ctl *ctl = c->ctl;
-	uint64_t now = arflex_sys_now_ns();
-	int r;
 
 	STORE(&ctl->rt_hb_ns, now);
 	take_bindings(c);
@@ -317,6 +316,48 @@ static int rt_cycle(void *arg, uint64_t release_ns)
 				__atomic_add_fetch(&ctl->warnings[ARFLEX_WARN_PARAM], 1,
 						   __ATOMIC_RELAXED);
 	check_heartbeat(c, now);
+}
+
+/* Sporadic release test (D27), at every poll tick of the RT thread: the poll is a cycle
+ * boundary (heartbeat, bindings, parameters, safe mode are kept up while no sample comes). The
+ * clock is inputs[0], the first declared input: a release per change of its provider's write
+ * count (hdr->head: values written, state, or elements published, stream and frame). At START
+ * and on each new binding a value already published counts as one new sample. While safe mode
+ * is active the task is released every period (the safe hook does not wait for input) and the
+ * samples are consumed without an update. */
+static int rt_poll(void *arg, uint64_t now, uint64_t *events)
+{
+	struct arflex_component *c = arg;
+	struct arflex_input *in = &c->inputs[0];
+	uint64_t head, n = 0;
+
+	rt_boundary(c, now);
+	if (in->cur) {
+		if (in->binding != c->clk_binding) {
+			c->clk_binding = in->binding;
+			c->clk_seen = 0;
+		}
+		head = LOAD(&in->cur->hdr->head);
+		/* a provider segment formatted anew restarts its count */
+		n = head >= c->clk_seen ? head - c->clk_seen : head;
+		c->clk_seen = head;
+	}
+	if (c->safe) {
+		*events = 1;
+		return 1;
+	}
+	*events = n;
+	return n > 0;
+}
+
+static int rt_cycle(void *arg, uint64_t release_ns)
+{
+	struct arflex_component *c = arg;
+	struct arflex_ctl *ctl = c->ctl;
+	int r;
+
+	if (!c->sporadic) /* sporadic: its poll, just now, was the boundary */
+		rt_boundary(c, arflex_sys_now_ns());
 	if (c->safe) {
 		uint64_t seq = ctl->stats.seq;
 
@@ -342,6 +383,8 @@ static int rt_start(void *arg)
 	struct arflex_component *c = arg;
 
 	c->safe = false;
+	c->clk_binding = 0; /* the first poll takes the clock's binding as new */
+	c->clk_seen = 0;
 	memset(&c->hbw, 0, sizeof(c->hbw));
 	take_bindings(c);
 	check_heartbeat(c, arflex_sys_now_ns());
@@ -921,6 +964,13 @@ int arflex_component_main(int argc, char **argv, const struct arflex_component_o
 		arflex_comp_log(c, "configure failed: %s", strerror(r < 0 ? -r : r));
 		code = ARFLEX_EXIT_CONFIGURE;
 		goto out_task;
+	}
+	/* A sporadic task is clocked by its first declared input (D27); without any input
+	 * nothing can release it, and it keeps the periodic loop at its minimum inter-arrival. */
+	if (c->ctl->config.task_type == ARFLEX_TASK_SPORADIC && c->ninputs > 0) {
+		c->sporadic = true;
+		c->task.o.poll = rt_poll;
+		c->task.o.poll_ns = ARFLEX_TASK_POLL_NS(c->task.o.period_ns);
 	}
 	STORE(&c->ctl->state, ARFLEX_STATE_READY);
 

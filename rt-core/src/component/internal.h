@@ -50,6 +50,9 @@ struct arflex_component {
 	bool orphan_safe;             /* RT -> mailbox: a safe cycle ran after the loss */
 	bool hb_stale;                /* RT -> mailbox: the windowed heartbeat judgement */
 	struct arflex_hb_window hbw;  /* RT thread */
+	bool sporadic;                /* released by new samples on inputs[0] (D27) */
+	uint32_t clk_binding;         /* RT thread: binding of inputs[0] clk_seen belongs to */
+	uint64_t clk_seen;            /* RT thread: write count (hdr->head) of inputs[0] seen */
 	uint64_t lost_ns;             /* watcher -> mailbox: when the supervisor was lost */
 	bool lost_noticed;            /* mailbox thread */
 	bool orphaned;                /* mailbox thread: left the loop as an orphan */

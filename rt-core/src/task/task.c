@@ -101,6 +101,8 @@ int arflex_task_init(struct arflex_task *t, const struct arflex_task_opts *o)
 	t->o = *o;
 	if (!t->o.deadline_ns)
 		t->o.deadline_ns = t->o.period_ns;
+	if (t->o.poll && !t->o.poll_ns)
+		t->o.poll_ns = ARFLEX_TASK_POLL_NS(t->o.period_ns);
 	t->dma_fd = -1;
 	pthread_mutex_init(&t->lock, NULL);
 	pthread_cond_init(&t->cond, NULL);
@@ -213,6 +215,86 @@ static void loop(struct arflex_task *t)
 	}
 }
 
+/* Sporadic mode: waits for the earliest release @earliest, then polls every poll_ns (absolute
+ * ticks) until poll reports events. Returns false when stopped first; else *@release is the
+ * tick at which the events were seen, *@wake the actual time of that poll. */
+static bool wait_release(struct arflex_task *t, uint64_t earliest, uint64_t *release,
+			 uint64_t *wake, uint64_t *events)
+{
+	const uint64_t poll = t->o.poll_ns;
+	uint64_t tick = earliest;
+
+	if (arflex_sys_sleep_until(tick))
+		warn(t, ARFLEX_WARN_SLEEP);
+	for (;;) {
+		uint64_t now;
+
+		if (LOAD(&t->stop))
+			return false;
+		now = arflex_sys_now_ns();
+		*events = 0;
+		if (t->o.poll(t->o.arg, now, events) > 0) {
+			if (*events == 0)
+				*events = 1;
+			*release = tick;
+			*wake = now;
+			return true;
+		}
+		tick += poll;
+		if (tick <= now) /* woke late: the next tick still ahead, no burst of polls */
+			tick += ((now - tick) / poll + 1) * poll;
+		if (arflex_sys_sleep_until(tick))
+			warn(t, ARFLEX_WARN_SLEEP);
+	}
+}
+
+static void sporadic_loop(struct arflex_task *t)
+{
+	struct arflex_stats *s = arflex_task_stats(t);
+	const uint64_t period = t->o.period_ns;
+	uint64_t earliest = arflex_sys_now_ns();
+
+	for (;;) {
+		uint64_t release, wake, end, seq, events;
+		int r;
+
+		if (!wait_release(t, earliest, &release, &wake, &events))
+			break;
+		r = t->o.cycle(t->o.arg, release);
+		end = arflex_sys_now_ns();
+
+		seq = s->seq;
+		STORE(&s->seq, seq + 1);
+		__atomic_thread_fence(__ATOMIC_RELEASE);
+		s->cycles++;
+		s->last_release_ns = release;
+		arflex_metric_add(&s->latency, wake > release ? wake - release : 0);
+		arflex_metric_add(&s->exec, end - wake);
+		if (end > release + t->o.deadline_ns) {
+			s->deadline_misses++;
+			warn(t, ARFLEX_WARN_DEADLINE);
+		}
+		if (r < 0) {
+			s->update_errors++;
+			warn(t, ARFLEX_WARN_UPDATE);
+		}
+		if (events > 1) { /* the input outran the minimum inter-arrival: coalesced */
+			s->overruns++;
+			s->missed_periods += events - 1;
+			warn(t, ARFLEX_WARN_OVERRUN);
+		}
+		STORE(&s->seq, seq + 2);
+
+		if (r > 0 || (t->o.max_cycles && s->cycles >= t->o.max_cycles))
+			break;
+		/* minimum inter-arrival; a cycle that ran past it is released no earlier than
+		 * its end (the deadline of what comes next counts from when it can be seen) */
+		earliest = release + period;
+		if (earliest < end)
+			earliest = end;
+	}
+}
+
 /* Body shared by the thread and arflex_task_run. */
 static int body(struct arflex_task *t)
 {
@@ -229,7 +311,10 @@ static int body(struct arflex_task *t)
 		}
 	}
 	set_state(t, T_RUNNING);
-	loop(t);
+	if (t->o.poll)
+		sporadic_loop(t);
+	else
+		loop(t);
 	if (t->o.on_stop)
 		t->o.on_stop(t->o.arg);
 	release_rt(t);
