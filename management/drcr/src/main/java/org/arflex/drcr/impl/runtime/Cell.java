@@ -280,7 +280,12 @@ public final class Cell {
         }
         inst.planned = true;
         inst.life.target(State.ACTIVE);
-        inst.life.to(State.UNSATISFIED, "resolving");
+        if (inst.half == null && inst.life.state() != State.FAILED) {
+            // A running half stays ACTIVE unless the plan stops it (a replace that changes
+            // nothing it runs with leaves it running); a FAILED one stays FAILED, blocked in the
+            // planner, until an operator reset (D26).
+            inst.life.to(State.UNSATISFIED, "resolving");
+        }
         log.accept("arflex: " + plan.title() + "\n" + plan.toText());
         execute(plan);
         changed();

@@ -216,6 +216,33 @@ class CellTest {
         assertEquals(State.ACTIVE, state("cons"));
     }
 
+    /**
+     * D26 (found by CellConcurrencyTest): the install of a contract into an instance that is
+     * planned already neither shows a running half as UNSATISFIED "resolving" when the plan
+     * leaves it running, nor takes a FAILED one out of FAILED while the planner keeps it blocked
+     * (a reset then said "nothing to reset" and the component stayed down for good).
+     */
+    @Test
+    void reinstallOfARunningOrFailedComponentKeepsItsStateAndResetStillRevives() throws Exception {
+        installBoth();
+        FakeLauncher.FakeHalf h = launcher.running.get("prov");
+        install(contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us"));
+        assertEquals(State.ACTIVE, state("prov"), reason("prov"));
+        assertSame(h, launcher.running.get("prov"), "an identical contract restarts nothing");
+        for (int i = 0; i < 3; i++) {
+            launcher.running.get("prov").crash(139, "killed by signal 11");
+            actor.runAll();
+            actor.advance(500);
+        }
+        assertEquals(State.FAILED, state("prov"));
+        install(contract("prov", PROVIDER_PORTS, PERMANENT, false, 5, "50us").replace("1.0.0", "1.0.1"));
+        assertEquals(State.FAILED, state("prov"), "still blocked in the planner: " + cell.planner().blocked());
+        String reply = actor.call(() -> cell.reset("prov"), 0);
+        assertTrue(reply.startsWith("prov: reset from FAILED"), reply);
+        assertEquals(State.ACTIVE, state("prov"));
+        assertEquals(State.ACTIVE, state("cons"));
+    }
+
     @Test
     void resetFromFailedRecreatesADamagedOutputSegmentAndKeepsAnIntactOne() throws Exception {
         installBoth();
