@@ -28,7 +28,7 @@ set +e
 mvn -B -o -Darflex.native.skip=true -Darflex.native.tests.skip=true -pl tests verify \
   -Dtest=none -Dsurefire.failIfNoSpecifiedTests=false -Dit.test=SoakBench -Dfailsafe.failIfNoSpecifiedTests=false \
   -Darflex.bench.cycles="$cycles" -Darflex.bench.kills="$kills" -Darflex.bench.threads="$threads" \
-  ${every:+-Darflex.bench.every="$every"} -Darflex.bench.out="$ROOT/target/bench/soak.json" >"$log" 2>&1
+  ${every:+-Darflex.bench.every="$every"} ${ARFLEX_SOAK_HISTOGRAM:+-Darflex.bench.histogram=true} -Darflex.bench.out="$ROOT/target/bench/soak.json" >"$log" 2>&1
 status=$?
 set -e
 grep -E '^(soak:|JSON:)' "$log" || true

@@ -125,6 +125,12 @@ class SoakBench {
                 }
             }
             maxShellMs = Math.max(maxShellMs, silence);
+            if (Boolean.getBoolean("arflex.bench.histogram")) {
+                // what the heap holds after the churn: the classes with the most bytes
+                Path jcmd = Path.of(ProcessHandle.current().info().command().orElseThrow()).resolveSibling("jcmd");
+                run(jcmd.toString(), Long.toString(jvm), "GC.class_histogram").lines().limit(25)
+                        .forEach(l -> System.out.println("soak: histogram " + l));
+            }
         }
         int leaks = leftovers(rid);
         report(total, killed, quiet, busy, leaks);

@@ -1,0 +1,119 @@
+package org.arflex.shell;
+
+import java.io.FileDescriptor;
+import java.io.FileInputStream;
+import java.io.FileOutputStream;
+import java.io.IOException;
+import java.io.InputStream;
+import java.io.InputStreamReader;
+import java.io.PrintStream;
+import java.net.URL;
+import java.nio.charset.StandardCharsets;
+import java.nio.file.Files;
+import java.nio.file.Path;
+import org.apache.felix.service.command.CommandProcessor;
+import org.apache.felix.service.command.CommandSession;
+import org.osgi.annotation.bundle.Header;
+import org.osgi.framework.Bundle;
+import org.osgi.framework.BundleActivator;
+import org.osgi.framework.BundleContext;
+import org.osgi.framework.BundleException;
+import org.osgi.framework.Constants;
+import org.osgi.util.tracker.ServiceTracker;
+
+/**
+ * The runtime's console on standard input (docs/DECISIONS.md D28): a Gogo session created as
+ * Gogo's shell creates its login session (the same profile, so the same {@code SCOPE}, prompt
+ * and commands), read by {@link LineConsole}. The end of input stops the framework, as Gogo's
+ * login shell did. Gogo's own console is kept off by {@code gosh.args=--nointeractive} in
+ * conf/config.properties; {@code arflex.shell=none} starts no console at all.
+ */
+@Header(name = Constants.BUNDLE_ACTIVATOR, value = "${@class}")
+public final class Activator implements BundleActivator {
+
+    private static final long WAIT_MS = 30_000;
+
+    private volatile Thread thread;
+    private volatile boolean stopping;
+
+    @Override
+    public void start(BundleContext ctx) {
+        if ("none".equals(ctx.getProperty("arflex.shell"))) {
+            return;
+        }
+        Thread t = new Thread(() -> run(ctx), "arflex-shell");
+        t.setDaemon(true);
+        thread = t;
+        t.start();
+    }
+
+    @Override
+    public void stop(BundleContext ctx) {
+        stopping = true;
+        Thread t = thread;
+        if (t != null) {
+            t.interrupt();
+        }
+    }
+
+    private void run(BundleContext ctx) {
+        ServiceTracker<CommandProcessor, CommandProcessor> tracker = new ServiceTracker<>(ctx, CommandProcessor.class, null);
+        tracker.open();
+        try {
+            CommandProcessor processor = tracker.waitForService(WAIT_MS);
+            if (processor == null) {
+                System.err.println("arflex shell: no Gogo command processor after " + WAIT_MS / 1000 + " s: no console");
+                return;
+            }
+            PrintStream out = new PrintStream(new FileOutputStream(FileDescriptor.out), true, StandardCharsets.UTF_8);
+            InputStream keyboard = new FileInputStream(FileDescriptor.in);
+            CommandSession session = processor.createSession(keyboard, out, new FileOutputStream(FileDescriptor.err));
+            session.put(".gosh_login", true);
+            session.put(".gosh_interactive", true);
+            session.put(".gosh_quiet", true);
+            profile(ctx, session);
+            new LineConsole(session, new InputStreamReader(keyboard, StandardCharsets.UTF_8), out).run();
+            session.close();
+            if (!stopping) {
+                out.println("gosh: stopping shell and framework");
+                ctx.getBundle(Constants.SYSTEM_BUNDLE_LOCATION).stop();
+            }
+        } catch (InterruptedException e) {
+            Thread.currentThread().interrupt();
+        } catch (IOException | BundleException | RuntimeException e) {
+            if (!stopping) {
+                System.err.println("arflex shell: " + e);
+            }
+        } finally {
+            tracker.close();
+        }
+    }
+
+    /** Gogo's login profile: etc/gosh_profile of the working directory, else the one in Gogo's shell bundle. */
+    private static void profile(BundleContext ctx, CommandSession session) {
+        String text = null;
+        try {
+            Path local = Path.of("etc", "gosh_profile");
+            if (Files.isRegularFile(local)) {
+                text = Files.readString(local);
+            } else {
+                for (Bundle b : ctx.getBundles()) {
+                    if ("org.apache.felix.gogo.shell".equals(b.getSymbolicName())) {
+                        URL u = b.getEntry("/ext/gosh_profile");
+                        u = u != null ? u : b.getEntry("/gosh_profile");
+                        if (u != null) {
+                            try (InputStream s = u.openStream()) {
+                                text = new String(s.readAllBytes(), StandardCharsets.UTF_8);
+                            }
+                        }
+                    }
+                }
+            }
+            if (text != null) {
+                session.execute(text);
+            }
+        } catch (Exception e) {
+            System.err.println("arflex shell: the login profile failed: " + e);
+        }
+    }
+}
