@@ -84,6 +84,10 @@ public final class Mailbox implements AutoCloseable {
     private final MessageQueue rsp;
     private final long token;
     private int seq;
+    /** Whether the RT half at the other end still runs: a call to a dead one ends early. */
+    private volatile java.util.function.BooleanSupplier peerAlive = () -> true;
+    /** How often a waiting call looks whether its peer still runs. */
+    static final long PEER_CHECK_MS = 10;
 
     Mailbox(MessageQueue cmd, MessageQueue rsp, long token) {
         this.cmd = cmd;
@@ -153,6 +157,16 @@ public final class Mailbox implements AutoCloseable {
         }, timeoutMs);
     }
 
+    /**
+     * A call now also ends when {@code alive} says the RT half has exited, within
+     * {@link #PEER_CHECK_MS} of that, instead of waiting for its whole timeout (issue 17: the
+     * lifecycle actor waited up to 2 s on a BIND to a half that had been killed, and the exit of
+     * every other half waited behind it).
+     */
+    public void watch(java.util.function.BooleanSupplier alive) {
+        peerAlive = alive;
+    }
+
     /** A command without payload. */
     public Reply call(Cmd c, long timeoutMs) throws IOException {
         return call(c, b -> { }, timeoutMs);
@@ -176,8 +190,11 @@ public final class Mailbox implements AutoCloseable {
             if (left <= 0) {
                 throw new IOException(c + " (seq " + s + "): no reply within " + timeoutMs + " ms on " + rsp.name());
             }
-            Optional<byte[]> got = rsp.receive(left);
+            Optional<byte[]> got = rsp.receive(Math.min(left, PEER_CHECK_MS));
             if (got.isEmpty()) {
+                if (!peerAlive.getAsBoolean()) {
+                    throw new IOException(c + " (seq " + s + "): the RT half exited before it answered (" + rsp.name() + ")");
+                }
                 continue;
             }
             ByteBuffer r = ByteBuffer.wrap(got.get()).order(ByteOrder.LITTLE_ENDIAN);

@@ -142,6 +142,7 @@ public final class ProcessLauncher implements RtLauncher {
         }
         // p.getOutputStream() is the supervisor pipe: held open until cleanup(); its first 8
         // bytes are the token (a half that died at once is reported by the wait below)
+        mb.watch(p::isAlive); // a call to a half that has exited ends at once, not at its timeout
         ProcessRtHalf half = new ProcessRtHalf(inst, p, ctl, mb, p.getOutputStream());
         sendToken(p.getOutputStream(), token);
         half.pumpOutput(log);

@@ -49,4 +49,18 @@ class MailboxTokenTest {
             assertEquals(TOKEN, seen.get());
         }
     }
+
+    @Test
+    void aCallToAnRtHalfThatExitedEndsAtOnceNotAtItsTimeout() throws Exception {
+        MessageQueue cmd = MessageQueue.create("/arflex." + rid + ".gone.cmd", Mailbox.MQ_MAXMSG, Mailbox.MSG_SIZE);
+        MessageQueue rsp = MessageQueue.create("/arflex." + rid + ".gone.rsp", Mailbox.MQ_MAXMSG, Mailbox.MSG_SIZE);
+        try (Mailbox mb = new Mailbox(cmd, rsp, TOKEN)) {
+            mb.watch(() -> false); // nobody will ever answer: the peer is gone
+            long t0 = System.nanoTime();
+            IOException e = assertThrows(IOException.class, () -> mb.call(Mailbox.Cmd.BIND, 60_000));
+            long ms = (System.nanoTime() - t0) / 1_000_000L;
+            org.junit.jupiter.api.Assertions.assertTrue(e.getMessage().contains("exited before it answered"), e.getMessage());
+            org.junit.jupiter.api.Assertions.assertTrue(ms < 30_000, "waited " + ms + " ms of a 60 s timeout");
+        }
+    }
 }
