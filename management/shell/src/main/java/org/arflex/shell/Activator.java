@@ -9,8 +9,6 @@ import java.io.InputStreamReader;
 import java.io.PrintStream;
 import java.net.URL;
 import java.nio.charset.StandardCharsets;
-import java.nio.file.Files;
-import java.nio.file.Path;
 import org.apache.felix.service.command.CommandProcessor;
 import org.apache.felix.service.command.CommandSession;
 import org.osgi.annotation.bundle.Header;
@@ -89,31 +87,26 @@ public final class Activator implements BundleActivator {
         }
     }
 
-    /** Gogo's login profile: etc/gosh_profile of the working directory, else the one in Gogo's shell bundle. */
+    /**
+     * Gogo's login profile, from Gogo's shell bundle only (a bundle the code gate admitted).
+     * Gogo's own shell also ran {@code etc/gosh_profile} of the working directory: a file on disk
+     * executed as commands at every start, unverified; this console does not.
+     */
     private static void profile(BundleContext ctx, CommandSession session) {
-        String text = null;
-        try {
-            Path local = Path.of("etc", "gosh_profile");
-            if (Files.isRegularFile(local)) {
-                text = Files.readString(local);
-            } else {
-                for (Bundle b : ctx.getBundles()) {
-                    if ("org.apache.felix.gogo.shell".equals(b.getSymbolicName())) {
-                        URL u = b.getEntry("/ext/gosh_profile");
-                        u = u != null ? u : b.getEntry("/gosh_profile");
-                        if (u != null) {
-                            try (InputStream s = u.openStream()) {
-                                text = new String(s.readAllBytes(), StandardCharsets.UTF_8);
-                            }
-                        }
-                    }
-                }
+        for (Bundle b : ctx.getBundles()) {
+            if (!"org.apache.felix.gogo.shell".equals(b.getSymbolicName())) {
+                continue;
             }
-            if (text != null) {
-                session.execute(text);
+            URL u = b.getEntry("/ext/gosh_profile");
+            u = u != null ? u : b.getEntry("/gosh_profile");
+            if (u == null) {
+                continue;
             }
-        } catch (Exception e) {
-            System.err.println("arflex shell: the login profile failed: " + e);
+            try (InputStream s = u.openStream()) {
+                session.execute(new String(s.readAllBytes(), StandardCharsets.UTF_8));
+            } catch (Exception e) {
+                System.err.println("arflex shell: the login profile failed: " + e);
+            }
         }
     }
 }
