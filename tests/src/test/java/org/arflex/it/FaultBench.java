@@ -260,7 +260,7 @@ class FaultBench {
                 rec.close();
             }
         }
-        leaks += leftovers(rid);
+        leaks += leftovers(rid, "faults");
 
         // S18: kill -9 of the JVM, each time a fresh runtime with the moving cell.
         for (int i = 0; i < Integer.getInteger("arflex.bench.jvmkills", Math.max(1, rounds / 2)); i++) {
@@ -294,7 +294,7 @@ class FaultBench {
                     System.out.println("faults: S18 " + e.getMessage().lines().findFirst().orElse(""));
                 }
             }
-            int l = leftovers(r18);
+            int l = leftovers(r18, "faults");
             leaks += l;
             record("S18-jvm-kill", new Run(safeMs >= 0 && gone && l == 0, safeMs, 0, ctlNote(l)));
         }
@@ -314,13 +314,14 @@ class FaultBench {
     }
 
     /** /dev/shm and /dev/mqueue objects and processes of a runtime id left after it closed. */
-    private static int leftovers(String rid) throws Exception {
+    /** RT processes and /dev/shm, /dev/mqueue objects left by runtime {@code rid}, each printed. */
+    static int leftovers(String rid, String bench) throws Exception {
         int n = Runtime.rtProcesses(rid).size();
         for (String dir : new String[] {"/dev/shm", "/dev/mqueue"}) {
             if (Files.isDirectory(Path.of(dir))) {
                 try (DirectoryStream<Path> ds = Files.newDirectoryStream(Path.of(dir), "arflex." + rid + ".*")) {
                     for (Path p : ds) {
-                        System.out.println("faults: leak " + p);
+                        System.out.println(bench + ": leak " + p);
                         n++;
                     }
                 }

@@ -3,7 +3,6 @@ package org.arflex.it;
 import static org.junit.jupiter.api.Assertions.assertEquals;
 import static org.junit.jupiter.api.Assertions.assertTrue;
 
-import java.nio.charset.StandardCharsets;
 import java.nio.file.Files;
 import java.nio.file.Path;
 import java.util.regex.Matcher;
@@ -35,11 +34,7 @@ class JvmStallIT {
 
     /** Holds every Java thread of the runtime at a safepoint while the heap is written out. */
     private static void heapDump(long jvm, Path file) throws Exception {
-        Path jcmd = Path.of(ProcessHandle.current().info().command().orElseThrow()).resolveSibling("jcmd");
-        Process p = new ProcessBuilder(jcmd.toString(), Long.toString(jvm), "GC.heap_dump", "-all", "-gz=9", file.toString())
-                .redirectErrorStream(true).start();
-        String out = new String(p.getInputStream().readAllBytes(), StandardCharsets.UTF_8);
-        assertEquals(0, p.waitFor(), "jcmd GC.heap_dump: " + out);
+        Jcmd.run(jvm, "GC.heap_dump", "-all", "-gz=9", file.toString());
         Files.deleteIfExists(file);
     }
 

@@ -3,8 +3,6 @@ package org.arflex.it;
 import static org.junit.jupiter.api.Assertions.assertEquals;
 import static org.junit.jupiter.api.Assertions.assertTrue;
 
-import java.nio.charset.StandardCharsets;
-import java.nio.file.Path;
 import java.util.regex.Matcher;
 import java.util.regex.Pattern;
 import org.junit.jupiter.api.Test;
@@ -22,10 +20,7 @@ class ShellLeakIT {
 
     /** PrintStream instances alive in the runtime JVM after a full GC (the histogram collects first). */
     private static long printStreams(long jvm) throws Exception {
-        Path jcmd = Path.of(ProcessHandle.current().info().command().orElseThrow()).resolveSibling("jcmd");
-        Process p = new ProcessBuilder(jcmd.toString(), Long.toString(jvm), "GC.class_histogram").redirectErrorStream(true).start();
-        String out = new String(p.getInputStream().readAllBytes(), StandardCharsets.UTF_8);
-        assertEquals(0, p.waitFor(), out);
+        String out = Jcmd.run(jvm, "GC.class_histogram");
         Matcher m = PRINT_STREAMS.matcher(out);
         return m.find() ? Long.parseLong(m.group(1)) : 0;
     }

@@ -1,6 +1,5 @@
 package org.arflex.it;
 
-import java.nio.charset.StandardCharsets;
 import java.nio.file.DirectoryStream;
 import java.nio.file.Files;
 import java.nio.file.Path;
@@ -127,12 +126,11 @@ class SoakBench {
             maxShellMs = Math.max(maxShellMs, silence);
             if (Boolean.getBoolean("arflex.bench.histogram")) {
                 // what the heap holds after the churn: the classes with the most bytes
-                Path jcmd = Path.of(ProcessHandle.current().info().command().orElseThrow()).resolveSibling("jcmd");
-                run(jcmd.toString(), Long.toString(jvm), "GC.class_histogram").lines().limit(25)
+                Jcmd.run(jvm, "GC.class_histogram").lines().limit(25)
                         .forEach(l -> System.out.println("soak: histogram " + l));
             }
         }
-        int leaks = leftovers(rid);
+        int leaks = FaultBench.leftovers(rid, "soak");
         report(total, killed, quiet, busy, leaks);
     }
 
@@ -186,9 +184,8 @@ class SoakBench {
 
     /** Heap after a full GC (KB), threads and fds of the JVM; the cell's shm, mq and RT processes. */
     private void sample(Runtime rt, long jvm, String rid) throws Exception {
-        Path jcmd = Path.of(ProcessHandle.current().info().command().orElseThrow()).resolveSibling("jcmd");
-        run(jcmd.toString(), Long.toString(jvm), "GC.run");
-        String info = run(jcmd.toString(), Long.toString(jvm), "GC.heap_info");
+        Jcmd.run(jvm, "GC.run");
+        String info = Jcmd.run(jvm, "GC.heap_info");
         Matcher m = Pattern.compile("used (\\d+)K").matcher(info);
         long heapKb = m.find() ? Long.parseLong(m.group(1)) : -1;
         long threads = 0;
@@ -220,22 +217,6 @@ class SoakBench {
                 n++;
             }
         }
-        return n;
-    }
-
-    private static String run(String... cmd) throws Exception {
-        Process p = new ProcessBuilder(cmd).redirectErrorStream(true).start();
-        String out = new String(p.getInputStream().readAllBytes(), StandardCharsets.UTF_8);
-        if (p.waitFor() != 0) {
-            throw new AssertionError(String.join(" ", cmd) + ": " + out);
-        }
-        return out;
-    }
-
-    private static int leftovers(String rid) throws Exception {
-        int n = Runtime.rtProcesses(rid).size();
-        n += (int) count("/dev/shm", rid);
-        n += (int) count("/dev/mqueue", rid);
         return n;
     }
 
