@@ -1,5 +1,6 @@
 /* The test kit without a test framework: ids, leak checks, small file reads. Linked by the
  * cmocka suites (through arflex_test_helper) and by the component tests of the bundles. */
+#define _GNU_SOURCE
 #include "helper.h"
 
 #include <dirent.h>
@@ -10,6 +11,7 @@
 #include <string.h>
 #include <sys/mman.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 
@@ -119,7 +121,7 @@ bool th_no_children(void)
 	return waitpid(-1, &st, WNOHANG) < 0 && errno == ECHILD;
 }
 
-int th_threads(void)
+static int count_threads(void)
 {
 	DIR *d = opendir("/proc/self/task");
 	struct dirent *e;
@@ -131,6 +133,21 @@ int th_threads(void)
 		if (e->d_name[0] != '.')
 			n++;
 	closedir(d);
+	return n;
+}
+
+int th_threads(void)
+{
+	/* pthread_join returns when the kernel clears the thread's tid, a moment before the
+	 * thread leaves /proc/self/task: a joined thread may still be listed. Wait (1 s at
+	 * most) for the count to settle at one before reporting more. */
+	struct timespec step = { 0, 1000000 };
+	int n = count_threads();
+
+	for (int i = 0; i < 1000 && n > 1; i++) {
+		nanosleep(&step, NULL);
+		n = count_threads();
+	}
 	return n;
 }
 

@@ -23,7 +23,7 @@ int th_leftovers(const char *rid);
 /* True when this process has no child (reaped or not). */
 bool th_no_children(void);
 
-/* Number of threads of this process. */
+/* Number of threads of this process, once any thread just joined has left (1 s at most). */
 int th_threads(void);
 
 /* Registers the message queues of (@rid, @inst) for th_leftovers: /dev/mqueue is not always
