@@ -1,6 +1,7 @@
 #include "arflex_sim/cell.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -178,6 +179,7 @@ void Cell::ResetTo(const JointVector& q) {
   mju_zero(data_->qacc_warmstart, model_->nv);
   for (int i = 0; i < kNumJoints; ++i) data_->qpos[motor_qadr_[i]] = q[i];
   SolveStaticCompliance();
+  braking_ = false;
   q_ref_ = q;
   correction_ = JointVector{};
   mj_forward(model_, data_);
@@ -201,6 +203,7 @@ JointVector Cell::NominalGravityTorque(const JointVector& q, double payload_mass
 }
 
 void Cell::Controller() {
+  if (braking_) Brake();
   JointVector q;
   for (int i = 0; i < kNumJoints; ++i) q[i] = data_->qpos[motor_qadr_[i]];
   JointVector gravity{};
@@ -213,10 +216,56 @@ void Cell::Controller() {
   // Reduced power: the corrective term is saturated, the gravity feed-forward is not.
   for (int i = 0; i < kNumJoints; ++i) {
     const double target = q_ref_[i] + correction_[i];
-    const double limit = power_scale_ * config_.arm.links[i].max_torque;
+    const double limit = (braking_ ? 1.0 : power_scale_) * config_.arm.links[i].max_torque;
     const double p_term = std::clamp(config_.gains.kp[i] * (target - q[i]), -limit, limit);
     data_->ctrl[i] = p_term + gravity[i];
   }
+}
+
+void Cell::Stop() {
+  stop_t0_ = data_->time;
+  stop_T_ = kStopTime;
+  // The inertial torque of the deceleration on every joint, per unit of the profile's
+  // acceleration: M v0, the full mass matrix at this pose (armature included), so a joint at
+  // rest is not pushed by its neighbours' braking. Motor dofs only; no allocation.
+  std::array<mjtNum, kMaxDofs> v{}, mv{};
+  const bool coupled = model_->nv <= kMaxDofs;
+  for (int i = 0; i < kNumJoints; ++i) v[motor_dadr_[i]] = data_->qvel[motor_dadr_[i]];
+  if (coupled) mj_mulM(model_, data_, mv.data(), v.data());
+  for (int i = 0; i < kNumJoints; ++i) {
+    const int dof = motor_dadr_[i];
+    const double kp = config_.gains.kp[i];
+    const double inertia = data_->qM[model_->dof_Madr[dof]];
+    stop_q0_[i] = data_->qpos[motor_qadr_[i]];
+    stop_v0_[i] = data_->qvel[dof];
+    stop_ff_c_[i] = model_->dof_damping[dof] * stop_v0_[i] / kp;
+    stop_ff_j_[i] = (coupled ? mv[dof] : inertia * stop_v0_[i]) / kp;
+    // The profile's peak deceleration is 1.5 v0 / T: within 80 % of the drive's torque.
+    const double need = 1.5 * std::fabs(stop_v0_[i]) * inertia / (0.8 * config_.arm.links[i].max_torque);
+    stop_T_ = std::max(stop_T_, need);
+  }
+  correction_ = JointVector{};
+  braking_ = true;
+}
+
+JointVector Cell::StopTarget() const {
+  JointVector q;
+  for (int i = 0; i < kNumJoints; ++i) q[i] = stop_q0_[i] + 0.5 * stop_v0_[i] * stop_T_;  // profile's integral
+  return q;
+}
+
+// One step of the stop: the profile's position, fed forward (see Stop).
+void Cell::Brake() {
+  const double u = std::min(1.0, (data_->time - stop_t0_) / stop_T_);
+  const double pos = u - u * u * u + 0.5 * u * u * u * u;  // integral of 1 - 3u^2 + 2u^3
+  const double vel = 1.0 - 3.0 * u * u + 2.0 * u * u * u;
+  const double acc = (-6.0 * u + 6.0 * u * u) / stop_T_;
+  for (int i = 0; i < kNumJoints; ++i) {
+    const double v0 = stop_v0_[i];
+    q_ref_[i] = stop_q0_[i] + v0 * stop_T_ * pos + stop_ff_c_[i] * vel + stop_ff_j_[i] * acc;
+  }
+  correction_ = JointVector{};
+  if (u >= 1.0) braking_ = false;  // q_ref_ stays where the profile ended
 }
 
 void Cell::SetPowerScale(double fraction) {

@@ -10,8 +10,8 @@
 // Safety input `safety` (arflex.SafetyState, role=safety: the force guard) permits motion
 // (SPEC §5.3 safety inputs, docs/safety.md): the servo follows joint_ref only while the
 // guard is bound, has spoken since it was bound, is fresh (safety_max_age_ms) and valid and
-// not in a protective stop (arflex/safety_gate.h). Otherwise the arm holds its measured pose
-// (a protective stop); losing a guard that had permitted motion also latches an operator
+// not in a protective stop (arflex/safety_gate.h). Otherwise the arm stops (a controlled
+// 20 ms stop, Cell::Stop) and holds where it stopped (a protective stop); losing a guard that had permitted motion also latches an operator
 // reset. Its power_scale limits the drives (Cell::SetPowerScale: the servo's corrective
 // torque saturates at that fraction of each drive's max torque). The fraction applied is
 // published on `servo_power` (arflex.Sample) every period.
@@ -24,7 +24,7 @@
 // REFERENCE / ARFLEX_HOLD_REF_INVALID with the input's index (the DRCR names the provider).
 //
 // Scripted disturbances come from parameters (see the contract, sim-robot.xml). The safe hook
-// holds the arm where it is (the servo's reference becomes the measured pose).
+// stops the arm the same way and holds it.
 //
 // Everything is allocated in configure; update/safe only step the Cell (no allocation, no
 // printing, no blocking).
@@ -345,12 +345,13 @@ bool AtRest(Robot& r, const double* q) {
   return ++r.rest_values >= kRestValues;
 }
 
-// The servo holds where the arm is: its reference becomes the measured pose, no blend.
-void HoldMeasured(Robot& r) {
-  const arflex::sim::JointState js = r.cell->ReadJointState();
-  r.q_ref = js.q;
+// A controlled stop (Cell::Stop, docs/safety.md "How the arm stops"): the arm decelerates
+// along a 20 ms profile and the servo holds where it ends; no blend. On an arm at rest it
+// holds where the arm is.
+void StopAndHold(Robot& r) {
+  r.cell->Stop();
+  r.q_ref = r.cell->StopTarget();
   r.blend_t = kBlendSeconds;  // holding: no blend in progress
-  r.cell->SetJointReference(r.q_ref);
   r.cell->SetCorrection(JointVector{});
 }
 
@@ -459,7 +460,7 @@ int Update(arflex_component* c, void* user, uint64_t release_ns) {
   if (r.safe) {  // the first cycle after safe mode (the reset): hold where the arm is now
     r.after_stop = true;
     r.rest_values = 0;
-    HoldMeasured(r);
+    StopAndHold(r);
   }
   r.safe = false;
   ApplyParams(c, r);
@@ -469,7 +470,7 @@ int Update(arflex_component* c, void* user, uint64_t release_ns) {
   const arflex_safety_verdict verdict = JudgeSafety(c, r, false);
   if (!arflex_safety_permits(verdict)) {
     if (!r.guard_hold) {
-      HoldMeasured(r);
+      StopAndHold(r);
       r.guard_hold = true;
       r.hold_stops_motion = r.guard_permitted;  // not merely waiting for a first guard
     }
@@ -479,7 +480,7 @@ int Update(arflex_component* c, void* user, uint64_t release_ns) {
     r.guard_hold = false;
     r.after_stop = r.hold_stops_motion;
     r.rest_values = 0;
-    HoldMeasured(r);  // where the arm is now (a push under reduced power may have moved it)
+    StopAndHold(r);  // where the arm is now (a push under reduced power may have moved it)
     r.acquired = false;
     r.refusing = false;
   }
@@ -549,13 +550,13 @@ int Update(arflex_component* c, void* user, uint64_t release_ns) {
   return ret < 0 ? ret : pub;
 }
 
-// Hold: the servo's reference becomes the measured pose (no motion); the physics keeps
+// Hold: a controlled stop, then the servo holds where it ended (no motion); the physics keeps
 // running (the world does not stop) and the sensors keep publishing. Both safe modes hold:
 // "zero" velocity is what holding a position means for a robot.
 int Safe(arflex_component* c, void* user, arflex_safe_mode /*mode*/, bool first) {
   Robot& r = *static_cast<Robot*>(user);
   if (first) {
-    HoldMeasured(r);
+    StopAndHold(r);
     r.acquired = false;  // after the reset the reference must meet the arm again (D9)
     r.refusing = false;
   }

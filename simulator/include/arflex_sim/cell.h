@@ -58,6 +58,20 @@ class Cell {
   void SetPowerScale(double fraction);
   double power_scale() const { return power_scale_; }
 
+  // A controlled stop (docs/safety.md, "How the arm stops"): from its present speed each
+  // joint decelerates along one smooth profile (speed v0 (1 - 3u^2 + 2u^3), u = t / T, T the
+  // same for all joints: kStopTime, longer when a drive's torque needs it) and the servo holds
+  // where the profile ends. The servo's reference is fed forward with the loop's damping and
+  // the joint's inertia, so the arm follows the profile instead of swinging back for 100 ms
+  // (the PD loop's own decay). Braking uses the drives' full torque (the power limit applies
+  // again at standstill). References set while braking are ignored. An arm at rest stays where
+  // it is.
+  static constexpr double kStopTime = 0.02;  // s
+  void Stop();
+  bool braking() const { return braking_; }
+  // Where the last stop's profile ends (the servo's reference once it has).
+  JointVector StopTarget() const;
+
   // Advances exactly `n` physics steps of config.timestep; each runs the servo once. No
   // sleeping: real-time pacing is the caller's business.
   void Step(int n);
@@ -116,6 +130,7 @@ class Cell {
  private:
   Cell(const CellConfig& config);
   void Controller();
+  void Brake();
   void ApplyDisturbances();
   void SolveStaticCompliance();
 
@@ -141,6 +156,12 @@ class Cell {
   JointVector q_ref_{};
   JointVector correction_{};
   double power_scale_ = 1.0;
+  bool braking_ = false;
+  double stop_t0_ = 0, stop_T_ = 0;  // the stop's start (sim time) and duration (s)
+  // Per joint: start, speed, and the feed-forward of the damping (c v0 / kp) and of the inertia
+  // (M v0 / kp), scaled by the profile's speed and acceleration.
+  JointVector stop_q0_{}, stop_v0_{}, stop_ff_c_{}, stop_ff_j_{};
+  static constexpr int kMaxDofs = 64;
   double payload_mass_ = 0.0;
   std::vector<PushSpec> pushes_;  // capacity fixed at Create()
   size_t push_capacity_ = 0;
