@@ -64,6 +64,7 @@ public final class Activator implements BundleActivator {
 
     private ThreadActor actor;
     private java.util.concurrent.ExecutorService stopper;
+    private java.util.concurrent.ExecutorService launches;
     private Cell cell;
     private Services services;
     private ScheduledExecutorService ticker;
@@ -130,6 +131,12 @@ public final class Activator implements BundleActivator {
             t.setDaemon(true);
             return t;
         });
+        // ... and spawned and awaited until READY here (a simulator loads its model meanwhile)
+        launches = Executors.newCachedThreadPool(r -> {
+            Thread t = new Thread(r, "arflex-drcr-launch");
+            t.setDaemon(true);
+            return t;
+        });
         VerifiedExecutables executables = new VerifiedExecutables(storage, log);
         Cell.Config cfg = new Cell.Config(rid, Long.parseLong(prop(ctx, "arflex.ready.timeout.ms", "5000")), 3_000,
                 Boolean.parseBoolean(prop(ctx, "arflex.nomlock", "false")), types, Posix::monotonicNs,
@@ -139,7 +146,7 @@ public final class Activator implements BundleActivator {
         cell = actor.call(() -> {
             ResourceManagerImpl tmp = new ResourceManagerImpl(null, cap, reserved);
             Planner planner = new Planner(tmp.capacities(cpus, memory, network));
-            Cell c = new Cell(cfg, actor, new ProcessLauncher(log, executables), planner, log, stopper);
+            Cell c = new Cell(cfg, actor, new ProcessLauncher(log, executables), planner, log, stopper, launches);
             rm[0] = new ResourceManagerImpl(c, cap, reserved);
             return c;
         }, 10_000);
@@ -300,6 +307,9 @@ public final class Activator implements BundleActivator {
         }
         if (stopper != null) {
             stopper.shutdown();
+        }
+        if (launches != null) {
+            launches.shutdown();
         }
         if (ticker != null) {
             ticker.shutdownNow();

@@ -62,19 +62,23 @@ public final class Cell {
     private final Stops stops;
     private final Segments segments;
     private final Failures failures;
+    private final Starter starter;
     private final PlanExecutor plans;
     private final WcetMonitor wcet;
 
-    /** A cell whose stops run inline, on the caller (tests with a steppable actor). */
+    /** A cell whose launches and stops run inline, on the caller (tests with a steppable actor). */
     public Cell(Config cfg, Actor actor, RtLauncher launcher, Planner planner, Consumer<String> log) {
-        this(cfg, actor, launcher, planner, log, Runnable::run);
+        this(cfg, actor, launcher, planner, log, Runnable::run, Runnable::run);
     }
 
     /**
-     * @param stopper where RT halves are stopped, killed and reaped: never the actor thread in the
-     *                runtime (a frozen half must not hold crash handling or the shell, issue 17)
+     * @param stopper  where RT halves are stopped, killed and reaped: never the actor thread in the
+     *                 runtime (a frozen half must not hold crash handling or the shell, issue 17)
+     * @param launches where RT halves are spawned and awaited until READY: never the actor thread
+     *                 in the runtime, for the same reason
      */
-    public Cell(Config cfg, Actor actor, RtLauncher launcher, Planner planner, Consumer<String> log, Executor stopper) {
+    public Cell(Config cfg, Actor actor, RtLauncher launcher, Planner planner, Consumer<String> log, Executor stopper,
+                Executor launches) {
         this.cfg = cfg;
         this.actor = actor;
         this.planner = planner;
@@ -84,8 +88,9 @@ public final class Cell {
         this.segments = new Segments(cfg.runtimeId(), cfg.types(), launcher, stops,
                 new EvaluationSegments(cfg.evaluation(), launcher));
         this.failures = new Failures(this, this::execute, log);
-        this.plans = new PlanExecutor(this, stops, segments,
-                new Starter(cfg, actor, launcher, monitor, segments, stops, failures, log), log);
+        this.starter = new Starter(cfg, actor, launcher, monitor, segments, stops, failures, log, launches,
+                planner, this::changed, this::resume);
+        this.plans = new PlanExecutor(this, stops, segments, starter, log);
         this.wcet = new WcetMonitor(this, log);
     }
 
@@ -104,9 +109,17 @@ public final class Cell {
         plans.stopped(b);
     }
 
-    /** Completes when every stop handed to the stop threads so far is recorded (any thread). */
+    private void resume() {
+        plans.resume();
+        changed();
+    }
+
+    /**
+     * Completes when every launch begun so far and every stop handed to the stop threads so far
+     * (also the stops of launches nobody wanted any more) is recorded (any thread).
+     */
     public CompletableFuture<Void> stopsDone() {
-        return stops.idle();
+        return starter.idle().thenCompose(v -> stops.idle());
     }
 
     /** Called after every change (on the actor thread): service registrations follow it. */

@@ -30,6 +30,10 @@ public final class Instance {
     final Lifecycle life;
     volatile RestartPolicy policy;
     volatile RtHalf half;
+    /** A half is being launched (spawned, waiting for READY) off the actor (Starter). Actor only. */
+    boolean launching;
+    /** Number of the newest launch; a stop of the instance while it launches makes it stale. */
+    long launchSeq;
     /** Output port name -> segment; created at the first start, kept until destroyed. */
     final Map<String, RtLauncher.Output> outputs = new LinkedHashMap<>();
     /**

@@ -36,7 +36,7 @@ final class Parameters {
         PropertySpec p = c.properties().get(idx);
         long bits = Params.parse(p, text);
         RtHalf half = inst.half;
-        if (half != null && !p.mutable()) {
+        if ((half != null || inst.launching) && !p.mutable()) {
             throw new IllegalArgumentException(name + "." + param + " is immutable while " + inst.life.state()
                     + " (mutable=false)");
         }

@@ -69,7 +69,7 @@ final class PlanExecutor {
         Set<String> later = new LinkedHashSet<>();
         for (String name : plan.startOrder()) {
             Instance inst = cell.find(name);
-            if (inst != null && inst.half == null && (stops.pending(name) || waiting.contains(name)
+            if (inst != null && inst.half == null && (stops.pending(name) || waiting.contains(name) || starter.launching(name)
                     || plan.wiringOf(name).stream().anyMatch(w -> later.contains(w.provider())))) {
                 later.add(name);
             }
@@ -82,7 +82,7 @@ final class PlanExecutor {
         // A failure here is reported by that component's own start below.
         for (String name : plan.startOrder()) {
             Instance inst = cell.find(name);
-            if (inst != null && inst.half == null && !later.contains(name)) {
+            if (inst != null && inst.half == null && !starter.launching(name) && !later.contains(name)) {
                 try {
                     segments.ensure(inst);
                 } catch (IOException | RuntimeException e) {
@@ -94,9 +94,9 @@ final class PlanExecutor {
             Instance inst = cell.find(name);
             // A start that failed earlier in this loop blocked its component, and the nested
             // plan took its dependents out of the active set: ask the planner again.
-            if (inst != null && inst.half == null && inst.life.state() != State.FAILED
+            if (inst != null && inst.half == null && !starter.launching(name) && inst.life.state() != State.FAILED
                     && cell.planner().active().contains(name) && !later.contains(name)) {
-                starter.start(inst, plan.cpuAssignment().getOrDefault(name, -1), plan.wiringOf(name));
+                starter.start(inst, plan.cpuAssignment().getOrDefault(name, -1));
             }
         }
         for (Plan.Action a : plan.rewires()) {
@@ -165,6 +165,9 @@ final class PlanExecutor {
      * see the runtime lost and latch safe mode on its way out. Returns null when nothing runs.
      */
     Stops.Going detach(Instance inst, String why) {
+        if (inst.launching) {
+            inst.launchSeq++; // the half being launched is not wanted any more (Starter stops it)
+        }
         RtHalf half = inst.half;
         if (half == null) {
             return null;
@@ -220,7 +223,7 @@ final class PlanExecutor {
      * Starts what waited for a name that is free now, with the planner's current CPU and
      * wiring, providers first; then binds running consumers to providers that started here.
      */
-    private void resume() {
+    void resume() {
         if (waiting.isEmpty()) {
             return;
         }
@@ -234,7 +237,7 @@ final class PlanExecutor {
                 waiting.remove(name);
                 continue;
             }
-            if (stops.pending(name) || now.wiringOf(name).stream().anyMatch(w -> still.contains(w.provider()))) {
+            if (stops.pending(name) || starter.launching(name) || now.wiringOf(name).stream().anyMatch(w -> still.contains(w.provider()))) {
                 still.add(name);
             } else {
                 ready.add(name);
@@ -254,9 +257,10 @@ final class PlanExecutor {
         }
         for (String name : ready) {
             Instance inst = cell.find(name);
-            if (inst.half == null && inst.life.state() != State.FAILED && cell.planner().active().contains(name)) {
+            if (inst.half == null && !starter.launching(name) && inst.life.state() != State.FAILED
+                    && cell.planner().active().contains(name)) {
                 log.accept("arflex: " + name + ": its previous RT half has exited; starting");
-                starter.start(inst, now.cpuAssignment().getOrDefault(name, -1), now.wiringOf(name));
+                starter.start(inst, now.cpuAssignment().getOrDefault(name, -1));
             }
         }
         for (Instance inst : cell.instances()) {

@@ -1,7 +1,12 @@
 package org.arflex.drcr.impl.runtime;
 
 import java.io.IOException;
+import java.util.ArrayList;
+import java.util.HashMap;
+import java.util.Map;
 import java.util.List;
+import java.util.concurrent.CompletableFuture;
+import java.util.concurrent.Executor;
 import java.util.function.Consumer;
 import org.arflex.contract.Contract;
 import org.arflex.drcr.impl.lifecycle.Actor;
@@ -9,13 +14,19 @@ import org.arflex.drcr.impl.lifecycle.State;
 import org.arflex.drcr.impl.supervisor.HeartbeatMonitor;
 import org.arflex.drcr.impl.supervisor.RtHalf;
 import org.arflex.drcr.impl.supervisor.RtLauncher;
+import org.arflex.planner.Planner;
 import org.arflex.planner.Wire;
 
 /**
- * Starts the RT half of one instance (actor thread): its output segments, the spawn with the
- * control block's configuration and parameters (waiting for READY), a BIND per wire, the runtime
- * heartbeat and START; then the half is watched for hangs and its exit goes to
- * {@link Failures}. A start that fails goes to {@link Failures} as a crash would.
+ * Starts the RT half of one instance in two steps. On the actor: its output segments and the
+ * spawn request (the control block's configuration and parameters). On a launch thread: the
+ * spawn and the wait for READY, which may take hundreds of milliseconds (a simulator loading
+ * its model) and must not hold crash handling, hang kills or the shell (issue 17). Back on the
+ * actor: if the instance still wants exactly this start, a BIND per input of the planner's
+ * current wiring, the parameters written while it started, the runtime heartbeat and START;
+ * then the half is watched for hangs and its exit goes to {@link Failures}. A start that is no
+ * longer wanted (uninstalled, updated, stopped by a plan while it launched) is stopped on a stop
+ * thread; a start that fails goes to {@link Failures} as a crash would.
  */
 final class Starter {
 
@@ -27,9 +38,17 @@ final class Starter {
     private final Stops stops;
     private final Failures failures;
     private final Consumer<String> log;
+    private final Executor launches;
+    private final Planner planner;
+    private final Runnable changed;
+    private final Runnable resume;
+    private int inFlight; // launches whose outcome is not recorded yet (guarded by this)
+    private final Map<String, Integer> byName = new HashMap<>(); // launches in flight per name (actor)
+    private final List<CompletableFuture<Void>> idleWaiters = new ArrayList<>();
 
     Starter(Cell.Config cfg, Actor actor, RtLauncher launcher, HeartbeatMonitor monitor, Segments segments, Stops stops,
-            Failures failures, Consumer<String> log) {
+            Failures failures, Consumer<String> log, Executor launches, Planner planner, Runnable changed,
+            Runnable resume) {
         this.cfg = cfg;
         this.actor = actor;
         this.launcher = launcher;
@@ -38,38 +57,146 @@ final class Starter {
         this.stops = stops;
         this.failures = failures;
         this.log = log;
+        this.launches = launches;
+        this.planner = planner;
+        this.changed = changed;
+        this.resume = resume;
     }
 
-    void start(Instance inst, int cpu, List<Wire> wires) {
+    /** Begins the start of {@code inst} on {@code cpu} (actor thread); see the class comment. */
+    void start(Instance inst, int cpu) {
         Contract c = inst.contract;
-        RtHalf half = null;
         long t0 = cfg.monotonicNs().getAsLong();
-        long tLaunched = t0;
+        boolean resetRequired = c.movesHardware() && inst.everStarted;
+        long[] params = inst.params.clone();
+        RtLauncher.Spec spec;
         try {
             segments.ensure(inst);
-            boolean resetRequired = c.movesHardware() && inst.everStarted;
-            half = launcher.launch(new RtLauncher.Spec(cfg.runtimeId(), inst.name, inst.executable,
-                    ControlSetup.config(c, cpu, cfg.noMlock()), ControlSetup.params(c, inst.params), resetRequired,
-                    cfg.readyTimeoutMs()));
-            tLaunched = cfg.monotonicNs().getAsLong();
+            spec = new RtLauncher.Spec(cfg.runtimeId(), inst.name, inst.executable,
+                    ControlSetup.config(c, cpu, cfg.noMlock()), ControlSetup.params(c, params), resetRequired,
+                    cfg.readyTimeoutMs());
+        } catch (IOException | RuntimeException e) {
+            fail(inst, e);
+            return;
+        }
+        long seq = ++inst.launchSeq;
+        inst.launching = true;
+        byName.merge(inst.name, 1, Integer::sum);
+        synchronized (this) {
+            inFlight++;
+        }
+        inst.life.reason("starting: spawned, waiting for READY");
+        launches.execute(() -> {
+            RtHalf half = null;
+            Exception error = null;
+            try {
+                half = launcher.launch(spec);
+            } catch (IOException | RuntimeException e) {
+                error = e;
+            }
+            long tLaunched = cfg.monotonicNs().getAsLong();
+            RtHalf h = half;
+            Exception err = error;
+            Runnable done = () -> launched(inst, seq, cpu, params, h, err, t0, tLaunched);
+            if (actor.inActor()) {
+                done.run(); // a launch executor that runs inline (tests)
+            } else {
+                actor.submit(done);
+            }
+        });
+    }
+
+    /**
+     * True while a half of this name is being launched (actor thread): a start of the name, also
+     * by a new instance after an uninstall, waits for it (the half owns the name's objects).
+     */
+    boolean launching(String name) {
+        return byName.containsKey(name);
+    }
+
+    /** Completes when every launch begun so far has its outcome recorded (any thread). */
+    synchronized CompletableFuture<Void> idle() {
+        CompletableFuture<Void> f = new CompletableFuture<>();
+        if (inFlight == 0) {
+            f.complete(null);
+        } else {
+            idleWaiters.add(f);
+        }
+        return f;
+    }
+
+    /** The launch of {@code seq} ended (actor thread): finish it, or stop a half nobody wants. */
+    private void launched(Instance inst, long seq, int cpu, long[] params, RtHalf half, Exception error, long t0,
+                          long tLaunched) {
+        byName.computeIfPresent(inst.name, (k, n) -> n == 1 ? null : n - 1);
+        try {
+            record(inst, seq, cpu, params, half, error, t0, tLaunched);
+        } finally {
+            List<CompletableFuture<Void>> done = List.of();
+            synchronized (this) {
+                if (--inFlight == 0) {
+                    done = List.copyOf(idleWaiters);
+                    idleWaiters.clear();
+                }
+            }
+            done.forEach(f -> f.complete(null));
+        }
+    }
+
+    private void record(Instance inst, long seq, int cpu, long[] params, RtHalf half, Exception error, long t0,
+                        long tLaunched) {
+        inst.launching = false;
+        if (seq != inst.launchSeq) {
+            // a plan stopped the instance while it launched (a start of it since waits for this)
+            if (half != null) {
+                stops.submit(List.of(new Stops.Going(inst, half, List.of(), 0, "stopped while it started")));
+            } else {
+                resume.run();
+            }
+            changed.run();
+            return;
+        }
+        boolean wanted = inst.half == null && inst.life.state() != State.DESTROYED
+                && inst.life.state() != State.FAILED && inst.life.target() != State.DESTROYED
+                && planner.active().contains(inst.name);
+        if (!wanted) {
+            if (half != null) {
+                stops.submit(List.of(new Stops.Going(inst, half, List.of(), 0, "no longer wanted when it was ready")));
+            } else {
+                resume.run();
+            }
+            changed.run();
+            return;
+        }
+        if (error != null) {
+            fail(inst, error);
+            resume.run();
+            changed.run();
+            return;
+        }
+        try {
             inst.bound.clear();
-            for (Wire w : wires) {
+            for (Wire w : planner.current().wiringOf(inst.name)) {
                 String seg = segments.name(w.provider(), w.outPort());
                 half.bind(w.inPort(), seg);
                 inst.bound.put(w.inPort(), seg);
             }
+            long[] now = inst.params;
+            for (int i = 0; i < now.length && i < params.length; i++) {
+                if (now[i] != params[i]) { // written while it started
+                    half.setParam(i, now[i]);
+                }
+            }
             half.runtimeHeartbeat(cfg.monotonicNs().getAsLong());
             half.start();
         } catch (IOException | RuntimeException e) {
-            if (half != null) {
-                // stopped and reaped on a stop thread; a restart of the name waits for it
-                stops.submit(List.of(new Stops.Going(inst, half, List.of(), 0, "start failed")));
-            }
-            inst.bound.clear();
-            log.accept("arflex: " + inst.name + ": start failed: " + e.getMessage());
-            failures.failed(inst, true, "start failed: " + e.getMessage());
+            // stopped and reaped on a stop thread; a restart of the name waits for it
+            stops.submit(List.of(new Stops.Going(inst, half, List.of(), 0, "start failed")));
+            fail(inst, e);
+            changed.run();
             return;
         }
+        Contract c = inst.contract;
         inst.half = half;
         inst.cpu = cpu;
         inst.awaitingReset = c.movesHardware() && inst.everStarted;
@@ -82,5 +209,12 @@ final class Starter {
         long t1 = cfg.monotonicNs().getAsLong();
         log.accept("arflex: " + inst.name + " ACTIVE (pid " + half.pid() + ", cpu " + cpu + ", inputs " + inst.bound
                 + "; spawn to READY " + (tLaunched - t0) / 1000 + " us, bind+start " + (t1 - tLaunched) / 1000 + " us)");
+        changed.run();
+    }
+
+    private void fail(Instance inst, Exception e) {
+        inst.bound.clear();
+        log.accept("arflex: " + inst.name + ": start failed: " + e.getMessage());
+        failures.failed(inst, true, "start failed: " + e.getMessage());
     }
 }

@@ -63,8 +63,9 @@ class CellConcurrencyTest {
     private final FakeLauncher fake = new FakeLauncher();
     private final Tracking launcher = new Tracking();
     private final ExecutorService stopper = Executors.newCachedThreadPool();
+    private final ExecutorService launches = Executors.newCachedThreadPool();
     private final Cell cell = new Cell(new Cell.Config("t", 1000, 1000, true, PortTypes.builtin(), System::nanoTime),
-            actor, launcher, new Planner(Capacities.of(2, 1.0, 1L << 30, 1_000_000_000L)), log::add, stopper);
+            actor, launcher, new Planner(Capacities.of(2, 1.0, 1L << 30, 1_000_000_000L)), log::add, stopper, launches);
     private final ResourceManagerImpl resources = new ResourceManagerImpl(cell, 1.0);
     private final Services services = new Services(cell, resources, null, null, null, log::add);
     private final Commands shell = new Commands(services, resources, services, services::management, null);
@@ -142,7 +143,10 @@ class CellConcurrencyTest {
         }
     }
 
-    /** Delegates to the fake launcher; a launch while an earlier half of the name lives is a violation. */
+    /**
+     * Delegates to the fake launcher; a launch on the actor thread, or while an earlier half of the
+     * name lives, is a violation.
+     */
     private final class Tracking implements RtLauncher {
         /** Halves launched whose process has not exited, by name. */
         final Map<String, Set<Watched>> live = new ConcurrentHashMap<>();
@@ -153,8 +157,8 @@ class CellConcurrencyTest {
         @Override
         public RtHalf launch(Spec spec) throws IOException {
             String name = spec.instance();
-            if (!actor.inActor()) {
-                violations.add(name + ": launched off the actor thread");
+            if (actor.inActor()) { // spawn and READY wait must never hold the actor (issue 17)
+                violations.add(name + ": launched on the actor thread");
             }
             Set<Watched> alive = live.computeIfAbsent(name, k -> ConcurrentHashMap.newKeySet());
             if (!alive.isEmpty()) {
@@ -430,6 +434,7 @@ class CellConcurrencyTest {
         actor.call(() -> null, 10_000);
         actor.shutdown(10_000);
         stopper.shutdownNow();
+        launches.shutdownNow();
         assertTrue(launcher.live.values().stream().allMatch(Set::isEmpty), "RT halves left alive: " + launcher.live);
         assertTrue(fake.openOutputs.isEmpty(), "segments left: " + fake.openOutputs);
     }

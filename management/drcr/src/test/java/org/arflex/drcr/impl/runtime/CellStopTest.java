@@ -42,7 +42,7 @@ class CellStopTest {
     private final List<String> log = java.util.Collections.synchronizedList(new ArrayList<>());
     private final ExecutorService stopper = Executors.newCachedThreadPool();
     private final Cell cell = new Cell(new Cell.Config("t", 1000, 1000, true, PortTypes.builtin(), () -> 1_000_000_000L),
-            actor, launcher, new Planner(Capacities.of(2, 1.0, 1L << 30, 1_000_000_000L)), log::add, stopper);
+            actor, launcher, new Planner(Capacities.of(2, 1.0, 1L << 30, 1_000_000_000L)), log::add, stopper, Runnable::run);
     private final CountDownLatch release = new CountDownLatch(1);
 
     private void install(String name, String ports) throws Exception {

@@ -16,17 +16,18 @@ final class FakeLauncher implements RtLauncher {
     /** Thread-safe: stops may run on a stop thread. */
     final List<String> events = java.util.Collections.synchronizedList(new ArrayList<>());
     final Map<String, FakeHalf> running = new java.util.concurrent.ConcurrentHashMap<>();
-    final List<Spec> specs = new ArrayList<>();
+    /** Thread-safe too: launches may run on launch threads. */
+    final List<Spec> specs = java.util.Collections.synchronizedList(new ArrayList<>());
     final Map<String, Integer> openOutputs = new HashMap<>();
     /** Segment name -> what damage() of its output reports (tests set it). */
     final Map<String, String> damaged = new HashMap<>();
     /** Instances whose next launches fail. */
-    final Map<String, Integer> failLaunches = new HashMap<>();
-    private long nextPid = 1000;
+    final Map<String, Integer> failLaunches = new java.util.concurrent.ConcurrentHashMap<>();
+    private final java.util.concurrent.atomic.AtomicLong nextPid = new java.util.concurrent.atomic.AtomicLong(1000);
 
     final class FakeHalf implements RtHalf {
         final String inst;
-        final long pid = nextPid++;
+        final long pid = nextPid.getAndIncrement();
         final CompletableFuture<Exit> exit = new CompletableFuture<>();
         final long[] params;
         long rtHb;
