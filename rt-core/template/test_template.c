@@ -2,8 +2,10 @@
  * test_template - CTest rt.template.*: the ported PI loop (ported/pi_velocity.c) run as a
  * component under the rt-core host API.
  *
- *   test_template ported <arflex-pi-velocity exe>
- *     create control block, queues and ports; spawn; START; wait (condition with deadline)
+ *   test_template ported <arflex-pi-velocity exe> <bundle/pi-velocity.xml>
+ *     load the component's contract (arflex_host_load_contract): its ports, parameters and
+ *     timing are declared there and nowhere in this file; create control block, queues and
+ *     ports from it; spawn; START; wait (condition with deadline)
  *     until N cycles and check the plant converged to the setpoint; change the setpoint with
  *     SET_PARAM and check it converges again; SHUTDOWN; check the exit status and that no
  *     shared object, queue or child process is left.
@@ -24,6 +26,7 @@
 #include <unistd.h>
 
 #include "arflex/host.h"
+#include "arflex/host_contract.h"
 #include "arflex_types/sample.h"
 #include "helper.h" /* rt-core test kit: leak checks */
 
@@ -33,6 +36,9 @@
 #define WAIT_TIMEOUT (15 * SEC)
 
 static const struct arflex_port_type sample_type = { "arflex.Sample", 1, 0, 24 };
+/* The port types this harness was compiled with, for the contracts it loads. */
+static const struct arflex_host_type types[] = { ARFLEX_HOST_TYPE(SAMPLE) };
+static struct arflex_host_contract contract;
 
 static char rid[ARFLEX_ID_MAX + 1];
 static struct arflex_host h;
@@ -93,27 +99,25 @@ static int wait_seq(struct arflex_port *p, uint64_t min_seq, struct arflex_sampl
 	return -ETIMEDOUT;
 }
 
-static int case_ported(const char *exe)
+static int case_ported(const char *exe, const char *contract_path)
 {
-	struct arflex_param_slot p[3] = {
-		param_f64("kp", 1.0, 0.0, 100.0),
-		param_f64("ki", 15.0, 0.0, 1000.0),
-		param_f64("setpoint", 1.0, -10.0, 10.0),
-	};
-	struct arflex_host_output outs[2] = {
-		{ "velocity", { .method = ARFLEX_PORT_STATE, .type = sample_type, .depth = 1 } },
-		{ "command", { .method = ARFLEX_PORT_STATE, .type = sample_type, .depth = 1 } },
-	};
-	struct arflex_host_opts o = {
-		.runtime = rid, .instance = "pi", .config = config(),
-		.params = p, .nparams = 3, .outputs = outs, .noutputs = 2,
-	};
+	struct arflex_host_opts o;
 	struct arflex_port vel;
 	struct arflex_sample v, u;
 	bool vel_open = false;
 	uint64_t applied;
+	char err[512];
 	int st;
 
+	/* Ports velocity and command, parameters kp, ki and setpoint with their defaults and
+	 * ranges, the 1 ms period, the safe mode: all from the bundle's contract. */
+	CHECK(arflex_host_load_contract(&contract, contract_path, types, 1, err,
+					sizeof(err)) == 0, "%s", err);
+	arflex_host_contract_opts(&contract, rid, "pi", &o);
+	/* The harness's own choices on a shared machine: no mlockall, no cpu_dma_latency, and no
+	 * heartbeat watchdog (this test does not write the runtime heartbeat while it waits). */
+	o.config.cfg_flags |= ARFLEX_CFG_NO_MLOCK | ARFLEX_CFG_NO_DMA_LATENCY;
+	o.config.hb_timeout_ns = 0;
 	CHECK(arflex_host_create(&h, &o) == 0, "create");
 	CHECK(arflex_host_spawn(&h, exe, NULL, NULL) == 0, "spawn %s", exe);
 	CHECK(arflex_host_wait_state(&h, ARFLEX_STATE_READY, WAIT_TIMEOUT) == 0, "READY");
@@ -203,14 +207,15 @@ int main(int argc, char **argv)
 {
 	bool ported;
 
-	if (argc != 3 || (strcmp(argv[1], "ported") && strcmp(argv[1], "template"))) {
-		fprintf(stderr, "usage: %s ported|template <component executable>\n", argv[0]);
+	ported = argc == 4 && strcmp(argv[1], "ported") == 0;
+	if (!ported && (argc != 3 || strcmp(argv[1], "template"))) {
+		fprintf(stderr, "usage: %s ported <component executable> <contract.xml>\n"
+			"       %s template <component executable>\n", argv[0], argv[0]);
 		return 2;
 	}
-	ported = strcmp(argv[1], "ported") == 0;
 	snprintf(rid, sizeof(rid), "t-tpl-%ld", (long)getpid());
 	if (ported)
-		case_ported(argv[2]);
+		case_ported(argv[2], argv[3]);
 	else
 		case_template(argv[2]);
 	if (failures)

@@ -3,7 +3,8 @@
 #   WORK        a directory under BUILD_DIR; removed and made again, nothing is written elsewhere
 #   TEMPLATE    rt-core/template: bundle/{CMakeLists.txt,pi-velocity.xml,MANIFEST.MF} and
 #               ported/pi_velocity.c are copied to WORK/pi-velocity, as GUIDE.md tells a user
-#   SAFETY_SRC  a small project using arflex::safety and arflex::rt_shared
+#   SAFETY_SRC  a small project using arflex::safety, arflex::rt_shared and
+#               arflex::host_contract (which needs expat, found by the package config)
 #   LIBDIR, INCLUDEDIR  the superbuild's CMAKE_INSTALL_LIBDIR and CMAKE_INSTALL_INCLUDEDIR
 #   GENERATOR, C_COMPILER, C_FLAGS, LINK_FLAGS  passed on (the sanitizer build's flags)
 #   JAR         the JDK's jar, or empty: then the bundle step is skipped
@@ -30,6 +31,7 @@ set(prefix ${WORK}/prefix)
 # 1. The SDK, installed from this build tree.
 run("cmake --install" ${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix})
 foreach(f ${INCLUDEDIR}/arflex/component.h ${INCLUDEDIR}/arflex/safety_gate.h
+          ${INCLUDEDIR}/arflex/host_contract.h ${LIBDIR}/libarflex_host_contract.a
           ${INCLUDEDIR}/arflex_types/sample.h ${LIBDIR}/libarflex_rt.a ${LIBDIR}/libarflex_rt.so
           ${LIBDIR}/libarflex_safety.a ${LIBDIR}/cmake/arflex/arflexConfig.cmake
           ${LIBDIR}/cmake/arflex/arflexConfigVersion.cmake ${LIBDIR}/cmake/arflex/arflexTargets.cmake)
@@ -71,12 +73,17 @@ if(RUN_OUT MATCHES "libarflex_rt")
   message(FATAL_ERROR "pi-velocity needs libarflex_rt.so:\n${RUN_OUT}")
 endif()
 
-# 3. arflex::safety and arflex::rt_shared.
+# 3. arflex::safety, arflex::rt_shared and arflex::host_contract (reading the guide's contract).
 build_project(${SAFETY_SRC} ${WORK}/safety)
 run("safety-check" ${WORK}/safety/safety-check)
 message(STATUS "safety: ${RUN_OUT}")
 run("shared-check" ${WORK}/safety/shared-check)
 message(STATUS "shared: ${RUN_OUT}")
+run("contract-check" ${WORK}/safety/contract-check ${src}/pi-velocity.xml)
+if(NOT RUN_OUT MATCHES "^pi-velocity: 2 outputs, 3 parameters, period 1000000 ns\n$")
+  message(FATAL_ERROR "contract-check printed: ${RUN_OUT}")
+endif()
+message(STATUS "contract: ${RUN_OUT}")
 
 # 4. The bundle, with the GUIDE's commands.
 if(JAR)
