@@ -15,11 +15,13 @@ import org.arflex.contract.PortTypes;
 import org.arflex.drcr.DrcrService;
 import org.arflex.drcr.ResourceManager;
 import org.arflex.drcr.UpdateService;
+import org.arflex.drcr.dto.PortValueDTO;
 import org.arflex.drcr.impl.abi.Posix;
 import org.arflex.drcr.impl.extender.ContractExtender;
 import org.arflex.drcr.impl.lifecycle.ThreadActor;
 import org.arflex.drcr.impl.runtime.Cell;
 import org.arflex.drcr.impl.runtime.ContractReader;
+import org.arflex.drcr.impl.runtime.PortValues;
 import org.arflex.drcr.impl.services.ResourceManagerImpl;
 import org.arflex.drcr.impl.services.CodeGate;
 import org.arflex.drcr.impl.services.Services;
@@ -173,7 +175,7 @@ public final class Activator implements BundleActivator {
                     public String deploy(String location, String sha256) {
                         return installer.deploy(location, sha256);
                     }
-                }), shell));
+                }, (component, port) -> readPort(ctx, component, port)), shell));
         // The runtime heartbeat is what keeps the RT halves out of safe mode: its thread runs at a
         // low SCHED_FIFO priority (below every component, above all ordinary load) so that a
         // busy machine cannot starve it past a 100 ms heartbeat timeout.
@@ -229,6 +231,23 @@ public final class Activator implements BundleActivator {
         tracker.open();
         log.accept("arflex: DRCR started, runtime id " + rid + ", cpus " + cpus + ", memory " + memory + ", network "
                 + network);
+    }
+
+    /**
+     * A port value for arflex:summary, or null when it cannot be read: a contract output through
+     * the component's management service (as the web console reads it), the evaluation-only
+     * {@code truth} segment through the cell.
+     */
+    private PortValueDTO readPort(BundleContext ctx, String component, String port) {
+        try {
+            PortValues.Ref truth = actor.call(() -> PortValues.evaluationRef(cell, component, port), 10_000);
+            if (truth != null) {
+                return PortValues.read(truth, Posix.monotonicNs());
+            }
+            return lookup(ctx, component).map(m -> m.portValue(port)).orElse(null);
+        } catch (RuntimeException e) {
+            return null;
+        }
     }
 
     private static java.util.Optional<org.arflex.drcr.ComponentManagement> lookup(BundleContext ctx, String name) {

@@ -30,13 +30,14 @@ public final class Commands {
     /** Service property values for the Gogo registration. */
     public static final String SCOPE = "arflex";
     public static final String[] FUNCTIONS = {"list", "info", "bindings", "get", "set", "plan", "update", "deploy",
-        "resources", "stats", "port", "reset", "dto"};
+        "resources", "stats", "port", "reset", "dto", "summary"};
 
     private final DrcrService drcr;
     private final ResourceManager resources;
     private final UpdateService updates;
     private final Function<String, Optional<ComponentManagement>> management;
     private final BundleUpdater bundles;
+    private final CellSummary.Ports ports;
 
     /** Bundle installs and updates through the DRCR's fetch and code gate. */
     public interface BundleUpdater {
@@ -55,11 +56,19 @@ public final class Commands {
 
     public Commands(DrcrService drcr, ResourceManager resources, UpdateService updates,
                     Function<String, Optional<ComponentManagement>> management, BundleUpdater bundles) {
+        this(drcr, resources, updates, management, bundles, (c, p) -> null);
+    }
+
+    /** Commands whose {@code summary} reads ports through {@code ports}. */
+    public Commands(DrcrService drcr, ResourceManager resources, UpdateService updates,
+                    Function<String, Optional<ComponentManagement>> management, BundleUpdater bundles,
+                    CellSummary.Ports ports) {
         this.drcr = drcr;
         this.resources = resources;
         this.updates = updates;
         this.management = management;
         this.bundles = bundles;
+        this.ports = ports;
     }
 
     /** One line per instance: name, state, pid, cpu, reason. */
@@ -289,6 +298,21 @@ public final class Commands {
         return guard(() -> {
             cm(name).reset();
             return name + ": reset; now " + drcr.instance(name).map(i -> i.state).orElse("?");
+        });
+    }
+
+    /**
+     * {@code summary [--json]}: the demonstration cell in one line (RT halves, operator resets
+     * awaited, robot cycles, vision-measured and TRUE TCP error; {@link CellSummary}).
+     */
+    public String summary(String... args) {
+        return guard(() -> {
+            boolean json = args.length == 1 && args[0].equals("--json");
+            if (args.length > 0 && !json) {
+                return "usage: summary [--json]";
+            }
+            CellSummary s = CellSummary.of(drcr.cell(), ports);
+            return json ? s.json() : s.text();
         });
     }
 

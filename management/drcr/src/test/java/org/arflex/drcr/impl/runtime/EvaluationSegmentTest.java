@@ -118,4 +118,18 @@ class EvaluationSegmentTest {
         assertEquals(Map.of(), segments(cell, "robot"));
         shutdown(cell);
     }
+
+    /** The port reader decodes the record by the fields of simulator/include/arflex_sim/ground_truth.h. */
+    @Test
+    void theGroundTruthTypeHasTheHeadersLayout() {
+        var t = EvaluationSegments.TRUTH_TYPE;
+        assertEquals(EvaluationSegments.SIZE, t.size());
+        assertEquals(40, t.field("p").orElseThrow().offset(), "the header's static assert");
+        assertEquals(3, t.field("p").orElseThrow().count());
+        assertEquals(64, t.field("quat").orElseThrow().offset());
+        assertEquals(168, t.field("obstacle_contacts").orElseThrow().offset());
+        assertEquals(184, t.field("reserved").orElseThrow().offset());
+        assertEquals(EvaluationSegments.TYPE, t.name());
+        assertEquals(EvaluationSegments.PORT, EvaluationSegments.TRUTH_SPEC.name());
+    }
 }

@@ -314,6 +314,17 @@ class CommandsTest {
     }
 
     @Test
+    void summaryIsACommand() {
+        assertEquals("arflex cell: 0 RT halves running", cmd.summary());
+        assertEquals("{\"rtHalves\":0,\"awaitingReset\":[],\"robotSeq\":null,\"visionErrorMm\":null,\"measurement\":null,"
+                + "\"correctionMrad\":null,\"trueErrorMm\":null,\"moving\":null}", cmd.summary("--json"));
+        assertEquals("usage: summary [--json]", cmd.summary("--yaml"));
+        for (String f : Commands.FUNCTIONS) {
+            assertTrue(java.util.Arrays.stream(Commands.class.getMethods()).anyMatch(m -> m.getName().equals(f)), f);
+        }
+    }
+
+    @Test
     void dtoIsOneLineOfValidJson() {
         String json = cmd.dto();
         assertFalse(json.contains("\n"), json);
