@@ -26,6 +26,7 @@ import org.arflex.drcr.impl.services.ResourceManagerImpl;
 import org.arflex.drcr.impl.services.CodeGate;
 import org.arflex.drcr.impl.services.Services;
 import org.arflex.drcr.impl.services.VerifiedInstaller;
+import org.arflex.drcr.impl.shell.CellWatch;
 import org.arflex.drcr.impl.shell.Commands;
 import org.arflex.drcr.impl.supervisor.HeartbeatBridge;
 import org.arflex.drcr.impl.supervisor.ProcessLauncher;
@@ -70,6 +71,7 @@ public final class Activator implements BundleActivator {
     private Services services;
     private ScheduledExecutorService ticker;
     private HeartbeatBridge bridge;
+    private CellWatch watch;
     private BundleTracker<ContractExtender.Tracked> tracker;
     private final List<ServiceRegistration<?>> regs = new ArrayList<>();
     private String rid;
@@ -156,7 +158,12 @@ public final class Activator implements BundleActivator {
         regs.add(ctx.registerService(org.osgi.framework.hooks.resolver.ResolverHookFactory.class, gateHook, null));
         services = new Services(cell, rm[0], reader, ctx, gate, log);
         VerifiedInstaller installer = new VerifiedInstaller(ctx, gate, log);
-        cell.onChange(services::sync);
+        // arflex:await looks at the cell again on each of its changes
+        watch = new CellWatch();
+        cell.onChange(() -> {
+            services.sync();
+            watch.changed();
+        });
         regs.add(ctx.registerService(DrcrService.class, services, null));
         regs.add(ctx.registerService(UpdateService.class, services, null));
         regs.add(ctx.registerService(ResourceManager.class, rm[0], null));
@@ -175,7 +182,7 @@ public final class Activator implements BundleActivator {
                     public String deploy(String location, String sha256) {
                         return installer.deploy(location, sha256);
                     }
-                }, (component, port) -> readPort(ctx, component, port)), shell));
+                }, (component, port) -> readPort(ctx, component, port), watch), shell));
         // The runtime heartbeat is what keeps the RT halves out of safe mode: its thread runs at a
         // low SCHED_FIFO priority (below every component, above all ordinary load) so that a
         // busy machine cannot starve it past a 100 ms heartbeat timeout.
@@ -330,6 +337,9 @@ public final class Activator implements BundleActivator {
             actor.shutdown(10_000);
         }
         Sweeper.sweep(rid, log);
+        if (watch != null) {
+            watch.changed(); // an arflex:await still waiting looks again and ends
+        }
         log.accept("arflex: DRCR stopped");
     }
 }

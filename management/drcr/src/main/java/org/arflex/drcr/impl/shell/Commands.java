@@ -30,7 +30,7 @@ public final class Commands {
     /** Service property values for the Gogo registration. */
     public static final String SCOPE = "arflex";
     public static final String[] FUNCTIONS = {"list", "info", "bindings", "get", "set", "plan", "update", "deploy",
-        "resources", "stats", "port", "reset", "dto", "summary"};
+        "resources", "stats", "port", "reset", "dto", "summary", "await"};
 
     private final DrcrService drcr;
     private final ResourceManager resources;
@@ -38,6 +38,7 @@ public final class Commands {
     private final Function<String, Optional<ComponentManagement>> management;
     private final BundleUpdater bundles;
     private final CellSummary.Ports ports;
+    private final Readiness readiness;
 
     /** Bundle installs and updates through the DRCR's fetch and code gate. */
     public interface BundleUpdater {
@@ -56,19 +57,23 @@ public final class Commands {
 
     public Commands(DrcrService drcr, ResourceManager resources, UpdateService updates,
                     Function<String, Optional<ComponentManagement>> management, BundleUpdater bundles) {
-        this(drcr, resources, updates, management, bundles, (c, p) -> null);
+        this(drcr, resources, updates, management, bundles, (c, p) -> null, new CellWatch());
     }
 
-    /** Commands whose {@code summary} reads ports through {@code ports}. */
+    /**
+     * Commands whose {@code summary} reads ports through {@code ports} and whose {@code await}
+     * wakes up on the changes {@code watch} is told of.
+     */
     public Commands(DrcrService drcr, ResourceManager resources, UpdateService updates,
                     Function<String, Optional<ComponentManagement>> management, BundleUpdater bundles,
-                    CellSummary.Ports ports) {
+                    CellSummary.Ports ports, CellWatch watch) {
         this.drcr = drcr;
         this.resources = resources;
         this.updates = updates;
         this.management = management;
         this.bundles = bundles;
         this.ports = ports;
+        this.readiness = new Readiness(drcr, watch);
     }
 
     /** One line per instance: name, state, pid, cpu, reason. */
@@ -314,6 +319,16 @@ public final class Commands {
             CellSummary s = CellSummary.of(drcr.cell(), ports);
             return json ? s.json() : s.text();
         });
+    }
+
+    /**
+     * {@code await <name> [<state>] [--timeout <s>]}: returns once the component is in that
+     * state (default ACTIVE); {@code await --cell [--timeout <s>]}: once every component is
+     * ACTIVE. Woken by the cell's changes, never polling; on timeout an {@code error:} line naming
+     * the component, its state and its reason ({@link Readiness}).
+     */
+    public String await(String... args) {
+        return guard(() -> readiness.await(args));
     }
 
     /** The whole cell as one line of JSON. */
