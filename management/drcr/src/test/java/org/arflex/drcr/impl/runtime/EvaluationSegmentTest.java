@@ -93,6 +93,13 @@ class EvaluationSegmentTest {
         assertEquals(Map.of(), segments(cell, "cam"));
         assertEquals(Map.of(), segments(cell, "real"));
         assertEquals(1, launcher.openOutputs.get(TRUTH));
+        // arflex:summary reads it through the port reader as eval.GroundTruth; no one else has one
+        PortValues.Ref ref = actor.call(() -> PortValues.evaluationRef(cell, "robot", "truth"), 0);
+        assertEquals(TRUTH, ref.segment());
+        assertEquals(EvaluationSegments.TRUTH_TYPE, ref.type());
+        assertEquals(null, actor.call(() -> PortValues.evaluationRef(cell, "cam", "truth"), 0));
+        assertEquals(null, actor.call(() -> PortValues.evaluationRef(cell, "robot", "y"), 0));
+        assertEquals(null, actor.call(() -> PortValues.evaluationRef(cell, "nobody", "truth"), 0));
 
         // a crash and restart keeps it (as every output segment); an uninstall removes it
         launcher.running.get("robot").crash(139, "killed by signal 11");
