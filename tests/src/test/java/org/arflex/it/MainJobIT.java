@@ -39,7 +39,9 @@ import org.junit.jupiter.api.io.TempDir;
  * The main job as the README runs it ({@code ./arflex run --headless N} is
  * {@code scripts/run-cell.sh <runtime> N} after the build), and its console login
  * ({@code scripts/console-login.sh}): no default password, a generated one printed once and
- * kept only as a hash in a private file, the console on the loopback interface only.
+ * kept only as a hash in a private file, the console on the loopback interface only. The job
+ * waits through the DRCR's {@code arflex:await} and prints {@code arflex:summary}'s line
+ * (docs/DECISIONS.md D31); it keeps no log of the runtime.
  */
 class MainJobIT {
 
@@ -239,8 +241,23 @@ class MainJobIT {
                 assertTrue(table.stream().anyMatch(l -> l.matches(".*\\b" + Pattern.quote(name) + "\\s+ACTIVE\\b.*")),
                         name + " not ACTIVE in the last arflex:list:\n" + String.join("\n", table));
             }
-            // (the summary is printed beside the shell's output: a line may begin with its prompt)
-            String summary = out.stream().filter(l -> l.contains("arflex cell: ")).reduce((a, b) -> b).orElseThrow();
+            // Readiness from the DRCR, not from the log: the console's arflex:await answered for
+            // vision (before its settings) and for the whole cell (before the first arflex:list).
+            assertTrue(out.stream().anyMatch(l -> l.matches("(g! )*vision ACTIVE \\(after \\d+\\.\\d s\\)")),
+                    "no arflex:await answer for vision");
+            assertTrue(out.stream().anyMatch(l -> l.matches("(g! )*cell ACTIVE: " + CellE2EIT.CELL.size()
+                    + " components \\(after \\d+\\.\\d s\\)")), "no arflex:await --cell answer");
+            assertTrue(out.stream().noneMatch(l -> l.matches("(g! )*error: .*")), "a command failed:\n" + String.join("\n", out));
+            // The summary is arflex:summary's answer in the console (a line may begin with its
+            // prompt): every component's RT half, the robot's cycles, the TRUE TCP error.
+            Pattern summaryP = Pattern.compile("^(?:g! )*arflex cell: (\\d+) RT halves running; .*robot seq \\d+;.*"
+                    + "TRUE TCP error \\d+\\.\\d{4} mm \\((?:at rest|moving)\\)$");
+            List<String> summaries = out.stream().filter(l -> l.contains("arflex cell: ")).toList();
+            assertTrue(summaries.size() >= 3, "fewer than 3 summaries in a " + seconds + " s run: " + summaries);
+            String summary = summaries.get(summaries.size() - 1);
+            Matcher sm = summaryP.matcher(summary);
+            assertTrue(sm.find(), "not arflex:summary's line: " + summary);
+            assertEquals(CellE2EIT.CELL.size(), Integer.parseInt(sm.group(1)), summary);
             System.out.println("MainJobIT: " + summary);
         } finally {
             if (p.isAlive()) {

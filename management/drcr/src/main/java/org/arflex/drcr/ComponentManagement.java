@@ -13,6 +13,15 @@ public interface ComponentManagement {
     /** Service property naming the instance. */
     String COMPONENT_PROPERTY = "arflex.component";
 
+    /**
+     * Since 0.5.0: service property holding the instance's lifecycle state (INSTALLED,
+     * UNSATISFIED, ACTIVE, DESTROYED or FAILED, as {@link #state()}), changed with the state
+     * (a {@code MODIFIED} service event). Readiness is this service: a client waits for a
+     * component by tracking {@code (&(arflex.component=vision)(arflex.state=ACTIVE))}, e.g. with a
+     * {@code ServiceTracker}, as the shell's {@code arflex:await} waits for the same state.
+     */
+    String STATE_PROPERTY = "arflex.state";
+
     /** The instance name. */
     String name();
 

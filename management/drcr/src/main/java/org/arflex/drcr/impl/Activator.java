@@ -15,15 +15,18 @@ import org.arflex.contract.PortTypes;
 import org.arflex.drcr.DrcrService;
 import org.arflex.drcr.ResourceManager;
 import org.arflex.drcr.UpdateService;
+import org.arflex.drcr.dto.PortValueDTO;
 import org.arflex.drcr.impl.abi.Posix;
 import org.arflex.drcr.impl.extender.ContractExtender;
 import org.arflex.drcr.impl.lifecycle.ThreadActor;
 import org.arflex.drcr.impl.runtime.Cell;
 import org.arflex.drcr.impl.runtime.ContractReader;
+import org.arflex.drcr.impl.runtime.PortValues;
 import org.arflex.drcr.impl.services.ResourceManagerImpl;
 import org.arflex.drcr.impl.services.CodeGate;
 import org.arflex.drcr.impl.services.Services;
 import org.arflex.drcr.impl.services.VerifiedInstaller;
+import org.arflex.drcr.impl.shell.CellWatch;
 import org.arflex.drcr.impl.shell.Commands;
 import org.arflex.drcr.impl.supervisor.HeartbeatBridge;
 import org.arflex.drcr.impl.supervisor.ProcessLauncher;
@@ -69,6 +72,7 @@ public final class Activator implements BundleActivator {
     private Services services;
     private ScheduledExecutorService ticker;
     private HeartbeatBridge bridge;
+    private CellWatch watch;
     private BundleTracker<ContractExtender.Tracked> tracker;
     private final List<ServiceRegistration<?>> regs = new ArrayList<>();
     private String rid;
@@ -161,7 +165,12 @@ public final class Activator implements BundleActivator {
         regs.add(ctx.registerService(org.osgi.framework.hooks.resolver.ResolverHookFactory.class, gateHook, null));
         services = new Services(cell, rm[0], reader, ctx, gate, log);
         VerifiedInstaller installer = new VerifiedInstaller(ctx, gate, log);
-        cell.onChange(services::sync);
+        // arflex:await looks at the cell again on each of its changes
+        watch = new CellWatch();
+        cell.onChange(() -> {
+            services.sync();
+            watch.changed();
+        });
         regs.add(ctx.registerService(DrcrService.class, services, null));
         regs.add(ctx.registerService(UpdateService.class, services, null));
         regs.add(ctx.registerService(ResourceManager.class, rm[0], null));
@@ -180,7 +189,7 @@ public final class Activator implements BundleActivator {
                     public String deploy(String location, String sha256) {
                         return installer.deploy(location, sha256);
                     }
-                }), shell));
+                }, (component, port) -> readPort(ctx, component, port), watch), shell));
         // The runtime heartbeat is what keeps the RT halves out of safe mode: its thread runs at a
         // low SCHED_FIFO priority (below every component, above all ordinary load) so that a
         // busy machine cannot starve it past a 100 ms heartbeat timeout.
@@ -236,6 +245,23 @@ public final class Activator implements BundleActivator {
         tracker.open();
         log.accept("arflex: DRCR started, runtime id " + rid + ", cpus " + cpus + ", memory " + memory + ", network "
                 + network);
+    }
+
+    /**
+     * A port value for arflex:summary, or null when it cannot be read: a contract output through
+     * the component's management service (as the web console reads it), the evaluation-only
+     * {@code truth} segment through the cell.
+     */
+    private PortValueDTO readPort(BundleContext ctx, String component, String port) {
+        try {
+            PortValues.Ref truth = actor.call(() -> PortValues.evaluationRef(cell, component, port), 10_000);
+            if (truth != null) {
+                return PortValues.read(truth, Posix.monotonicNs());
+            }
+            return lookup(ctx, component).map(m -> m.portValue(port)).orElse(null);
+        } catch (RuntimeException e) {
+            return null;
+        }
     }
 
     private static java.util.Optional<org.arflex.drcr.ComponentManagement> lookup(BundleContext ctx, String name) {
@@ -321,6 +347,9 @@ public final class Activator implements BundleActivator {
             actor.shutdown(10_000);
         }
         Sweeper.sweep(rid, log);
+        if (watch != null) {
+            watch.changed(); // an arflex:await still waiting looks again and ends
+        }
         log.accept("arflex: DRCR stopped");
     }
 }

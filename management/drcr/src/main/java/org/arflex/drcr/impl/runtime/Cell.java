@@ -174,6 +174,12 @@ public final class Cell {
         return Optional.ofNullable(instances.get(name));
     }
 
+    /** The lifecycle state of the instance of that name (INSTALLED ... FAILED), or null (actor thread). */
+    public String state(String name) {
+        Instance i = instances.get(name);
+        return i == null ? null : i.life.state().name();
+    }
+
     /** The instance of that name, or null (actor thread). */
     Instance find(String name) {
         return instances.get(name);

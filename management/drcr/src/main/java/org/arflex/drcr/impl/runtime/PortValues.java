@@ -44,6 +44,20 @@ public final class PortValues {
     }
 
     /**
+     * Looks up the evaluation-only output {@code port} of {@code name} (the simulator's
+     * {@code truth}, {@link EvaluationSegments}); actor thread only.
+     *
+     * @return the port, or null when the instance does not exist or has no such segment (not an
+     *         evaluation run, not a simulated robot)
+     */
+    public static Ref evaluationRef(Cell cell, String name, String port) {
+        cell.actor().checkThread();
+        Instance inst = cell.find(name);
+        RtLauncher.Output o = inst == null || !EvaluationSegments.PORT.equals(port) ? null : inst.evaluationOutputs.get(port);
+        return o == null ? null : new Ref(name, EvaluationSegments.TRUTH_SPEC, EvaluationSegments.TRUTH_TYPE, o.name());
+    }
+
+    /**
      * Reads and decodes the newest value; any thread.
      *
      * @throws IllegalStateException naming the segment when it cannot be read

@@ -51,6 +51,8 @@ public final class Services implements DrcrService, UpdateService {
     private final Consumer<String> log;
     private final CodeGate gate;
     private final Map<String, ServiceRegistration<ComponentManagement>> regs = new HashMap<>();
+    /** The state each registration's {@link ComponentManagement#STATE_PROPERTY} shows. */
+    private final Map<String, String> states = new HashMap<>();
 
     public Services(Cell cell, ResourceManagerImpl resources, ContractReader reader, BundleContext context,
                     CodeGate gate, Consumer<String> log) {
@@ -64,7 +66,10 @@ public final class Services implements DrcrService, UpdateService {
 
     // ---- per-instance registrations ---------------------------------------------------------
 
-    /** Brings the ComponentManagement registrations in line with the cell (actor thread). */
+    /**
+     * Brings the ComponentManagement registrations in line with the cell, their state property
+     * included (actor thread).
+     */
     public void sync() {
         if (context == null) {
             return;
@@ -73,17 +78,26 @@ public final class Services implements DrcrService, UpdateService {
         for (String n : List.copyOf(regs.keySet())) {
             if (!names.contains(n)) {
                 unregister(regs.remove(n));
+                states.remove(n);
             }
         }
         for (String n : names) {
-            if (!regs.containsKey(n)) {
-                Hashtable<String, Object> props = new Hashtable<>();
-                props.put(ComponentManagement.COMPONENT_PROPERTY, n);
-                try {
+            String state = cell.state(n);
+            if (regs.containsKey(n) && state.equals(states.get(n))) {
+                continue;
+            }
+            Hashtable<String, Object> props = new Hashtable<>();
+            props.put(ComponentManagement.COMPONENT_PROPERTY, n);
+            props.put(ComponentManagement.STATE_PROPERTY, state);
+            try {
+                if (regs.containsKey(n)) {
+                    regs.get(n).setProperties(props);
+                } else {
                     regs.put(n, context.registerService(ComponentManagement.class, new ComponentManagementImpl(n, cell), props));
-                } catch (IllegalStateException e) {
-                    return; // the DRCR bundle is stopping
                 }
+                states.put(n, state);
+            } catch (IllegalStateException e) {
+                return; // the DRCR bundle is stopping
             }
         }
     }
@@ -94,6 +108,7 @@ public final class Services implements DrcrService, UpdateService {
             unregister(r);
         }
         regs.clear();
+        states.clear();
     }
 
     private static void unregister(ServiceRegistration<?> r) {

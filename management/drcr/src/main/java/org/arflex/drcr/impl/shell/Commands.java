@@ -30,13 +30,15 @@ public final class Commands {
     /** Service property values for the Gogo registration. */
     public static final String SCOPE = "arflex";
     public static final String[] FUNCTIONS = {"list", "info", "bindings", "get", "set", "plan", "update", "deploy",
-        "resources", "stats", "port", "reset", "dto"};
+        "resources", "stats", "port", "reset", "dto", "summary", "await"};
 
     private final DrcrService drcr;
     private final ResourceManager resources;
     private final UpdateService updates;
     private final Function<String, Optional<ComponentManagement>> management;
     private final BundleUpdater bundles;
+    private final CellSummary.Ports ports;
+    private final Readiness readiness;
 
     /** Bundle installs and updates through the DRCR's fetch and code gate. */
     public interface BundleUpdater {
@@ -55,11 +57,23 @@ public final class Commands {
 
     public Commands(DrcrService drcr, ResourceManager resources, UpdateService updates,
                     Function<String, Optional<ComponentManagement>> management, BundleUpdater bundles) {
+        this(drcr, resources, updates, management, bundles, (c, p) -> null, new CellWatch());
+    }
+
+    /**
+     * Commands whose {@code summary} reads ports through {@code ports} and whose {@code await}
+     * wakes up on the changes {@code watch} is told of.
+     */
+    public Commands(DrcrService drcr, ResourceManager resources, UpdateService updates,
+                    Function<String, Optional<ComponentManagement>> management, BundleUpdater bundles,
+                    CellSummary.Ports ports, CellWatch watch) {
         this.drcr = drcr;
         this.resources = resources;
         this.updates = updates;
         this.management = management;
         this.bundles = bundles;
+        this.ports = ports;
+        this.readiness = new Readiness(drcr, watch);
     }
 
     /** One line per instance: name, state, pid, cpu, reason. */
@@ -290,6 +304,31 @@ public final class Commands {
             cm(name).reset();
             return name + ": reset; now " + drcr.instance(name).map(i -> i.state).orElse("?");
         });
+    }
+
+    /**
+     * {@code summary [--json]}: the demonstration cell in one line (RT halves, operator resets
+     * awaited, robot cycles, vision-measured and TRUE TCP error; {@link CellSummary}).
+     */
+    public String summary(String... args) {
+        return guard(() -> {
+            boolean json = args.length == 1 && args[0].equals("--json");
+            if (args.length > 0 && !json) {
+                return "usage: summary [--json]";
+            }
+            CellSummary s = CellSummary.of(drcr.cell(), ports);
+            return json ? s.json() : s.text();
+        });
+    }
+
+    /**
+     * {@code await <name> [<state>] [--timeout <s>]}: returns once the component is in that
+     * state (default ACTIVE); {@code await --cell [--timeout <s>]}: once every component is
+     * ACTIVE. Woken by the cell's changes, never polling; on timeout an {@code error:} line naming
+     * the component, its state and its reason ({@link Readiness}).
+     */
+    public String await(String... args) {
+        return guard(() -> readiness.await(args));
     }
 
     /** The whole cell as one line of JSON. */

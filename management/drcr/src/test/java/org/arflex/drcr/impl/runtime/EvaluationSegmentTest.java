@@ -93,6 +93,13 @@ class EvaluationSegmentTest {
         assertEquals(Map.of(), segments(cell, "cam"));
         assertEquals(Map.of(), segments(cell, "real"));
         assertEquals(1, launcher.openOutputs.get(TRUTH));
+        // arflex:summary reads it through the port reader as eval.GroundTruth; no one else has one
+        PortValues.Ref ref = actor.call(() -> PortValues.evaluationRef(cell, "robot", "truth"), 0);
+        assertEquals(TRUTH, ref.segment());
+        assertEquals(EvaluationSegments.TRUTH_TYPE, ref.type());
+        assertEquals(null, actor.call(() -> PortValues.evaluationRef(cell, "cam", "truth"), 0));
+        assertEquals(null, actor.call(() -> PortValues.evaluationRef(cell, "robot", "y"), 0));
+        assertEquals(null, actor.call(() -> PortValues.evaluationRef(cell, "nobody", "truth"), 0));
 
         // a crash and restart keeps it (as every output segment); an uninstall removes it
         launcher.running.get("robot").crash(139, "killed by signal 11");
@@ -117,5 +124,19 @@ class EvaluationSegmentTest {
         assertTrue(launcher.events.stream().noneMatch(e -> e.contains("truth")), launcher.events.toString());
         assertEquals(Map.of(), segments(cell, "robot"));
         shutdown(cell);
+    }
+
+    /** The port reader decodes the record by the fields of simulator/include/arflex_sim/ground_truth.h. */
+    @Test
+    void theGroundTruthTypeHasTheHeadersLayout() {
+        var t = EvaluationSegments.TRUTH_TYPE;
+        assertEquals(EvaluationSegments.SIZE, t.size());
+        assertEquals(40, t.field("p").orElseThrow().offset(), "the header's static assert");
+        assertEquals(3, t.field("p").orElseThrow().count());
+        assertEquals(64, t.field("quat").orElseThrow().offset());
+        assertEquals(168, t.field("obstacle_contacts").orElseThrow().offset());
+        assertEquals(184, t.field("reserved").orElseThrow().offset());
+        assertEquals(EvaluationSegments.TYPE, t.name());
+        assertEquals(EvaluationSegments.PORT, EvaluationSegments.TRUTH_SPEC.name());
     }
 }

@@ -314,6 +314,20 @@ class CommandsTest {
     }
 
     @Test
+    void summaryAndAwaitAreCommands() throws Exception {
+        assertEquals("arflex cell: 0 RT halves running", cmd.summary());
+        assertEquals("{\"rtHalves\":0,\"awaitingReset\":[],\"robotSeq\":null,\"visionErrorMm\":null,\"measurement\":null,"
+                + "\"correctionMrad\":null,\"trueErrorMm\":null,\"moving\":null}", cmd.summary("--json"));
+        assertEquals("usage: summary [--json]", cmd.summary("--yaml"));
+        assertEquals("cons UNSATISFIED (after 0.0 s)", cmd.await("cons", "UNSATISFIED", "--timeout", "0"));
+        assertEquals("error: cons is UNSATISFIED, not ACTIVE, after 0 s: input x: no provider \"prov\"",
+                cmd.await("cons", "--timeout", "0"));
+        for (String f : Commands.FUNCTIONS) {
+            assertTrue(java.util.Arrays.stream(Commands.class.getMethods()).anyMatch(m -> m.getName().equals(f)), f);
+        }
+    }
+
+    @Test
     void dtoIsOneLineOfValidJson() {
         String json = cmd.dto();
         assertFalse(json.contains("\n"), json);
