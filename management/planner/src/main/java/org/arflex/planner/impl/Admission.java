@@ -173,7 +173,7 @@ public final class Admission {
                 for (Task t : tasks) {
                     String no = analysis.test(t);
                     if (no != null) {
-                        throw new IllegalStateException("cpu " + id + ": replay of '" + t.name() + "' refused: " + no);
+                        throw new ReplayRefused("cpu " + id + ": replay of '" + t.name() + "' refused: " + no);
                     }
                     analysis.add(t);
                 }
@@ -663,6 +663,19 @@ public final class Admission {
             }
             return new Decision(n, true, cpu == null ? OptionalInt.empty() : OptionalInt.of(cpu.id), wcetOf(c), r,
                     reason);
+        }
+    }
+
+    /**
+     * A CPU rebuilt from a trace refused a task it had accepted in the recorded run: the test
+     * does not keep the contract of {@link CpuAdmissionTest} (its state depends on more than the
+     * adds), so nothing can be derived from the trace.
+     */
+    static final class ReplayRefused extends RuntimeException {
+        private static final long serialVersionUID = 1L;
+
+        ReplayRefused(String message) {
+            super(message);
         }
     }
 

@@ -310,8 +310,13 @@ public final class PlanEngine {
         ResolveDelta delta = resolver.put(x);
         boolean keep = false;
         try {
-            Plan plan = InstallDryRun.plan(base, resolver, delta, x, change, capacities, measured, blocked.keySet(),
-                    cpuTest);
+            Plan plan;
+            try {
+                plan = InstallDryRun.plan(base, resolver, delta, x, change, capacities, measured, blocked.keySet(),
+                        cpuTest);
+            } catch (Admission.ReplayRefused e) {
+                plan = null; // a test whose state the trace cannot rebuild: plan in full
+            }
             if (plan != null) {
                 derived++;
                 if (commit) {

@@ -45,7 +45,7 @@ class InstallDryRunTest {
     void derivedPlansEqualFullPlansOnRandomCells() {
         Tally tally = new Tally();
         for (long seed = 1; seed <= 300; seed++) {
-            runCase(seed, tally);
+            runCase(seed, tally, CpuAdmissionTest.responseTime());
         }
         assertEquals(300, tally.cases);
         String t = "dry runs " + tally.dryRuns + ", derived " + tally.derived + " (started " + tally.derivedStarted
@@ -57,13 +57,52 @@ class InstallDryRunTest {
         assertTrue(tally.derived < tally.dryRuns, "the fallback must be exercised too: " + t);
     }
 
-    private static void runCase(long seed, Tally tally) {
+    /** Another schedulability test: at most three tasks per CPU, response time = own WCET. */
+    private static final class AtMostThree implements CpuAdmissionTest {
+        @Override
+        public Cpu open(int cpu) {
+            return new Cpu() {
+                final List<String> held = new ArrayList<>();
+
+                @Override
+                public String test(Task task) {
+                    return held.size() < 3 ? null : "'" + task.name() + "' would be the fourth after " + held;
+                }
+
+                @Override
+                public Runnable add(Task task) {
+                    held.add(task.name());
+                    return () -> held.remove(task.name());
+                }
+
+                @Override
+                public String proof() {
+                    return held.isEmpty() ? "none" : held.size() + " of 3";
+                }
+
+                @Override
+                public long responseTimeNs(String task) {
+                    return held.indexOf(task) * 1000L;
+                }
+            };
+        }
+    }
+
+    @Test
+    void derivedPlansUseTheChosenTest() {
+        Tally tally = new Tally();
+        for (long seed = 1001; seed <= 1080; seed++) {
+            runCase(seed, tally, new AtMostThree());
+        }
+        assertTrue(tally.derivedStarted > 10 && tally.derivedRefused > 5, tally.derivedStarted + " " + tally.derivedRefused);
+    }
+
+    private static void runCase(long seed, Tally tally, CpuAdmissionTest test) {
         Random rnd = new Random(seed);
         int n = 3 + rnd.nextInt(seed % 25 == 0 ? 120 : 30);
         int cpus = 1 + rnd.nextInt(4);
         Capacities caps = Capacities.of(cpus, 0.5 + rnd.nextInt(5) / 10.0, (long) (n / 2 + rnd.nextInt(n * 2 + 1)) << 20,
                 rnd.nextInt(4) == 0 ? 5_000 : 1_000_000);
-        CpuAdmissionTest test = CpuAdmissionTest.responseTime();
         PlanEngine full = new PlanEngine(caps, test, false);
         PlanEngine inc = new PlanEngine(caps, test, true);
         String ctx = "seed " + seed;
