@@ -781,11 +781,15 @@ public final class Admission {
             return run.admittedDecision(name, run.cands.get(name));
         }
 
-        /** Decisions of every task on that CPU, and its load. */
-        List<Decision> decisionsOn(int cpu) {
+        /**
+         * Decisions of every task on that CPU: {@code known} gives the ones the caller can prove
+         * unchanged (null: judge it again).
+         */
+        List<Decision> decisionsOn(int cpu, Function<Task, Decision> known) {
             List<Decision> out = new ArrayList<>();
             for (Task t : run.cpus.get(cpu).tasks) {
-                out.add(run.admittedDecision(t.name(), run.cands.get(t.name())));
+                Decision d = t.name().equals(name) ? null : known.apply(t);
+                out.add(d != null ? d : run.admittedDecision(t.name(), run.cands.get(t.name())));
             }
             return out;
         }

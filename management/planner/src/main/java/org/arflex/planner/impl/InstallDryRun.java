@@ -104,14 +104,16 @@ final class InstallDryRun {
         TreeMap<String, Decision> ds = new TreeMap<>(old.decisions());
         List<CpuLoad> loads = old.cpus();
         if (k >= 0) {
-            for (Decision d : run.decisionsOn(k)) {
-                ds.put(d.component(), d);
-            }
+            CpuLoad now = run.load(k);
             loads = new ArrayList<>(loads);
+            CpuLoad was = null;
             for (int i = 0; i < loads.size(); i++) {
                 if (loads.get(i).cpu() == k) {
-                    loads.set(i, run.load(k));
+                    was = loads.set(i, now);
                 }
+            }
+            for (Decision d : run.decisionsOn(k, unchanged(test, was, now, x, old.decisions()))) {
+                ds.put(d.component(), d);
             }
         }
         Decision dx = run.decision();
@@ -134,6 +136,25 @@ final class InstallDryRun {
         List<Plan.Action> actions = List.of(new Plan.Action(Plan.Op.START, xn, "installed; " + dx.reason()));
         return new Plan(change, title, actions, List.of(), List.of(List.of(xn)), b.activeBefore(), after, inactive,
                 wiring, adm, b.cycles(), b.notes());
+    }
+
+    /**
+     * The decisions on the CPU {@code x} joined that are the same as before, for the default
+     * test only: a decision says the CPU, the proof, the utilisation (two decimals) and, under
+     * response-time analysis, the response time, which depends only on the tasks of higher or
+     * equal priority ({@link FixedPriorityCpu}). So with the same proof and the same utilisation
+     * text, a decision is unchanged under the bound, and under response-time analysis for the
+     * tasks more urgent than {@code x}.
+     */
+    private static java.util.function.Function<CpuAdmissionTest.Task, Decision> unchanged(CpuAdmissionTest test,
+            CpuLoad was, CpuLoad now, Contract x, Map<String, Decision> old) {
+        if (!(test instanceof ResponseTimeTest) || was == null || !was.test().equals(now.test())
+                || !Text.util(was.utilisation()).equals(Text.util(now.utilisation()))) {
+            return t -> null;
+        }
+        boolean bound = ResponseTimeTest.HYPERBOLIC.equals(now.test());
+        int p = x.timing().priority();
+        return t -> bound || t.priority() > p ? old.get(t.name()) : null;
     }
 
     /** The resolver change added {@code x} and wires into it, and nothing else. */
