@@ -106,7 +106,7 @@ public final class Plan {
         this.activeBefore = Collections.unmodifiableSortedSet(new TreeSet<>(activeBefore));
         this.activeAfter = Collections.unmodifiableSortedSet(new TreeSet<>(activeAfter));
         this.inactiveAfter = Collections.unmodifiableSortedMap(new TreeMap<>(inactiveAfter));
-        this.wiring = List.copyOf(new TreeSet<>(wiring));
+        this.wiring = sortedDistinct(wiring);
         this.admission = admission;
         List<List<String>> cyc = new ArrayList<>();
         for (List<String> c : cycles) {
@@ -114,6 +114,16 @@ public final class Plan {
         }
         this.cycles = List.copyOf(cyc);
         this.notes = List.copyOf(notes);
+    }
+
+    /** The wires sorted without duplicates; in one pass when they already are. */
+    private static List<Wire> sortedDistinct(List<Wire> wires) {
+        for (int i = 1; i < wires.size(); i++) {
+            if (wires.get(i - 1).compareTo(wires.get(i)) >= 0) {
+                return List.copyOf(new TreeSet<>(wires));
+            }
+        }
+        return List.copyOf(wires);
     }
 
     /** The change this plan is for. */

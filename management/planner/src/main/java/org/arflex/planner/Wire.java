@@ -1,6 +1,5 @@
 package org.arflex.planner;
 
-import java.util.Comparator;
 import java.util.Objects;
 
 /**
@@ -14,9 +13,6 @@ import java.util.Objects;
  * @param outPort  output port name
  */
 public record Wire(String consumer, String inPort, String provider, String outPort) implements Comparable<Wire> {
-
-    private static final Comparator<Wire> ORDER = Comparator.comparing(Wire::consumer)
-            .thenComparing(Wire::inPort).thenComparing(Wire::provider).thenComparing(Wire::outPort);
 
     public Wire {
         Objects.requireNonNull(consumer, "consumer");
@@ -37,7 +33,15 @@ public record Wire(String consumer, String inPort, String provider, String outPo
 
     @Override
     public int compareTo(Wire o) {
-        return ORDER.compare(this, o);
+        // By consumer, input, provider, output (plans compare every wire of the cell).
+        int c = consumer.compareTo(o.consumer);
+        if (c == 0) {
+            c = inPort.compareTo(o.inPort);
+        }
+        if (c == 0) {
+            c = provider.compareTo(o.provider);
+        }
+        return c != 0 ? c : outPort.compareTo(o.outPort);
     }
 
     /** {@code consumer.inPort <- provider.outPort}. */

@@ -12,6 +12,7 @@ import java.util.PriorityQueue;
 import java.util.Set;
 import java.util.TreeMap;
 import java.util.TreeSet;
+import java.util.function.Function;
 import org.arflex.contract.Contract;
 import org.arflex.contract.PortSpec;
 import org.arflex.contract.Timing;
@@ -106,7 +107,14 @@ public final class Admission {
     public static AdmissionResult admit(Collection<Contract> candidates, Collection<Wire> wires,
             Capacities capacities, Map<String, Long> measuredWcetNs, Map<String, Integer> previousCpu,
             Set<String> running, CpuAdmissionTest cpuTest) {
-        return new Run(candidates, wires, capacities, measuredWcetNs, previousCpu, running, cpuTest).run();
+        return new Run(candidates, wires, capacities, measuredWcetNs, previousCpu, running, cpuTest, null).run();
+    }
+
+    /** As {@link #admit(Collection, Collection, Capacities, Map, Map, Set, CpuAdmissionTest)}, recording the run. */
+    static AdmissionResult admit(Collection<Contract> candidates, Collection<Wire> wires, Capacities capacities,
+            Map<String, Long> measuredWcetNs, Map<String, Integer> previousCpu, Set<String> running,
+            CpuAdmissionTest cpuTest, AdmissionTrace trace) {
+        return new Run(candidates, wires, capacities, measuredWcetNs, previousCpu, running, cpuTest, trace).run();
     }
 
     /** Runs admission over the satisfied components of {@code resolver}, with nothing running. */
@@ -119,21 +127,58 @@ public final class Admission {
     }
 
     /** One capacity CPU during a run: placement state here, schedulability in {@link #analysis}. */
-    private static final class Cpu {
+    static final class Cpu {
         final int id;
         final double cap;
         final boolean reserved;
-        final CpuAdmissionTest.Cpu analysis;
+        private final CpuAdmissionTest test;
+        /** The test's state; null until first needed on a CPU resumed from a trace. */
+        private CpuAdmissionTest.Cpu analysis;
         final List<Task> tasks = new ArrayList<>();
         double util;
         /** The exclusive task placed here, or null. */
         String owner;
+        /** Where to record adds, or null. */
+        AdmissionTrace trace;
+        int step;
 
         Cpu(Capacities.Cpu c, CpuAdmissionTest test) {
             this.id = c.id();
             this.cap = c.utilisationCap();
             this.reserved = c.reserved();
+            this.test = test;
             this.analysis = test.open(c.id());
+        }
+
+        /**
+         * The CPU as a recorded run left it after {@code tasks} were added in this order: the
+         * placement state now, the test's state when first asked (the adds replayed, each after
+         * its test, as the run did them; the test's contract makes its state depend on nothing
+         * else).
+         */
+        Cpu(Capacities.Cpu c, CpuAdmissionTest test, List<Task> placed) {
+            this.id = c.id();
+            this.cap = c.utilisationCap();
+            this.reserved = c.reserved();
+            this.test = test;
+            for (Task t : placed) {
+                util += t.utilisation();
+                tasks.add(t);
+            }
+        }
+
+        CpuAdmissionTest.Cpu analysis() {
+            if (analysis == null) {
+                analysis = test.open(id);
+                for (Task t : tasks) {
+                    String no = analysis.test(t);
+                    if (no != null) {
+                        throw new ReplayRefused("cpu " + id + ": replay of '" + t.name() + "' refused: " + no);
+                    }
+                    analysis.add(t);
+                }
+            }
+            return analysis;
         }
 
         /** Why {@code t} may not share this CPU (SPEC §8.6), or null. */
@@ -160,20 +205,27 @@ public final class Admission {
                 return "cpu " + id + ": utilisation " + Text.util(u) + " with '" + t.name() + "' exceeds cap "
                         + Text.util(cap);
             }
-            String no = analysis.test(t);
+            String no = analysis().test(t);
             return no == null ? null : "cpu " + id + ": " + no;
         }
 
         /** Adds a task that passed {@link #test}; returns the undo step. */
         Runnable add(Task t) {
-            Runnable undo = analysis.add(t);
+            Runnable undo = analysis().add(t);
             double oldUtil = util;
             util += t.utilisation();
             tasks.add(t);
+            AdmissionTrace tr = trace;
+            if (tr != null) {
+                tr.added(id, step, t);
+            }
             return () -> {
                 tasks.remove(t);
                 util = oldUtil;
                 undo.run();
+                if (tr != null) {
+                    tr.removedLast(id);
+                }
             };
         }
     }
@@ -196,9 +248,13 @@ public final class Admission {
         final Map<Integer, Integer> wantedExclusively = new HashMap<>();
         long memUsed;
         long netUsed;
+        final AdmissionTrace trace;
+        AdmissionTrace.Step step;
+        final Map<String, AdmissionTrace.Member> traced = new HashMap<>();
 
         Run(Collection<Contract> candidates, Collection<Wire> wires, Capacities caps, Map<String, Long> measured,
-                Map<String, Integer> previousCpu, Set<String> running, CpuAdmissionTest cpuTest) {
+                Map<String, Integer> previousCpu, Set<String> running, CpuAdmissionTest cpuTest, AdmissionTrace trace) {
+            this.trace = trace;
             for (Contract c : candidates) {
                 if (cands.put(c.name(), c) != null) {
                     throw new IllegalArgumentException("candidate '" + c.name() + "' given twice");
@@ -228,10 +284,15 @@ public final class Admission {
             this.previousCpu = previousCpu;
             this.running = running;
             for (Capacities.Cpu c : caps.cpus()) {
-                cpus.put(c.id(), new Cpu(c, cpuTest));
+                Cpu cpu = new Cpu(c, cpuTest);
+                cpu.trace = trace;
+                cpus.put(c.id(), cpu);
             }
             for (Contract c : cands.values()) {
                 if (isExclusive(c)) {
+                    if (trace != null) {
+                        trace.exclusiveCandidate();
+                    }
                     for (int id : new TreeSet<>(c.timing().cpus())) {
                         wantedExclusively.merge(id, 1, Integer::sum);
                     }
@@ -321,6 +382,16 @@ public final class Admission {
             }
             while (!ready.isEmpty()) {
                 int i = ready.poll();
+                if (trace != null) {
+                    step = trace.beginStep(eff[i], isRunning[i], groups.get(i), memUsed, netUsed);
+                    for (Cpu cpu : cpus.values()) {
+                        cpu.step = step.index();
+                    }
+                    for (String n : groups.get(i)) {
+                        Contract c = cands.get(n);
+                        traced.put(n, trace.member(step, n, c.resources().memoryBytes(), c.resources().networkBps()));
+                    }
+                }
                 admitGroup(groups.get(i));
                 for (int c : consumersOf.get(i)) {
                     if (--pending[c] == 0) {
@@ -328,7 +399,11 @@ public final class Admission {
                     }
                 }
             }
-            return result();
+            AdmissionResult r = result();
+            if (trace != null) {
+                trace.finish(r);
+            }
+            return r;
         }
 
         void admitGroup(List<String> members) {
@@ -358,6 +433,13 @@ public final class Admission {
                     for (int k = undo.size() - 1; k >= 0; k--) {
                         undo.get(k).run();
                     }
+                    for (String m : members) {
+                        AdmissionTrace.Member tm = traced.get(m);
+                        if (tm != null) {
+                            tm.cpu = -1;
+                            tm.prevFirst = false;
+                        }
+                    }
                     refuseAll(members, n, refusal);
                     return;
                 }
@@ -377,6 +459,15 @@ public final class Admission {
             }
         }
 
+        /** Notes a measured WCET larger than the declared one. */
+        void noteMeasured(Contract c) {
+            long wcet = wcetOf(c);
+            long declared = c.timing().wcetNs();
+            if (wcet > declared) {
+                notes.put(c.name(), "measured WCET " + Text.duration(wcet) + " > declared " + Text.duration(declared));
+            }
+        }
+
         long wcetOf(Contract c) {
             if (c.taskType() == Contract.TaskType.SERVICE) {
                 return 0;
@@ -390,6 +481,13 @@ public final class Admission {
             String n = c.name();
             long mem = c.resources().memoryBytes();
             long net = c.resources().networkBps();
+            AdmissionTrace.Member tm = traced.get(n);
+            if (tm != null) {
+                tm.budgetChecked = true;
+                tm.memBefore = memUsed;
+                tm.netBefore = netUsed;
+                tm.budgetRefused = memUsed + mem > caps.memoryBytes() || netUsed + net > caps.networkBps();
+            }
             if (memUsed + mem > caps.memoryBytes()) {
                 return "memory: " + Text.bytes(mem) + " requested, " + Text.bytes(Math.max(0, caps.memoryBytes() - memUsed))
                         + " free";
@@ -403,9 +501,7 @@ public final class Admission {
                 Timing t = c.timing();
                 long wcet = wcetOf(c);
                 long declared = t.wcetNs();
-                if (wcet > declared) {
-                    notes.put(n, "measured WCET " + Text.duration(wcet) + " > declared " + Text.duration(declared));
-                }
+                noteMeasured(c);
                 if (t.periodNs() <= 0) {
                     return "timing: period " + t.periodNs() + " ns is not positive";
                 }
@@ -450,6 +546,12 @@ public final class Admission {
                 // Keep the previous CPU when it still fits; otherwise worst fit, then lowest id;
                 // a shared task tries the CPUs an exclusive candidate still wants last.
                 boolean exclusive = t.exclusive();
+                if (tm != null) {
+                    tm.allowed = new int[allowed.size()];
+                    for (int k = 0; k < allowed.size(); k++) {
+                        tm.allowed[k] = allowed.get(k).id;
+                    }
+                }
                 List<Cpu> order = new ArrayList<>(allowed);
                 order.sort(Comparator.comparingInt((Cpu x) -> !exclusive && wantedExclusively.containsKey(x.id) ? 1 : 0)
                         .thenComparingDouble(x -> x.util).thenComparingInt(x -> x.id));
@@ -482,6 +584,10 @@ public final class Admission {
                     return wcet > declared ? r + " (" + notes.get(n) + ")" : r;
                 }
                 Cpu cpu = chosen;
+                if (tm != null) {
+                    tm.cpu = cpu.id;
+                    tm.prevFirst = prev != null && order.get(0) == cpu && cpu.id == prev;
+                }
                 Runnable cpuUndo = cpu.add(task);
                 placedOn.put(n, cpu);
                 taskOf.put(n, task);
@@ -517,37 +623,179 @@ public final class Admission {
         AdmissionResult result() {
             List<CpuLoad> loads = new ArrayList<>();
             for (Cpu cpu : cpus.values()) {
-                List<Task> sorted = new ArrayList<>(cpu.tasks);
-                sorted.sort(Comparator.comparingInt((Task t) -> -t.priority()).thenComparing(Task::name));
-                List<String> names = new ArrayList<>();
-                for (Task t : sorted) {
-                    names.add(t.name());
-                }
-                loads.add(new CpuLoad(cpu.id, cpu.cap, cpu.util, names, cpu.analysis.proof()));
+                loads.add(load(cpu));
             }
             for (String n : admitted) {
-                Contract c = cands.get(n);
-                Cpu cpu = placedOn.get(n);
-                String reason;
-                long r = -1;
-                if (cpu == null) {
-                    reason = "service task: no CPU budget";
-                } else {
-                    Task task = taskOf.get(n);
-                    r = cpu.analysis.responseTimeNs(n);
-                    String where = "cpu " + cpu.id + (n.equals(cpu.owner) ? " (exclusive)" : "");
-                    reason = r >= 0
-                            ? where + ": R=" + Text.duration(r) + " <= D=" + Text.duration(task.deadlineNs())
-                                    + " (U=" + Text.util(cpu.util) + ")"
-                            : where + ": " + cpu.analysis.proof() + " holds (U=" + Text.util(cpu.util) + ")";
-                    if (notes.containsKey(n)) {
-                        reason += "; " + notes.get(n);
-                    }
-                }
-                decisions.put(n, new Decision(n, true, cpu == null ? OptionalInt.empty() : OptionalInt.of(cpu.id),
-                        wcetOf(c), r, reason));
+                decisions.put(n, admittedDecision(n, cands.get(n)));
             }
             return new AdmissionResult(decisions, loads, memUsed, netUsed, caps);
+        }
+
+        /** The load of one CPU as the run leaves it. */
+        static CpuLoad load(Cpu cpu) {
+            List<Task> sorted = new ArrayList<>(cpu.tasks);
+            sorted.sort(Comparator.comparingInt((Task t) -> -t.priority()).thenComparing(Task::name));
+            List<String> names = new ArrayList<>();
+            for (Task t : sorted) {
+                names.add(t.name());
+            }
+            return new CpuLoad(cpu.id, cpu.cap, cpu.util, names, cpu.analysis().proof());
+        }
+
+        /** The decision for an admitted component, once every task is placed. */
+        Decision admittedDecision(String n, Contract c) {
+            Cpu cpu = placedOn.get(n);
+            String reason;
+            long r = -1;
+            if (cpu == null) {
+                reason = "service task: no CPU budget";
+            } else {
+                Task task = taskOf.get(n);
+                r = cpu.analysis().responseTimeNs(n);
+                String where = "cpu " + cpu.id + (n.equals(cpu.owner) ? " (exclusive)" : "");
+                reason = r >= 0
+                        ? where + ": R=" + Text.duration(r) + " <= D=" + Text.duration(task.deadlineNs())
+                                + " (U=" + Text.util(cpu.util) + ")"
+                        : where + ": " + cpu.analysis().proof() + " holds (U=" + Text.util(cpu.util) + ")";
+                if (notes.containsKey(n)) {
+                    reason += "; " + notes.get(n);
+                }
+            }
+            return new Decision(n, true, cpu == null ? OptionalInt.empty() : OptionalInt.of(cpu.id), wcetOf(c), r,
+                    reason);
+        }
+    }
+
+    /**
+     * A CPU rebuilt from a trace refused a task it had accepted in the recorded run: the test
+     * does not keep the contract of {@link CpuAdmissionTest} (its state depends on more than the
+     * adds), so nothing can be derived from the trace.
+     */
+    static final class ReplayRefused extends RuntimeException {
+        private static final long serialVersionUID = 1L;
+
+        ReplayRefused(String message) {
+            super(message);
+        }
+    }
+
+    /**
+     * Admission resumed just before a step of a recorded run, to place one more component there
+     * as a full run over the same candidates plus that one would (see {@link InstallDryRun}, which
+     * checks that the run would otherwise be the same). CPUs are rebuilt from the trace; the
+     * test's state of a CPU only when it is asked.
+     */
+    static final class Resumed {
+        private final Run run;
+        private final String name;
+
+        /**
+         * @param trace     the recorded run (no exclusive candidate)
+         * @param step      index of the step the new component goes before
+         * @param x         the new component
+         * @param providers contracts of its required providers (candidates of the recorded run)
+         * @param xWires    its input wires
+         */
+        Resumed(AdmissionTrace trace, int step, Contract x, List<Contract> providers, Collection<Wire> xWires,
+                Capacities caps, Map<String, Long> measured, CpuAdmissionTest test) {
+            List<Contract> cs = new ArrayList<>(providers);
+            cs.add(x);
+            this.name = x.name();
+            this.run = new Run(cs, xWires, caps, measured, Map.of(), Set.of(), test, null);
+            for (Capacities.Cpu c : caps.cpus()) {
+                List<Task> before = new ArrayList<>();
+                for (AdmissionTrace.Add a : trace.adds(c.id())) {
+                    if (a.step() < step) {
+                        before.add(a.task());
+                    }
+                }
+                run.cpus.put(c.id(), new Cpu(c, test, before));
+            }
+            List<AdmissionTrace.Step> steps = trace.steps();
+            run.memUsed = step < steps.size() ? steps.get(step).memBefore() : trace.memUsed();
+            run.netUsed = step < steps.size() ? steps.get(step).netBefore() : trace.netUsed();
+            for (Contract p : providers) {
+                if (trace.result().decisions().get(p.name()).admitted()) {
+                    run.admitted.add(p.name());
+                }
+            }
+        }
+
+        /** Admits the new component; its decision when refused, else null (see {@link #decision}). */
+        Decision admit() {
+            run.admitGroup(List.of(name));
+            return run.decisions.get(name);
+        }
+
+        /** The CPU the new component was placed on, -1 for none. */
+        int cpu() {
+            Cpu c = run.placedOn.get(name);
+            return c == null ? -1 : c.id;
+        }
+
+        /** Budgets the new component takes, once admitted. */
+        long mem() {
+            return run.cands.get(name).resources().memoryBytes();
+        }
+
+        long net() {
+            return run.cands.get(name).resources().networkBps();
+        }
+
+        /** Registers the tasks that were on {@code cpu} before the new component (for their decisions). */
+        void adopt(int cpu, Function<String, Contract> contracts) {
+            Cpu c = run.cpus.get(cpu);
+            for (Task t : c.tasks) {
+                if (!t.name().equals(name)) {
+                    Contract k = contracts.apply(t.name());
+                    run.cands.putIfAbsent(t.name(), k);
+                    run.placedOn.put(t.name(), c);
+                    run.taskOf.put(t.name(), t);
+                    run.noteMeasured(k);
+                }
+            }
+        }
+
+        /**
+         * Places a component that the recorded run placed first try on its previous CPU
+         * {@code cpu}, now beside the new one: true when it still fits there (then added), false
+         * when the full run would go elsewhere.
+         */
+        boolean keeps(Contract y, int cpu) {
+            Cpu c = run.cpus.get(cpu);
+            Timing t = y.timing();
+            Task task = new Task(y.name(), t.periodNs(), t.deadlineNs(), run.wcetOf(y), t.priority());
+            if (c.exclusion(task, t.exclusive()) != null || c.test(task) != null) {
+                return false;
+            }
+            c.add(task);
+            run.cands.putIfAbsent(y.name(), y);
+            run.placedOn.put(y.name(), c);
+            run.taskOf.put(y.name(), task);
+            run.noteMeasured(y);
+            return true;
+        }
+
+        /** Decision of the new component once admitted and every later task is placed. */
+        Decision decision() {
+            return run.admittedDecision(name, run.cands.get(name));
+        }
+
+        /**
+         * Decisions of every task on that CPU: {@code known} gives the ones the caller can prove
+         * unchanged (null: judge it again).
+         */
+        List<Decision> decisionsOn(int cpu, Function<Task, Decision> known) {
+            List<Decision> out = new ArrayList<>();
+            for (Task t : run.cpus.get(cpu).tasks) {
+                Decision d = t.name().equals(name) ? null : known.apply(t);
+                out.add(d != null ? d : run.admittedDecision(t.name(), run.cands.get(t.name())));
+            }
+            return out;
+        }
+
+        CpuLoad load(int cpu) {
+            return Run.load(run.cpus.get(cpu));
         }
     }
 

@@ -60,11 +60,28 @@ public final class PlanEngine {
     private final TreeMap<String, String> lastRefused = new TreeMap<>();
     private final CpuAdmissionTest cpuTest;
     private Capacities capacities;
+    /** Derive the plan of one install from {@link #picture} when it is provably the same. */
+    private final boolean incremental;
+    /** The plan of no change in the current state, once asked; null after a commit. */
+    private CurrentPicture picture;
+    /** How many plans {@link InstallDryRun} derived (for tests). */
+    private long derived;
 
     /** An empty cell with these capacities, whose CPUs {@code cpuTest} judges. */
     public PlanEngine(Capacities capacities, CpuAdmissionTest cpuTest) {
+        this(capacities, cpuTest, true);
+    }
+
+    /** As {@link #PlanEngine(Capacities, CpuAdmissionTest)}; {@code incremental} false always plans in full (tests). */
+    PlanEngine(Capacities capacities, CpuAdmissionTest cpuTest, boolean incremental) {
         this.capacities = Objects.requireNonNull(capacities, "capacities");
         this.cpuTest = Objects.requireNonNull(cpuTest, "cpuTest");
+        this.incremental = incremental;
+    }
+
+    /** How many plans were derived from the plan of no change instead of computed in full. */
+    long derivedPlans() {
+        return derived;
     }
 
     /**
@@ -92,7 +109,16 @@ public final class PlanEngine {
 
     /** The plan of the empty change: the full current picture, normally without actions. */
     public Plan current() {
-        return plan(Change.none());
+        return picture().plan();
+    }
+
+    private CurrentPicture picture() {
+        if (picture == null) {
+            AdmissionTrace trace = new AdmissionTrace();
+            Plan p = compute(Change.none(), false, trace);
+            picture = new CurrentPicture(p, trace);
+        }
+        return picture;
     }
 
     /** Current capacities. */
@@ -147,6 +173,11 @@ public final class PlanEngine {
     // ------------------------------------------------------------------------------------------
 
     private Plan compute(Change change, boolean commit) {
+        return compute(change, commit, null);
+    }
+
+    /** Plans in full, or derives the plan of one install (both validate first). */
+    private Plan compute(Change change, boolean commit, AdmissionTrace trace) {
         Objects.requireNonNull(change, "change");
         // 1. Validate against the current state; nothing is touched before this passes.
         Map<String, Contract> puts = new LinkedHashMap<>();
@@ -218,6 +249,15 @@ public final class PlanEngine {
         }
         Capacities newCaps = change.capacities().orElse(capacities);
 
+        if (incremental && trace == null && installed.size() == 1 && puts.size() == 1 && uninstalled.isEmpty()
+                && change.blocks().isEmpty() && change.unblocks().isEmpty() && change.measuredWcetNs().isEmpty()
+                && change.capacities().isEmpty()) {
+            Plan p = derive(change, puts.values().iterator().next(), commit, newBlocked, newMeasured);
+            if (p != null) {
+                return p;
+            }
+        }
+
         // 2. The picture before: effective input wiring of the Active components.
         Map<String, List<Wire>> oldEff = new HashMap<>();
         for (String n : active) {
@@ -239,19 +279,9 @@ public final class PlanEngine {
         boolean done = false;
         try {
             Plan plan = build(change, installed, replaced, uninstalled, newBlocked, newMeasured, newCaps, oldEff,
-                    oldContracts);
+                    oldContracts, trace);
             if (commit) {
-                active.clear();
-                active.addAll(plan.activeAfter());
-                cpuOf.clear();
-                cpuOf.putAll(plan.cpuAssignment());
-                blocked.clear();
-                blocked.putAll(newBlocked);
-                measured.clear();
-                measured.putAll(newMeasured);
-                capacities = newCaps;
-                lastRefused.clear();
-                lastRefused.putAll(plan.admission().refused());
+                commit(plan, newBlocked, newMeasured, newCaps);
             }
             done = true;
             return plan;
@@ -267,6 +297,56 @@ public final class PlanEngine {
                 resolver.apply(restore, installed);
             }
         }
+    }
+
+    /**
+     * The plan of installing {@code x} derived from the plan of no change, or null when it may
+     * differ from the full computation ({@link InstallDryRun}). Leaves the state as it was,
+     * unless committing.
+     */
+    private Plan derive(Change change, Contract x, boolean commit, SortedMap<String, String> newBlocked,
+            SortedMap<String, Long> newMeasured) {
+        CurrentPicture base = picture();
+        ResolveDelta delta = resolver.put(x);
+        boolean keep = false;
+        try {
+            Plan plan;
+            try {
+                plan = InstallDryRun.plan(base, resolver, delta, x, change, capacities, measured, blocked.keySet(),
+                        cpuTest);
+            } catch (Admission.ReplayRefused e) {
+                plan = null; // a test whose state the trace cannot rebuild: plan in full
+            }
+            if (plan != null) {
+                derived++;
+                if (commit) {
+                    commit(plan, newBlocked, newMeasured, capacities);
+                    keep = true;
+                }
+            }
+            return plan;
+        } finally {
+            if (!keep) {
+                resolver.remove(x.name());
+            }
+        }
+    }
+
+    /** Makes a plan's outcome the state. */
+    private void commit(Plan plan, SortedMap<String, String> newBlocked, SortedMap<String, Long> newMeasured,
+            Capacities newCaps) {
+        picture = null;
+        active.clear();
+        active.addAll(plan.activeAfter());
+        cpuOf.clear();
+        cpuOf.putAll(plan.cpuAssignment());
+        blocked.clear();
+        blocked.putAll(newBlocked);
+        measured.clear();
+        measured.putAll(newMeasured);
+        capacities = newCaps;
+        lastRefused.clear();
+        lastRefused.putAll(plan.admission().refused());
     }
 
     private static void addPut(Map<String, Contract> puts, Contract c) {
@@ -293,7 +373,7 @@ public final class PlanEngine {
     private Plan build(Change change, Set<String> installed, SortedMap<String, Contract> replaced,
             SortedMap<String, Contract> uninstalled, SortedMap<String, String> newBlocked,
             SortedMap<String, Long> newMeasured, Capacities newCaps, Map<String, List<Wire>> oldEff,
-            Map<String, Contract> oldContracts) {
+            Map<String, Contract> oldContracts, AdmissionTrace trace) {
         // Candidates: satisfied, not blocked, and not depending (required) on a blocked one.
         TreeMap<String, String> inactive = new TreeMap<>();
         Set<String> cands = new HashSet<>(resolver.satisfied());
@@ -324,7 +404,8 @@ public final class PlanEngine {
                 prevCpu.put(e.getKey(), e.getValue());
             }
         }
-        AdmissionResult adm = Admission.admit(candContracts, resolver.wiresUnsorted(), newCaps, newMeasured, prevCpu, active, cpuTest);
+        AdmissionResult adm = Admission.admit(candContracts, resolver.wiresUnsorted(), newCaps, newMeasured, prevCpu, active,
+                cpuTest, trace);
         TreeSet<String> target = new TreeSet<>(adm.admitted());
         inactive.putAll(adm.refused());
         for (String n : resolver.names()) {

@@ -56,13 +56,17 @@ public final class Text {
     /** Two decimals, trailing zeros dropped: 1, 1.2, 1.25. */
     public static String trim(double v) {
         String s = String.format(Locale.ROOT, "%.2f", v);
-        if (s.contains(".")) {
-            s = s.replaceAll("0+$", "");
-            if (s.endsWith(".")) {
-                s = s.substring(0, s.length() - 1);
-            }
+        if (s.indexOf('.') < 0) {
+            return s;
         }
-        return s;
+        int end = s.length();
+        while (s.charAt(end - 1) == '0') {
+            end--;
+        }
+        if (s.charAt(end - 1) == '.') {
+            end--;
+        }
+        return s.substring(0, end);
     }
 
     /** Utilisation with two decimals: {@code 0.97}. */
