@@ -11,13 +11,19 @@ import java.util.function.Consumer;
 
 /**
  * The real actor: one daemon thread named {@value Actor#THREAD_NAME}. A task that throws is
- * logged and does not kill the thread.
+ * logged and does not kill the thread. The longest time a submitted task waited for the actor
+ * (what a crash report or a shell command waits behind) is logged each time it grows beyond
+ * {@link #LAG_LOG_MS}: "the actor answered after N ms (longest yet)" (issue 17's supervision
+ * stall, read by the soak bench).
  */
 public final class ThreadActor implements Actor {
 
     private final ScheduledThreadPoolExecutor executor;
     private volatile Thread thread;
     private final Consumer<String> log;
+    /** A wait for the actor longer than this is logged when it is the longest yet. */
+    static final long LAG_LOG_MS = 20;
+    private long longestWaitNs = LAG_LOG_MS * 1_000_000L; // actor thread only
 
     public ThreadActor(Consumer<String> log) {
         this.log = log;
@@ -43,7 +49,21 @@ public final class ThreadActor implements Actor {
 
     @Override
     public void submit(Runnable r) {
-        executor.execute(guarded(r));
+        long queued = System.nanoTime();
+        Runnable g = guarded(r);
+        executor.execute(() -> {
+            waited(queued);
+            g.run();
+        });
+    }
+
+    /** Logs the wait of a task that started now, when it is the longest yet (actor thread). */
+    private void waited(long queuedNs) {
+        long w = System.nanoTime() - queuedNs;
+        if (w > longestWaitNs) {
+            longestWaitNs = w;
+            log.accept("arflex: the actor answered after " + w / 1_000_000L + " ms (longest yet)");
+        }
     }
 
     @Override
@@ -77,7 +97,11 @@ public final class ThreadActor implements Actor {
                 throw new IllegalStateException(e);
             }
         }
-        Future<T> f = executor.submit(c);
+        long queued = System.nanoTime();
+        Future<T> f = executor.submit(() -> {
+            waited(queued);
+            return c.call();
+        });
         try {
             return f.get(timeoutMs, TimeUnit.MILLISECONDS);
         } catch (ExecutionException e) {

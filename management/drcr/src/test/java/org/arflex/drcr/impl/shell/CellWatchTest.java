@@ -29,8 +29,10 @@ class CellWatchTest {
         AtomicBoolean active = new AtomicBoolean();
         AtomicInteger probes = new AtomicInteger();
         Thread[] other = new Thread[1];
-        // the first look starts the change; the waiter can only return through it (the timeout is an hour)
+        // the first look starts the change (which may be signalled before the waiter waits); the
+        // waiter can only return through it (the timeout is an hour)
         CellWatch.Outcome<Boolean> o = w.await(() -> {
+            boolean now = active.get(); // read before the change can happen: the first look sees false
             if (probes.getAndIncrement() == 0) {
                 other[0] = new Thread(() -> {
                     active.set(true);
@@ -38,7 +40,7 @@ class CellWatchTest {
                 });
                 other[0].start();
             }
-            return active.get();
+            return now;
         }, Boolean::booleanValue, TimeUnit.HOURS.toNanos(1));
         other[0].join();
         assertTrue(o.met());
