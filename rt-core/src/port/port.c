@@ -38,9 +38,13 @@ uint64_t arflex_port_type_hash(const char *name)
 	return h;
 }
 
+/* ABI 2.0 (D30): the payload follows the 24-byte slot header directly; the slot is rounded up
+ * to whole cache lines. Computed in 64 bits: elem <= ARFLEX_PORT_MAX_ELEM, so it fits. */
 static uint32_t stride_of(uint32_t elem)
 {
-	return ARFLEX_SLOT_HDR_SIZE + ((elem + 63u) & ~63u);
+	uint64_t s = (uint64_t)ARFLEX_SLOT_HDR_SIZE + elem + (ARFLEX_SLOT_ALIGN - 1u);
+
+	return (uint32_t)(s & ~(uint64_t)(ARFLEX_SLOT_ALIGN - 1u));
 }
 
 static int spec_valid(const struct arflex_port_spec *s)
@@ -111,8 +115,8 @@ int arflex_port_create(struct arflex_port *p, const char *shm_name,
 	arflex_sys_close(fd);
 
 	h = base;
-	h->abi_major = ARFLEX_ABI_MAJOR;
-	h->abi_minor = ARFLEX_ABI_MINOR;
+	h->abi_major = ARFLEX_PORT_ABI_MAJOR;
+	h->abi_minor = ARFLEX_PORT_ABI_MINOR;
 	h->header_size = ARFLEX_PORT_HDR_SIZE;
 	h->size = len;
 	h->method = spec->method;
@@ -155,7 +159,7 @@ int arflex_port_destroy(struct arflex_port *p)
 static int check_hdr(const struct arflex_port_hdr *h, size_t len, bool producer,
 		     enum arflex_port_method method, const struct arflex_port_type *t)
 {
-	if (LOAD(&h->magic) != ARFLEX_PORT_MAGIC || h->abi_major != ARFLEX_ABI_MAJOR ||
+	if (LOAD(&h->magic) != ARFLEX_PORT_MAGIC || h->abi_major != ARFLEX_PORT_ABI_MAJOR ||
 	    h->header_size != ARFLEX_PORT_HDR_SIZE)
 		return -EPROTO;
 	if (h->size != len || h->slot_stride != stride_of(h->elem_size) || h->depth == 0 ||
