@@ -591,6 +591,19 @@ static void port_abi_2_layout_and_1x_refused(void **state)
 	assert_int_equal(((const struct arflex_slot_hdr *)slot0)->length, 8);
 	assert_int_equal(arflex_state_read(&r, &got, sizeof(got), NULL), 1);
 	assert_true(got == v);
+	/* arflex_state_write_at: the producer's own stamp, which freshness is judged by */
+	{
+		uint64_t t = arflex_sys_now_ns(), age = 0;
+
+		assert_int_equal(arflex_state_write_at(&w, &t, sizeof(t), t), 0);
+		assert_true(((const struct arflex_slot_hdr *)slot0)->stamp_ns == t);
+		assert_int_equal(arflex_port_age(&r, t + 5000, &age), 0);
+		assert_int_equal(age, 5000);
+		assert_int_equal(arflex_state_read(&r, &got, sizeof(got), NULL), 1);
+		assert_true(got == t);
+		assert_int_equal(arflex_state_write_at(&r, &t, sizeof(t), t), -EINVAL);
+		assert_int_equal(arflex_state_write_at(&w, &t, 9, t), -EINVAL);
+	}
 	arflex_port_close(&r);
 	arflex_port_close(&w);
 

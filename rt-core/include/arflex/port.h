@@ -223,6 +223,17 @@ ARFLEX_API int arflex_port_age(const struct arflex_port *p, uint64_t now_ns, uin
 ARFLEX_API int arflex_state_write(struct arflex_port *p, const void *val, size_t len);
 
 /**
+ * As arflex_state_write, but the slot's stamp_ns is @stamp_ns, a CLOCK_MONOTONIC time
+ * (arflex_sys_now_ns) the producer already took for this value (e.g. the value's own t_ns),
+ * instead of a clock read inside the call: one clock read less between the producer's stamp
+ * and the publication (about 30 ns on the development VM, D30). Consumers judge freshness by
+ * it (arflex_port_age): pass a time taken before the call, never a later one. Returns 0 or
+ * -EINVAL. RT safe.
+ */
+ARFLEX_API int arflex_state_write_at(struct arflex_port *p, const void *val, size_t len,
+				     uint64_t stamp_ns);
+
+/**
  * Reads the latest value into @out (@len <= elem_size bytes copied) if it is newer than the
  * one this handle returned last. Returns 1 (new value, *@seq = its write count if @seq is not
  * NULL), 0 (no new value, or the writer kept it busy for ARFLEX_STATE_READ_RETRIES attempts:

@@ -248,10 +248,10 @@ static inline struct arflex_slot_hdr *slot(const struct arflex_port *p, uint64_t
 
 /* Copy helpers: payload bytes are accessed as plain memory inside the seqlock window; the
  * seq re-check discards any torn copy. */
-static void slot_write(struct arflex_port *p, uint64_t idx, const void *val, size_t len)
+static void slot_write(struct arflex_port *p, uint64_t idx, const void *val, size_t len,
+		       uint64_t stamp)
 {
 	struct arflex_slot_hdr *s = slot(p, idx);
-	uint64_t stamp = arflex_sys_now_ns(); /* outside the write window: readers retry less */
 
 	STORER(&s->seq, 2 * idx + 1);
 	__atomic_thread_fence(__ATOMIC_RELEASE);
@@ -261,15 +261,21 @@ static void slot_write(struct arflex_port *p, uint64_t idx, const void *val, siz
 	STORE(&s->seq, 2 * idx + 2);
 }
 
-int arflex_state_write(struct arflex_port *p, const void *val, size_t len)
+int arflex_state_write_at(struct arflex_port *p, const void *val, size_t len, uint64_t stamp_ns)
 {
 	if (!p->hdr || !p->writable || p->method != ARFLEX_PORT_STATE || len > p->elem_size)
 		return -EINVAL;
-	slot_write(p, p->next_idx, val, len);
+	slot_write(p, p->next_idx, val, len, stamp_ns);
 	p->next_idx++;
 	STORE(&p->hdr->head, p->next_idx);
 	STORE(&p->hdr->written, p->next_idx);
 	return 0;
+}
+
+int arflex_state_write(struct arflex_port *p, const void *val, size_t len)
+{
+	/* the clock is read before the write window opens: readers retry less */
+	return arflex_state_write_at(p, val, len, arflex_sys_now_ns());
 }
 
 /* The identification cannot change while mapped: anything else is damage (an overwritten
@@ -343,7 +349,7 @@ int arflex_stream_push(struct arflex_port *p, const void *val, size_t len)
 		STORE(&h->written, LOADR(&h->written) + 1);
 		return 0;
 	}
-	slot_write(p, idx, val, len);
+	slot_write(p, idx, val, len, arflex_sys_now_ns()); /* before the write window */
 	p->next_idx = idx + 1;
 	STORE(&h->head, idx + 1);
 	STORE(&h->written, LOADR(&h->written) + 1);
