@@ -542,6 +542,123 @@ static void frame_port_zero_copy(void **state)
 	th_assert_clean(rid);
 }
 
+/* Port ABI 2.0 (DECISIONS.md D30): the segment says 2.0, slot k is at 256 + k * stride with
+ * stride = round_up(24 + elem_size, 64), the payload follows the 24-byte slot header (a value
+ * of up to 40 bytes shares the seqlock word's cache line), for every method; a 1.x segment (or
+ * any other major) is refused on open, by producers and consumers alike. */
+static void port_abi_2_layout_and_1x_refused(void **state)
+{
+	static const struct {
+		uint32_t elem, stride;
+	} geo[] = { { 1, 64 }, { 8, 64 }, { 40, 64 }, { 41, 128 }, { 64, 128 }, { 104, 128 },
+		    { 105, 192 } };
+	struct arflex_port_spec spec = { .method = ARFLEX_PORT_STATE, .type = sample_type };
+	struct arflex_port_type t8 = { .name = "test.Stamp", .major = 1, .minor = 0, .elem_size = 8 };
+	struct arflex_port mgr, w, r, q, f;
+	char name[ARFLEX_OBJ_NAME_SIZE];
+	uint64_t v = UINT64_C(0x1122334455667788), got = 0, stored;
+	uint8_t *slot0;
+
+	(void)state;
+	assert_int_equal(ARFLEX_SLOT_HDR_SIZE, 24);
+	assert_int_equal(ARFLEX_SLOT_INLINE_MAX, 40);
+	th_rid(rid, sizeof(rid), "abi2");
+	for (size_t i = 0; i < sizeof(geo) / sizeof(geo[0]); i++) {
+		char gname[ARFLEX_OBJ_NAME_SIZE], port[16];
+
+		snprintf(port, sizeof(port), "g%zu", i);
+		name_of(gname, port);
+		spec.type.elem_size = geo[i].elem;
+		assert_int_equal(arflex_port_segment_size(&spec), 4096);
+		assert_int_equal(arflex_port_create(&mgr, gname, &spec), 0);
+		assert_int_equal(mgr.hdr->slot_stride, geo[i].stride);
+		assert_int_equal(mgr.hdr->abi_major, 2);
+		assert_int_equal(mgr.hdr->abi_minor, 0);
+		assert_int_equal(arflex_port_destroy(&mgr), 0);
+	}
+
+	/* a state value of 8 bytes sits at +24 of slot 0, in the line of its seq */
+	name_of(name, "s");
+	spec.type = t8;
+	assert_int_equal(arflex_port_create(&mgr, name, &spec), 0);
+	assert_int_equal(arflex_port_open(&w, name, true, true, ARFLEX_PORT_STATE, &t8), 0);
+	assert_int_equal(arflex_port_open(&r, name, false, false, ARFLEX_PORT_STATE, &t8), 0);
+	assert_int_equal(arflex_state_write(&w, &v, sizeof(v)), 0);
+	slot0 = (uint8_t *)mgr.base + ARFLEX_PORT_HDR_SIZE;
+	memcpy(&stored, slot0 + 24, sizeof(stored));
+	assert_true(stored == v);
+	assert_int_equal(((const struct arflex_slot_hdr *)slot0)->seq, 2);
+	assert_int_equal(((const struct arflex_slot_hdr *)slot0)->length, 8);
+	assert_int_equal(arflex_state_read(&r, &got, sizeof(got), NULL), 1);
+	assert_true(got == v);
+	/* arflex_state_write_at: the producer's own stamp, which freshness is judged by */
+	{
+		uint64_t t = arflex_sys_now_ns(), age = 0;
+
+		assert_int_equal(arflex_state_write_at(&w, &t, sizeof(t), t), 0);
+		assert_true(((const struct arflex_slot_hdr *)slot0)->stamp_ns == t);
+		assert_int_equal(arflex_port_age(&r, t + 5000, &age), 0);
+		assert_int_equal(age, 5000);
+		assert_int_equal(arflex_state_read(&r, &got, sizeof(got), NULL), 1);
+		assert_true(got == t);
+		assert_int_equal(arflex_state_write_at(&r, &t, sizeof(t), t), -EINVAL);
+		assert_int_equal(arflex_state_write_at(&w, &t, 9, t), -EINVAL);
+	}
+	arflex_port_close(&r);
+	arflex_port_close(&w);
+
+	/* a 1.x segment (the 1.2 layout had its payload at +64) and a future 3.x are refused */
+	for (uint16_t major = 0; major <= 3; major++) {
+		if (major == ARFLEX_PORT_ABI_MAJOR)
+			continue;
+		mgr.hdr->abi_major = major;
+		mgr.hdr->abi_minor = 2;
+		assert_int_equal(arflex_port_open(&r, name, false, false, ARFLEX_PORT_STATE, &t8),
+				 -EPROTO);
+		assert_int_equal(arflex_port_open(&w, name, true, true, ARFLEX_PORT_STATE, &t8),
+				 -EPROTO);
+		assert_int_equal(arflex_port_open(&r, name, false, false, ARFLEX_PORT_STATE, NULL),
+				 -EPROTO);
+	}
+	/* a higher minor of the same major is accepted (minors only add in reserved space) */
+	mgr.hdr->abi_major = ARFLEX_PORT_ABI_MAJOR;
+	mgr.hdr->abi_minor = 7;
+	assert_int_equal(arflex_port_open(&r, name, false, false, ARFLEX_PORT_STATE, &t8), 0);
+	arflex_port_close(&r);
+	assert_int_equal(arflex_port_destroy(&mgr), 0);
+
+	/* streams and frames follow the same rule: element i of a stream at slot i mod depth, +24 */
+	name_of(name, "q");
+	spec = (struct arflex_port_spec){ .method = ARFLEX_PORT_STREAM, .type = t8, .depth = 4,
+					  .overflow = ARFLEX_OVERFLOW_DROP_OLDEST };
+	assert_int_equal(arflex_port_create(&mgr, name, &spec), 0);
+	assert_int_equal(mgr.hdr->slot_stride, 64);
+	assert_int_equal(arflex_port_open(&q, name, true, true, ARFLEX_PORT_STREAM, &t8), 0);
+	for (uint64_t i = 0; i < 2; i++) {
+		uint64_t x = v + i;
+
+		assert_int_equal(arflex_stream_push(&q, &x, sizeof(x)), 1);
+	}
+	memcpy(&stored, (uint8_t *)mgr.base + ARFLEX_PORT_HDR_SIZE + 64 + 24, sizeof(stored));
+	assert_true(stored == v + 1);
+	arflex_port_close(&q);
+	assert_int_equal(arflex_port_destroy(&mgr), 0);
+
+	name_of(name, "f");
+	spec = (struct arflex_port_spec){ .method = ARFLEX_PORT_FRAME,
+					  .type = { "test.Frame", 1, 0, 1000 }, .depth = 2 };
+	assert_int_equal(arflex_port_create(&mgr, name, &spec), 0);
+	assert_int_equal(mgr.hdr->slot_stride, 1024);
+	assert_int_equal(arflex_port_open(&f, name, true, true, ARFLEX_PORT_FRAME, NULL), 0);
+	/* (the producer's own mapping: f.base) */
+	assert_ptr_equal(arflex_frame_begin(&f), (uint8_t *)f.base + ARFLEX_PORT_HDR_SIZE + 24);
+	assert_int_equal(arflex_frame_commit(&f, 10), 0);
+	assert_ptr_equal(arflex_frame_begin(&f), (uint8_t *)f.base + ARFLEX_PORT_HDR_SIZE + 1024 + 24);
+	arflex_port_close(&f);
+	assert_int_equal(arflex_port_destroy(&mgr), 0);
+	th_assert_clean(rid);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -554,6 +671,7 @@ int main(void)
 		cmocka_unit_test(stream_drop_newest_exact_counts),
 		cmocka_unit_test(stream_drop_oldest_exact_counts),
 		cmocka_unit_test(frame_port_zero_copy),
+		cmocka_unit_test(port_abi_2_layout_and_1x_refused),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);

@@ -5,7 +5,15 @@
  * manager (arflex_port_create, O_CREAT|O_EXCL, mode 0600) and removed by it; the producing RT
  * process opens it read-write, consumers open it (stream: read-write, to advance their tail;
  * state/frame: read-only). The segment survives a restart of its producer. Byte layout: see
- * rt-core/docs/ABI.md; the structs below are that layout.
+ * rt-core/docs/ABI.md; the structs below are that layout. Port segments carry their own layout
+ * version (ARFLEX_PORT_ABI_MAJOR.MINOR in abi_major/abi_minor, 2.0 since DECISIONS.md D30);
+ * control blocks and messages carry ARFLEX_ABI_MAJOR.MINOR.
+ *
+ * Slot layout (one rule for all three methods): slot k starts at ARFLEX_PORT_HDR_SIZE +
+ * k * slot_stride (64-byte aligned); its 24-byte header (struct arflex_slot_hdr) is followed
+ * directly by the payload; slot_stride = round_up(24 + elem_size, 64). A payload of up to
+ * ARFLEX_SLOT_INLINE_MAX (40) bytes therefore shares the cache line of its seqlock word: a
+ * state read of such a value touches one line. Payloads are 8-byte aligned.
  *
  * Three methods:
  *   STATE  latest value. Single writer, any number of readers. Seqlock on one slot: a reader
@@ -40,8 +48,16 @@ extern "C" {
 #define ARFLEX_PORT_MAGIC UINT64_C(0x545250584C465241)
 /** Size of the segment header; the first slot starts here. */
 #define ARFLEX_PORT_HDR_SIZE 256u
-/** Size of the header in front of each slot's payload. */
-#define ARFLEX_SLOT_HDR_SIZE 64u
+/** Version of the port segment layout (hdr.abi_major/abi_minor). A reader refuses a segment
+ *  whose major differs (-EPROTO). 2.0: 24-byte slot header, payload right after it (D30). */
+#define ARFLEX_PORT_ABI_MAJOR 2u
+#define ARFLEX_PORT_ABI_MINOR 0u
+/** Size of the header in front of each slot's payload; the payload starts right after it. */
+#define ARFLEX_SLOT_HDR_SIZE 24u
+/** Slots are aligned to (and their stride is a multiple of) one cache line. */
+#define ARFLEX_SLOT_ALIGN 64u
+/** Largest payload that shares its slot header's cache line. */
+#define ARFLEX_SLOT_INLINE_MAX (ARFLEX_SLOT_ALIGN - ARFLEX_SLOT_HDR_SIZE)
 /** Size of the type_name field. */
 #define ARFLEX_TYPE_NAME_SIZE 64
 /** A state reader gives up after this many torn attempts in one call. */
@@ -69,15 +85,15 @@ enum arflex_port_overflow {
  *  (single, stream) consumer only. */
 struct arflex_port_hdr {
 	uint64_t magic;        /**< ARFLEX_PORT_MAGIC */
-	uint16_t abi_major;    /**< ARFLEX_ABI_MAJOR */
-	uint16_t abi_minor;    /**< ARFLEX_ABI_MINOR */
+	uint16_t abi_major;    /**< ARFLEX_PORT_ABI_MAJOR */
+	uint16_t abi_minor;    /**< ARFLEX_PORT_ABI_MINOR */
 	uint32_t header_size;  /**< ARFLEX_PORT_HDR_SIZE: offset of slot 0 */
 	uint64_t size;         /**< segment size in bytes (page multiple) */
 	uint32_t method;       /**< enum arflex_port_method */
 	uint32_t elem_size;    /**< payload bytes per element (frame: max bytes per frame) */
 	uint32_t depth;        /**< slots: 1 for state, ring depth for stream and frame */
 	uint32_t overflow;     /**< enum arflex_port_overflow */
-	uint32_t slot_stride;  /**< 64 + elem_size rounded up to 64 */
+	uint32_t slot_stride;  /**< ARFLEX_SLOT_HDR_SIZE + elem_size rounded up to 64 */
 	uint16_t type_major;   /**< port type version */
 	uint16_t type_minor;
 	uint64_t type_hash;    /**< FNV-1a 64 of the port type name (see arflex_port_type_hash) */
@@ -99,15 +115,14 @@ struct arflex_port_hdr {
 	uint64_t reserved_c[4];
 };
 
-/** Header in front of each slot's payload, 64 bytes. seq is the slot's seqlock: for element
- *  index i (0-based count of writes) it is 2*i+1 while being written and 2*i+2 when
- *  complete; 0 = never written. */
+/** Header in front of each slot's payload, 24 bytes, the payload follows at +24 in the same
+ *  cache line. seq is the slot's seqlock: for element index i (0-based count of writes) it is
+ *  2*i+1 while being written and 2*i+2 when complete; 0 = never written. */
 struct arflex_slot_hdr {
 	uint64_t seq;
 	uint64_t stamp_ns;     /**< CLOCK_MONOTONIC when the producer wrote it */
 	uint32_t length;       /**< valid payload bytes (elem_size except for frames) */
 	uint32_t reserved0;
-	uint64_t reserved[5];
 };
 
 ARFLEX_STATIC_ASSERT(sizeof(struct arflex_port_hdr) == ARFLEX_PORT_HDR_SIZE, "port hdr");
@@ -115,6 +130,10 @@ ARFLEX_STATIC_ASSERT(offsetof(struct arflex_port_hdr, type_hash) == 48, "port ty
 ARFLEX_STATIC_ASSERT(offsetof(struct arflex_port_hdr, head) == 128, "port head");
 ARFLEX_STATIC_ASSERT(offsetof(struct arflex_port_hdr, tail) == 192, "port tail");
 ARFLEX_STATIC_ASSERT(sizeof(struct arflex_slot_hdr) == ARFLEX_SLOT_HDR_SIZE, "slot hdr");
+ARFLEX_STATIC_ASSERT(offsetof(struct arflex_slot_hdr, stamp_ns) == 8, "slot stamp_ns");
+ARFLEX_STATIC_ASSERT(offsetof(struct arflex_slot_hdr, length) == 16, "slot length");
+ARFLEX_STATIC_ASSERT(ARFLEX_SLOT_HDR_SIZE % 8 == 0 && ARFLEX_PORT_HDR_SIZE % ARFLEX_SLOT_ALIGN == 0,
+		     "slot alignment");
 
 /** What a port carries; used to create a segment and to check one on open. */
 struct arflex_port_type {
@@ -177,7 +196,8 @@ ARFLEX_API int arflex_port_destroy(struct arflex_port *p);
  * check). @writable maps read-write (producers, stream consumers). For a producer
  * (@producer true) method, type hash, version and elem_size must match exactly; for a
  * consumer the provider's type major must equal, its minor be >= and its elem_size be >=
- * the expected ones. Returns 0 or -errno: -ENOENT, -EPROTO (bad magic / ABI major / header),
+ * the expected ones. Returns 0 or -errno: -ENOENT, -EPROTO (bad magic, a port ABI major other
+ * than ARFLEX_PORT_ABI_MAJOR, e.g. a 1.x segment, or a bad header),
  * -EPROTOTYPE (method or type mismatch), -EMSGSIZE (size mismatch).
  */
 ARFLEX_API int arflex_port_open(struct arflex_port *p, const char *shm_name, bool writable,
@@ -201,6 +221,17 @@ ARFLEX_API int arflex_port_age(const struct arflex_port *p, uint64_t now_ns, uin
 
 /** Writes @len (<= elem_size) bytes as the new value. Returns 0 or -EINVAL. RT safe. */
 ARFLEX_API int arflex_state_write(struct arflex_port *p, const void *val, size_t len);
+
+/**
+ * As arflex_state_write, but the slot's stamp_ns is @stamp_ns, a CLOCK_MONOTONIC time
+ * (arflex_sys_now_ns) the producer already took for this value (e.g. the value's own t_ns),
+ * instead of a clock read inside the call: one clock read less between the producer's stamp
+ * and the publication (about 30 ns on the development VM, D30). Consumers judge freshness by
+ * it (arflex_port_age): pass a time taken before the call, never a later one. Returns 0 or
+ * -EINVAL. RT safe.
+ */
+ARFLEX_API int arflex_state_write_at(struct arflex_port *p, const void *val, size_t len,
+				     uint64_t stamp_ns);
 
 /**
  * Reads the latest value into @out (@len <= elem_size bytes copied) if it is newer than the

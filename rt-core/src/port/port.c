@@ -38,9 +38,13 @@ uint64_t arflex_port_type_hash(const char *name)
 	return h;
 }
 
+/* ABI 2.0 (D30): the payload follows the 24-byte slot header directly; the slot is rounded up
+ * to whole cache lines. Computed in 64 bits: elem <= ARFLEX_PORT_MAX_ELEM, so it fits. */
 static uint32_t stride_of(uint32_t elem)
 {
-	return ARFLEX_SLOT_HDR_SIZE + ((elem + 63u) & ~63u);
+	uint64_t s = (uint64_t)ARFLEX_SLOT_HDR_SIZE + elem + (ARFLEX_SLOT_ALIGN - 1u);
+
+	return (uint32_t)(s & ~(uint64_t)(ARFLEX_SLOT_ALIGN - 1u));
 }
 
 static int spec_valid(const struct arflex_port_spec *s)
@@ -111,8 +115,8 @@ int arflex_port_create(struct arflex_port *p, const char *shm_name,
 	arflex_sys_close(fd);
 
 	h = base;
-	h->abi_major = ARFLEX_ABI_MAJOR;
-	h->abi_minor = ARFLEX_ABI_MINOR;
+	h->abi_major = ARFLEX_PORT_ABI_MAJOR;
+	h->abi_minor = ARFLEX_PORT_ABI_MINOR;
 	h->header_size = ARFLEX_PORT_HDR_SIZE;
 	h->size = len;
 	h->method = spec->method;
@@ -155,7 +159,7 @@ int arflex_port_destroy(struct arflex_port *p)
 static int check_hdr(const struct arflex_port_hdr *h, size_t len, bool producer,
 		     enum arflex_port_method method, const struct arflex_port_type *t)
 {
-	if (LOAD(&h->magic) != ARFLEX_PORT_MAGIC || h->abi_major != ARFLEX_ABI_MAJOR ||
+	if (LOAD(&h->magic) != ARFLEX_PORT_MAGIC || h->abi_major != ARFLEX_PORT_ABI_MAJOR ||
 	    h->header_size != ARFLEX_PORT_HDR_SIZE)
 		return -EPROTO;
 	if (h->size != len || h->slot_stride != stride_of(h->elem_size) || h->depth == 0 ||
@@ -244,10 +248,10 @@ static inline struct arflex_slot_hdr *slot(const struct arflex_port *p, uint64_t
 
 /* Copy helpers: payload bytes are accessed as plain memory inside the seqlock window; the
  * seq re-check discards any torn copy. */
-static void slot_write(struct arflex_port *p, uint64_t idx, const void *val, size_t len)
+static void slot_write(struct arflex_port *p, uint64_t idx, const void *val, size_t len,
+		       uint64_t stamp)
 {
 	struct arflex_slot_hdr *s = slot(p, idx);
-	uint64_t stamp = arflex_sys_now_ns(); /* outside the write window: readers retry less */
 
 	STORER(&s->seq, 2 * idx + 1);
 	__atomic_thread_fence(__ATOMIC_RELEASE);
@@ -257,15 +261,21 @@ static void slot_write(struct arflex_port *p, uint64_t idx, const void *val, siz
 	STORE(&s->seq, 2 * idx + 2);
 }
 
-int arflex_state_write(struct arflex_port *p, const void *val, size_t len)
+int arflex_state_write_at(struct arflex_port *p, const void *val, size_t len, uint64_t stamp_ns)
 {
 	if (!p->hdr || !p->writable || p->method != ARFLEX_PORT_STATE || len > p->elem_size)
 		return -EINVAL;
-	slot_write(p, p->next_idx, val, len);
+	slot_write(p, p->next_idx, val, len, stamp_ns);
 	p->next_idx++;
 	STORE(&p->hdr->head, p->next_idx);
 	STORE(&p->hdr->written, p->next_idx);
 	return 0;
+}
+
+int arflex_state_write(struct arflex_port *p, const void *val, size_t len)
+{
+	/* the clock is read before the write window opens: readers retry less */
+	return arflex_state_write_at(p, val, len, arflex_sys_now_ns());
 }
 
 /* The identification cannot change while mapped: anything else is damage (an overwritten
@@ -339,7 +349,7 @@ int arflex_stream_push(struct arflex_port *p, const void *val, size_t len)
 		STORE(&h->written, LOADR(&h->written) + 1);
 		return 0;
 	}
-	slot_write(p, idx, val, len);
+	slot_write(p, idx, val, len, arflex_sys_now_ns()); /* before the write window */
 	p->next_idx = idx + 1;
 	STORE(&h->head, idx + 1);
 	STORE(&h->written, LOADR(&h->written) + 1);

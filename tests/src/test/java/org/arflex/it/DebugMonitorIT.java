@@ -16,6 +16,8 @@ import java.util.Map;
 import java.util.concurrent.ConcurrentHashMap;
 import java.util.concurrent.atomic.AtomicLong;
 import java.util.concurrent.atomic.AtomicReference;
+import java.util.regex.Matcher;
+import java.util.regex.Pattern;
 import org.junit.jupiter.api.Test;
 
 /**
@@ -236,6 +238,7 @@ class DebugMonitorIT {
                         StatePort m1 = new StatePort(rt.segment("debug-monitor", "m1_last"))) {
                     assertMonitorFollows(rt, rec, m0, m1, 2.0, 5);
                     watch.checkpoint("monitor following (gain 2)");
+                    assertConsoleReadsTheCounter(rt);
 
                     // the engineer retunes the scaler and sees the monitor observe the new scaling
                     assertEquals("sample-scaler.gain = 3.5", rt.cmd("arflex:set sample-scaler gain 3.5"));
@@ -266,6 +269,25 @@ class DebugMonitorIT {
             }
             watch.report();
         }
+    }
+
+    /**
+     * The runtime's own port reader (arflex:port, the DRCR's PortReader in the runtime JVM) reads the
+     * counter's state port as a C producer writes it (port ABI 2.0, DECISIONS.md D30): the seq it shows
+     * lies between two direct reads of the segment around the command, so the JVM, this test's
+     * reader and the RT half agree on the slot layout.
+     */
+    static void assertConsoleReadsTheCounter(Runtime rt) throws IOException {
+        Path seg = rt.segment("sample-counter", "count");
+        Ports.Sample before = Ports.readState(seg);
+        String pv = rt.cmd("arflex:port sample-counter count");
+        Ports.Sample after = Ports.readState(seg);
+        Matcher m = Pattern.compile("(?m)^  seq = (\\d+)\\b").matcher(pv);
+        assertTrue(before != null && after != null && pv.startsWith("sample-counter.count (arflex.Sample")
+                && pv.contains(": element ") && m.find(), pv);
+        long seq = Long.parseLong(m.group(1));
+        assertTrue(before.seq() <= seq && seq <= after.seq(),
+                "console seq " + seq + " not within direct reads " + before.seq() + ".." + after.seq() + ": " + pv);
     }
 
     /** Waits for 3 new windows on m0 and m1; checks each window's min <= mean <= max and range. */

@@ -148,11 +148,15 @@ public final class Layout {
     // ---- port.h
     public static final long PORT_MAGIC = 0x545250584c465241L;
     public static final int PORT_HDR_SIZE = 256;
-    public static final int SLOT_HDR_SIZE = 64;
+    public static final int SLOT_HDR_SIZE = 24;
     public static final int TYPE_NAME_SIZE = 64;
     public static final int STATE_READ_RETRIES = 16;
     public static final int PORT_MAX_ELEM = 67108864;
     public static final int PORT_MAX_DEPTH = 65536;
+    public static final int PORT_ABI_MAJOR = 2;
+    public static final int PORT_ABI_MINOR = 0;
+    public static final int SLOT_ALIGN = 64;
+    public static final int SLOT_INLINE_MAX = 40;
     public static final int PORT_STATE = 1;
     public static final int PORT_STREAM = 2;
     public static final int PORT_FRAME = 3;
@@ -186,7 +190,7 @@ public final class Layout {
     public static final int OFF_PORT_HDR_READER_PID = 216;
 
     // struct arflex_slot_hdr
-    public static final int SIZEOF_SLOT_HDR = 64;
+    public static final int SIZEOF_SLOT_HDR = 24;
     public static final int OFF_SLOT_HDR_SEQ = 0;
     public static final int OFF_SLOT_HDR_STAMP_NS = 8;
     public static final int OFF_SLOT_HDR_LENGTH = 16;

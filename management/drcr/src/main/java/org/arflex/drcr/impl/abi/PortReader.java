@@ -78,6 +78,12 @@ public final class PortReader {
         if ((long) LONGS.getAcquire(b, PortSegment.OFF_MAGIC) != PortSegment.MAGIC) {
             throw new IOException("port segment " + name + ": no port header (magic) yet");
         }
+        int major = Short.toUnsignedInt(b.getShort(PortSegment.OFF_ABI_MAJOR));
+        if (major != PortSegment.ABI_MAJOR) {
+            throw new IOException("port segment " + name + ": port ABI " + major + "."
+                    + Short.toUnsignedInt(b.getShort(PortSegment.OFF_ABI_MINOR)) + ", this reader reads "
+                    + PortSegment.ABI_MAJOR + ".x only (another slot layout: rt-core/docs/ABI.md §4)");
+        }
         long hash = b.getLong(PortSegment.OFF_TYPE_HASH);
         if (hash != PortSegment.typeHash(typeName)) {
             throw new IOException("port segment " + name + ": carries type hash " + Long.toHexString(hash)

@@ -17,7 +17,12 @@ public final class PortSegment implements AutoCloseable {
 
     public static final long MAGIC = Layout.PORT_MAGIC; // "ARFLXPRT"
     public static final int HDR_SIZE = Layout.PORT_HDR_SIZE;
+    /** Port segment layout version (ABI.md §4; 2.0 since DECISIONS.md D30), not the control block's. */
+    public static final int ABI_MAJOR = Layout.PORT_ABI_MAJOR;
+    public static final int ABI_MINOR = Layout.PORT_ABI_MINOR;
+    /** Slot header bytes; the payload follows right after it (ABI 2.0). */
     public static final int SLOT_HDR_SIZE = Layout.SLOT_HDR_SIZE;
+    public static final int SLOT_ALIGN = Layout.SLOT_ALIGN;
     public static final int TYPE_NAME_SIZE = Layout.TYPE_NAME_SIZE;
     public static final int OFF_MAGIC = Layout.OFF_PORT_HDR_MAGIC;
     public static final int OFF_ABI_MAJOR = Layout.OFF_PORT_HDR_ABI_MAJOR;
@@ -68,9 +73,9 @@ public final class PortSegment implements AutoCloseable {
         return h;
     }
 
-    /** Stride of one slot: slot header plus payload, rounded up to 64. */
+    /** Stride of one slot: slot header plus payload, rounded up to 64 (ABI.md §4, one rule for every method). */
     public static int stride(int elemSize) {
-        return (SLOT_HDR_SIZE + elemSize + 63) & ~63;
+        return (SLOT_HDR_SIZE + elemSize + SLOT_ALIGN - 1) & -SLOT_ALIGN;
     }
 
     /** Segment size: header plus depth slots, rounded up to 4096, as arflex_port_segment_size. */
@@ -95,8 +100,8 @@ public final class PortSegment implements AutoCloseable {
         }
         long size = segmentSize(method, elemSize, d);
         ShmSegment s = ShmSegment.create(name, size);
-        s.buffer().putShort(OFF_ABI_MAJOR, (short) ControlBlock.ABI_MAJOR);
-        s.buffer().putShort(OFF_ABI_MINOR, (short) ControlBlock.ABI_MINOR);
+        s.buffer().putShort(OFF_ABI_MAJOR, (short) ABI_MAJOR);
+        s.buffer().putShort(OFF_ABI_MINOR, (short) ABI_MINOR);
         s.putInt(OFF_HEADER_SIZE, HDR_SIZE);
         s.putLong(OFF_SIZE, size);
         s.putInt(OFF_METHOD, method);

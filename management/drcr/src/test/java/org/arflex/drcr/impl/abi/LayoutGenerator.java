@@ -57,6 +57,7 @@ final class LayoutGenerator {
             struct input_count name_hash rejects
             port.h
             const PORT_MAGIC PORT_HDR_SIZE SLOT_HDR_SIZE TYPE_NAME_SIZE STATE_READ_RETRIES PORT_MAX_ELEM PORT_MAX_DEPTH
+            const PORT_ABI_MAJOR PORT_ABI_MINOR SLOT_ALIGN SLOT_INLINE_MAX
             const PORT_STATE PORT_STREAM PORT_FRAME OVERFLOW_NONE OVERFLOW_DROP_OLDEST OVERFLOW_DROP_NEWEST
             struct port_hdr magic abi_major abi_minor header_size size method elem_size depth overflow slot_stride
             struct port_hdr type_major type_minor type_hash type_name head written dropped writer_pid tail delivered lost

@@ -54,6 +54,10 @@ class MailboxPortLayoutTest {
         e.put("ARFLEX_PORT_HDR_SIZE", (long) PortSegment.HDR_SIZE);
         e.put("sizeof(struct arflex_port_hdr)", (long) PortSegment.HDR_SIZE);
         e.put("ARFLEX_SLOT_HDR_SIZE", (long) PortSegment.SLOT_HDR_SIZE);
+        e.put("sizeof(struct arflex_slot_hdr)", (long) PortSegment.SLOT_HDR_SIZE);
+        e.put("ARFLEX_SLOT_ALIGN", (long) PortSegment.SLOT_ALIGN);
+        e.put("ARFLEX_PORT_ABI_MAJOR", (long) PortSegment.ABI_MAJOR);
+        e.put("ARFLEX_PORT_ABI_MINOR", (long) PortSegment.ABI_MINOR);
         e.put("ARFLEX_TYPE_NAME_SIZE", (long) PortSegment.TYPE_NAME_SIZE);
         e.put("offsetof(struct arflex_port_hdr, abi_major)", (long) PortSegment.OFF_ABI_MAJOR);
         e.put("offsetof(struct arflex_port_hdr, abi_minor)", (long) PortSegment.OFF_ABI_MINOR);

@@ -30,7 +30,7 @@ class PortSegmentDamageTest {
             assertTrue(seg.damage().startsWith("magic 0x0000000000000000"), seg.damage());
             seg.segment().putLong(PortSegment.OFF_MAGIC, PortSegment.MAGIC);
             assertNull(seg.damage());
-            seg.segment().putInt(PortSegment.OFF_SLOT_STRIDE, 64);
+            seg.segment().putInt(PortSegment.OFF_SLOT_STRIDE, PortSegment.stride(24) + 64);
             assertTrue(seg.damage().startsWith("geometry overwritten"), seg.damage());
         }
         assertFalse(Files.exists(file), "segment left behind");

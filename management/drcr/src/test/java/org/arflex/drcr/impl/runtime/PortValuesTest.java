@@ -69,6 +69,34 @@ class PortValuesTest {
         }
     }
 
+    /** Port ABI 2.0 (DECISIONS.md D30): the value follows the 24-byte slot header in slot 0's first
+     *  cache line, and a segment of another layout major (a 1.x one had its payload at +64) is refused
+     *  with a message naming both versions, never misread. */
+    @Test
+    void abi2LayoutIsReadAndA1xSegmentIsRefused() throws Exception {
+        assertEquals(2, PortSegment.ABI_MAJOR);
+        assertEquals(24, PortSegment.SLOT_HDR_SIZE);
+        assertEquals(64, PortSegment.stride(40));
+        assertEquals(128, PortSegment.stride(41));
+        String name = "/arflex." + rid + ".src.out.v";
+        try (PortSegment seg = PortSegment.create(name, PortSegment.METHOD_STATE, "arflex.Sample", 1, 0, 24, 1,
+                PortSegment.OVERFLOW_NONE)) {
+            ByteBuffer b = seg.segment().buffer();
+            assertEquals(2, b.getShort(PortSegment.OFF_ABI_MAJOR));
+            assertEquals(0, b.getShort(PortSegment.OFF_ABI_MINOR));
+            assertEquals(64, b.getInt(PortSegment.OFF_SLOT_STRIDE));
+            write(seg, 0, 1, 7, sample(5, 7, 1.5));
+            assertEquals(5, b.getLong(PortSegment.HDR_SIZE + 24), "payload right after the 24-byte slot header");
+            assertEquals(0, PortReader.readNewest(name, "arflex.Sample", 24).index());
+            b.putShort(PortSegment.OFF_ABI_MAJOR, (short) 1);
+            b.putShort(PortSegment.OFF_ABI_MINOR, (short) 2);
+            IOException e = assertThrows(IOException.class, () -> PortReader.readNewest(name, "arflex.Sample", 24));
+            assertTrue(e.getMessage().contains("port ABI 1.2") && e.getMessage().contains("reads 2.x"), e.getMessage());
+            b.putShort(PortSegment.OFF_ABI_MAJOR, (short) 3);
+            assertThrows(IOException.class, () -> PortReader.readNewest(name, "arflex.Sample", 24));
+        }
+    }
+
     @Test
     void streamIsPeekedAtTheNewestSlotNeverConsumed() throws Exception {
         String name = "/arflex." + rid + ".src.out.s";
