@@ -10,7 +10,7 @@ package org.arflex.drcr.impl.abi;
  * {@code OFF_<S>_<M>} is {@code offsetof(struct arflex_<s>, <m>)} (a nested member's {@code .}
  * as {@code _}), {@code SIZEOF_<S>} is {@code sizeof(struct arflex_<s>)}, any other name
  * {@code N} is the value of {@code ARFLEX_<N>}. LayoutTest fails when this file is not what
- * the headers give; scripts/layout.env holds the same names and values.
+ * the headers give.
  */
 public final class Layout {
 

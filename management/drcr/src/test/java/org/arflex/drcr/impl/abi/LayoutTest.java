@@ -15,8 +15,8 @@ import java.util.stream.Stream;
 import org.junit.jupiter.api.Test;
 
 /**
- * {@link Layout} and scripts/layout.env are what rt-core's headers give now (LayoutGenerator).
- * With {@code -Darflex.layout.write=true} the test writes them instead (DECISIONS.md D22).
+ * {@link Layout} is what rt-core's headers give now (LayoutGenerator). With
+ * {@code -Darflex.layout.write=true} the test writes it instead (DECISIONS.md D22).
  */
 class LayoutTest {
 
