@@ -122,6 +122,12 @@ class StressBench {
             }
 
             System.out.printf(Locale.ROOT, "stress: %s%n", String.join("; ", notes));
+            // why anything stopped, from the runtime's own log: its stalls and the halves' safe modes
+            rt.logSince(mark).stream()
+                    .filter(l -> !l.contains("g! ") && (l.contains("silent for") || l.contains("answered after")
+                            || l.contains("safe mode") || l.contains("heartbeat") || l.contains("reset")
+                            || l.contains("protective stop")))
+                    .limit(40).forEach(l -> System.out.println("stress: log " + l));
             System.out.printf(Locale.ROOT, "stress: %-40s %d%n", "seconds under stress-ng", windows);
             System.out.printf(Locale.ROOT, "stress: %-40s %d%n", "seconds with the arm still", stillWindows);
             System.out.printf(Locale.ROOT, "stress: %-40s %d%n", "safe-hook cycles (all components)", safeCycles);
