@@ -203,7 +203,9 @@ class CellIT {
             rt.awaitState("INSTALLED", T, "sample-counter");
             assertEquals(0L, rt.pid("sample-counter"));
             assertTrue(Runtime.rtProcesses(rt.rid).isEmpty());
-            assertTrue(rt.shmObjects().isEmpty(), rt.shmObjects().toString());
+            // the output segment goes once the actor has recorded the stop (Felix's stop returns
+            // when the consumers are safe, a moment before)
+            rt.waitUntil("the segments removed", T, () -> rt.shmObjects().isEmpty());
             assertEquals("", rt.cmd("start " + id));
             rt.awaitState("ACTIVE", T, "sample-counter");
             assertNotEquals(pid, rt.pid("sample-counter"));

@@ -135,8 +135,10 @@ public final class Activator implements BundleActivator {
             t.setDaemon(true);
             return t;
         });
-        // ... and spawned and awaited until READY here (a simulator loads its model meanwhile)
-        launches = Executors.newCachedThreadPool(r -> {
+        // ... and spawned and awaited until READY here (a simulator loads its model meanwhile),
+        // one at a time: halves that load models, renderers and detectors all at once starve the
+        // running ones on a small machine (D33)
+        launches = Executors.newSingleThreadExecutor(r -> {
             Thread t = new Thread(r, "arflex-drcr-launch");
             t.setDaemon(true);
             return t;
