@@ -237,9 +237,16 @@ class MainJobIT {
             }
             assertTrue(header >= 0, "no arflex:list output");
             List<String> table = out.subList(header, out.size());
+            // what the runtime and the halves said about stalls, safe modes and lost inputs
+            // (the cause of a component that is not ACTIVE, when it happened early)
+            String why = out.stream().filter(l -> l.contains("safe mode") || l.contains("silent for")
+                    || l.contains("answered after") || l.contains("hung") || l.contains("lost")
+                    || l.contains("overran") || l.contains("reset")).limit(60)
+                    .collect(java.util.stream.Collectors.joining("\n"));
             for (String name : CellE2EIT.CELL) {
                 assertTrue(table.stream().anyMatch(l -> l.matches(".*\\b" + Pattern.quote(name) + "\\s+ACTIVE\\b.*")),
-                        name + " not ACTIVE in the last arflex:list:\n" + String.join("\n", table));
+                        name + " not ACTIVE in the last arflex:list:\n" + String.join("\n", table) + "\n--- from its output:\n"
+                                + why);
             }
             // Readiness from the DRCR, not from the log: the console's arflex:await answered for
             // vision (before its settings) and for the whole cell (before the first arflex:list).
