@@ -3,8 +3,8 @@ C++ agree with the cell model (docs/DECISIONS.md D24, D31).
 
   check_copies.py <arflex-cellmodel> <NominalArm.java>...
 
-The chain constants (OFFSETS, AXES, TCP) of each NominalArm.java (the integration tests'
-TRUE-error reference, and the DRCR's for `arflex:summary`) are compared with
+The chain constants (OFFSETS, AXES, TCP) of each NominalArm.java (the DRCR's, for
+`arflex:summary` and the integration tests' TRUE-error reference) are compared with
 `arflex-cellmodel chain`. The DRCR's copy is also run, by its unit test CellSummaryTest, at
 five poses against values `arflex-cellmodel fk` printed.
 """

@@ -216,7 +216,7 @@ final class CellRig {
         CellPorts.Joints r = CellPorts.Joints.of(ref.read(), false);
         org.junit.jupiter.api.Assertions.assertNotNull(t, "no ground truth");
         org.junit.jupiter.api.Assertions.assertNotNull(r, "no reference");
-        return 1e3 * NominalArm.distance(t.p(), NominalArm.tcp(r.q()));
+        return 1e3 * org.arflex.drcr.impl.shell.NominalArm.distance(t.p(), org.arflex.drcr.impl.shell.NominalArm.tcp(r.q()));
     }
 
     /** The cell's ports the accuracy measurements read (mapped read-only). */

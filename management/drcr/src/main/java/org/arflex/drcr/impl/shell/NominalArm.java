@@ -5,9 +5,9 @@ package org.arflex.drcr.impl.shell;
  * joints about z, y, y, x, y, x; each body's offset in its parent's frame at q = 0, where every
  * frame is aligned with the world; the tool centre point 0.30 m along the flange's x axis. The
  * summary's TRUE TCP error is the distance of the true TCP from this model at the program's
- * reference (the accuracy benchmark's definition).
+ * reference (the accuracy benchmark's definition). The integration tests use this one too.
  */
-final class NominalArm {
+public final class NominalArm {
 
     private static final double[][] OFFSETS = {
         {0, 0, 0}, {0.35, 0, 0.675}, {0, 0, 1.15}, {0.50, 0, 0.041}, {0.70, 0, 0}, {0.215, 0, 0}};
@@ -18,7 +18,7 @@ final class NominalArm {
     }
 
     /** The nominal TCP position (m, world frame) at joint angles {@code q} (rad, 6 of them). */
-    static double[] tcp(double[] q) {
+    public static double[] tcp(double[] q) {
         double[][] r = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
         double[] p = {0, 0, 0};
         for (int j = 0; j < AXES.length; j++) {
@@ -26,6 +26,11 @@ final class NominalArm {
             r = times(r, rotation(AXES[j], q[j]));
         }
         return plus(p, times(r, TCP));
+    }
+
+    /** The distance (m) between two points. */
+    public static double distance(double[] a, double[] b) {
+        return Math.sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
     }
 
     private static double[][] rotation(char axis, double angle) {
