@@ -1,5 +1,5 @@
 // force-guard - RT half of the force-guard component (README.md): watches the joint torques
-// and the wrist wrench against the nominal model; above a threshold it puts the cell in a
+// and the wrist wrench against the nominal model's inverse dynamics (cellkin::ContactMonitor); above a threshold it puts the cell in a
 // protective stop in the same cycle and keeps it there until an operator reset.
 //
 // Ports: in joint_state (arflex.JointState), in wrench (arflex.Wrench), out safety
@@ -29,6 +29,7 @@ using arflex::cellkin::Q;
 
 struct State {
   arflex::cellkin::Model model;
+  arflex::cellkin::ContactMonitor monitor{&model};
   struct arflex_port* out = nullptr;
   struct arflex_input* in_js = nullptr;
   struct arflex_input* in_w = nullptr;
@@ -81,6 +82,7 @@ int Configure(struct arflex_component* c, void*) {
 
 int Start(struct arflex_component* c, void*) {
   g.have_js = g.have_w = false;
+  g.monitor.Reset();
   g.reset_prev = arflex_param_bool(c, g.p_reset);
   // A restarted guard that was latched stays latched: rt-core keeps RESET_REQUIRED.
   g.latched = (arflex_component_ctl(c)->flags & ARFLEX_FLAG_RESET_REQUIRED) != 0;
@@ -117,33 +119,40 @@ bool ResetEdge(struct arflex_component* c) {
 }
 
 // Measures the external joint torques and the contact force (sets g.force_norm) against the
-// limits; returns the reason bits of what is above a limit (0 = nothing).
+// limits, widened while the arm accelerates by the monitor's allowance for what the rigid
+// nominal model cannot know (cellkin.h, ContactMonitor); returns the reason bits of what is
+// above a limit (0 = nothing).
 uint32_t Measure(struct arflex_component* c) {
   const double payload = arflex_param_f64(c, g.p_payload);
   uint32_t reason = 0;
-  Q q;
   if (g.have_js) {
-    Q tau;
+    Q q, qd, tau;
     for (int j = 0; j < 6; ++j) {
       q[j] = g.js.q[j];
+      qd[j] = g.js.qd[j];
       tau[j] = g.js.tau[j];
     }
-    const Q ext = tau - g.model.GravityTorque(q, payload);
-    if (ext.cwiseAbs().maxCoeff() > arflex_param_f64(c, g.p_torque))
-      reason |= ARFLEX_SAFETY_STATE_FLAG_FORCE_LIMIT;
+    g.monitor.Update(g.js.t_ns, q, qd, tau, payload);
+    const Q over = g.monitor.external_torque().cwiseAbs() - g.monitor.torque_allowance();
+    if (over.maxCoeff() > arflex_param_f64(c, g.p_torque)) reason |= ARFLEX_SAFETY_STATE_FLAG_FORCE_LIMIT;
+  } else {
+    g.monitor.Reset();
   }
   g.force_norm = 0;
+  double allowance = 0;
   if (g.have_w) {
     const Eigen::Vector3d f(g.w.force[0], g.w.force[1], g.w.force[2]);
     if (g.have_js) {
-      g.force_norm = g.model.ContactForceWorld(q, f, payload).norm();
+      g.force_norm = g.monitor.ContactForce(f, payload).norm();
+      allowance = g.monitor.force_allowance();
     } else {
       // No joint angles: the tool's weight direction is unknown; the contact force is at
       // least | |F| - weight |.
       const double weight = (g.model.arm().tool_mass + payload) * arflex::cellkin::kGravity;
       g.force_norm = std::fabs(f.norm() - weight);
     }
-    if (g.force_norm > arflex_param_f64(c, g.p_force)) reason |= ARFLEX_SAFETY_STATE_FLAG_FORCE_LIMIT;
+    if (g.force_norm - allowance > arflex_param_f64(c, g.p_force))
+      reason |= ARFLEX_SAFETY_STATE_FLAG_FORCE_LIMIT;
   }
   return reason;
 }

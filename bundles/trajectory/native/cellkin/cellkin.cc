@@ -115,6 +115,66 @@ Q Model::GravityTorque(const Q& q, double payload_kg) const {
   return tau;
 }
 
+Q Model::InverseDynamics(const Q& q, const Q& qd, const Q& qdd, double payload_kg,
+                         Eigen::Vector3d* tool_accel) const {
+  // Forward pass in the world frame. Body i turns about axis z[i] through its origin p[i];
+  // the base "accelerates" upwards at g, which adds gravity to every body at once.
+  Eigen::Vector3d z[6], p[6], c[6], w[6], al[6], ap[6], ac[6];
+  Eigen::Matrix3d rot[6];
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  Eigen::Vector3d w_prev = Eigen::Vector3d::Zero(), al_prev = Eigen::Vector3d::Zero();
+  Eigen::Vector3d a_prev(0, 0, kGravity), p_prev = Eigen::Vector3d::Zero();
+  for (int i = 0; i < 6; ++i) {
+    const cellmodel::LinkParams& l = arm_.links[i];
+    const Eigen::Vector3d a = V3(l.axis).normalized();
+    t = t * Eigen::Translation3d(V3(l.offset)) * Eigen::AngleAxisd(q[i], a);
+    rot[i] = t.linear();
+    p[i] = t.translation();
+    z[i] = rot[i] * a;
+    c[i] = t * V3(l.com);
+    const Eigen::Vector3d r = p[i] - p_prev;  // the joint's origin rides on the parent
+    ap[i] = a_prev + al_prev.cross(r) + w_prev.cross(w_prev.cross(r));
+    w[i] = w_prev + z[i] * qd[i];
+    al[i] = al_prev + z[i] * qdd[i] + w_prev.cross(z[i] * qd[i]);
+    const Eigen::Vector3d rc = c[i] - p[i];
+    ac[i] = ap[i] + al[i].cross(rc) + w[i].cross(w[i].cross(rc));
+    w_prev = w[i];
+    al_prev = al[i];
+    a_prev = ap[i];
+    p_prev = p[i];
+  }
+  // The tool and the payload: point masses on the last body.
+  const Eigen::Vector3d tool_c = t * V3(arm_.tool_com);
+  const Eigen::Vector3d pay_c = t * V3(arm_.payload_com);
+  auto point_accel = [&](const Eigen::Vector3d& pt) {
+    const Eigen::Vector3d r = pt - p[5];
+    return Eigen::Vector3d(ap[5] + al[5].cross(r) + w[5].cross(w[5].cross(r)));
+  };
+  const Eigen::Vector3d a_tool = point_accel(tool_c), a_pay = point_accel(pay_c);
+  if (tool_accel) *tool_accel = a_tool - Eigen::Vector3d(0, 0, kGravity);
+  // Backward pass: force f and moment n (about p[i]) that body i-1 exerts on body i.
+  Eigen::Vector3d f_next = Eigen::Vector3d::Zero(), n_next = Eigen::Vector3d::Zero();
+  Q tau;
+  for (int i = 5; i >= 0; --i) {
+    const cellmodel::LinkParams& l = arm_.links[i];
+    const Eigen::Matrix3d inertia = rot[i] * V3(l.inertia).asDiagonal() * rot[i].transpose();
+    Eigen::Vector3d f = l.mass * ac[i];
+    Eigen::Vector3d n = inertia * al[i] + w[i].cross(inertia * w[i]) + (c[i] - p[i]).cross(f);
+    if (i == 5) {
+      const Eigen::Vector3d ft = arm_.tool_mass * a_tool, fp = payload_kg * a_pay;
+      n += (tool_c - p[5]).cross(ft) + (pay_c - p[5]).cross(fp);
+      f += ft + fp;
+    } else {
+      n += n_next + (p[i + 1] - p[i]).cross(f_next);
+      f += f_next;
+    }
+    tau[i] = z[i].dot(n) + l.armature * qdd[i] + l.damping * qd[i];
+    f_next = f;
+    n_next = n;
+  }
+  return tau;
+}
+
 void Model::ToolWeightWrench(const Q& q, double payload_kg, Eigen::Vector3d* f,
                              Eigen::Vector3d* tq) const {
   const Eigen::Matrix3d r = Flange(q).linear();
@@ -134,6 +194,42 @@ Eigen::Vector3d Model::ContactForceWorld(const Q& q, const Eigen::Vector3d& f_se
   // Tool at rest: F_arm + F_contact + m g = 0 and F_arm(no contact) = -m g, so
   // F_contact = -(F_arm - F_arm(no contact)).
   return -(Flange(q).linear() * (f_sensor - f0));
+}
+
+Eigen::Vector3d Model::ContactForceWorld(const Q& q, const Eigen::Vector3d& f_sensor,
+                                         double payload_kg,
+                                         const Eigen::Vector3d& tool_accel) const {
+  // F_arm + F_contact + m g = m a, so F_contact = -(F_arm - m (a - g)): the static case
+  // above plus the force that accelerates the tool.
+  return ContactForceWorld(q, f_sensor, payload_kg) +
+         (arm_.tool_mass + payload_kg) * tool_accel;
+}
+
+bool ContactMonitor::Update(int64_t t_ns, const Q& q, const Q& qd, const Q& tau,
+                            double payload_kg) {
+  if (have_prev_ && t_ns == t_prev_) return false;
+  const double dt = have_prev_ ? (t_ns - t_prev_) * 1e-9 : 0.0;
+  const bool diff = have_prev_ && dt > 0 && dt <= kMaxGap;
+  const Q qdd = diff ? Q((qd - qd_prev_) / dt) : Q::Zero();
+  const double decay = dt > 0 ? std::exp(-dt / kHoldTau) : 1.0;
+  const Q moving = model_->InverseDynamics(q, qd, Q::Zero(), payload_kg);
+  const Q full = model_->InverseDynamics(q, qd, qdd, payload_kg, &a_tool_);
+  if (!diff) a_tool_.setZero();
+  ext_ = tau - full;
+  const Q inertial = (full - moving).cwiseAbs() * kInertialShare;
+  hold_t_ = (hold_t_ * decay).cwiseMax(inertial);
+  const double m = model_->arm().tool_mass + payload_kg;
+  hold_f_ = std::max(hold_f_ * decay, kInertialShare * m * a_tool_.norm());
+  q_ = q;
+  qd_prev_ = qd;
+  t_prev_ = t_ns;
+  have_prev_ = true;
+  return true;
+}
+
+Eigen::Vector3d ContactMonitor::ContactForce(const Eigen::Vector3d& f_sensor,
+                                             double payload_kg) const {
+  return model_->ContactForceWorld(q_, f_sensor, payload_kg, a_tool_);
 }
 
 // ---- programs -----------------------------------------------------------------------------

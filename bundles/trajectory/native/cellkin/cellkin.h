@@ -55,6 +55,16 @@ class Model {
   // payload_com. Same sign convention as the measured drive torques of arflex.JointState.
   Q GravityTorque(const Q& q, double payload_kg) const;
 
+  // Joint torques (N m) the drives deliver to move the arm with velocities qd (rad/s) and
+  // accelerations qdd (rad/s^2) at q, with nothing touching it: the nominal rigid-body
+  // inverse dynamics (recursive Newton-Euler in the world frame: link inertias, tool and
+  // payload as point masses as in GravityTorque, Coriolis and centripetal terms, gravity)
+  // plus each drive's reflected rotor inertia (armature * qdd) and viscous friction
+  // (damping * qd). Equals GravityTorque when qd and qdd are zero. When `tool_accel` is not null it receives the acceleration (m/s^2,
+  // world, gravity not included) of the tool's centre of mass.
+  Q InverseDynamics(const Q& q, const Q& qd, const Q& qdd, double payload_kg,
+                    Eigen::Vector3d* tool_accel = nullptr) const;
+
   // Force (N) and torque (N m) in the flange frame that the wrist sensor reads with the tool
   // and a payload at rest and nothing else touching them (the arm holds them up).
   void ToolWeightWrench(const Q& q, double payload_kg, Eigen::Vector3d* f,
@@ -65,6 +75,12 @@ class Model {
   // simulator's sensor reports it) minus the tool weight, rotated to the world, sign flipped.
   Eigen::Vector3d ContactForceWorld(const Q& q, const Eigen::Vector3d& f_sensor,
                                     double payload_kg) const;
+  // The same for a tool that accelerates: `tool_accel` (m/s^2, world, from InverseDynamics)
+  // is the acceleration of the tool's centre of mass; the force the arm spends on it,
+  // (tool mass + payload) * tool_accel, is not contact either. Tool and payload are taken as
+  // one rigid point mass at the tool's centre of mass for this term.
+  Eigen::Vector3d ContactForceWorld(const Q& q, const Eigen::Vector3d& f_sensor,
+                                    double payload_kg, const Eigen::Vector3d& tool_accel) const;
 
   const cellmodel::ArmParams& arm() const { return arm_; }
   double lower(int j) const { return arm_.links[j].lower; }
@@ -73,6 +89,52 @@ class Model {
  private:
   cellmodel::ArmParams arm_;
   cellmodel::NominalKinematics kin_;
+};
+
+// ---- contact monitoring (force-guard) ------------------------------------------------------
+//
+// What a moving arm's drives and wrist sensor report beyond the nominal model: the external
+// joint torques (measured minus InverseDynamics) and the contact force at the tool (wrist
+// force minus the tool's weight and the force that accelerates it). The joint accelerations
+// are differenced from the velocities of consecutive measurements.
+//
+// The nominal model is rigid; the real (and the simulated TRUE) arm has compliant gears. A
+// fast deceleration (the 20 ms controlled stop) rings the gear springs, and for a few tens of
+// milliseconds the residual is a large fraction of the inertial load itself (measured on the
+// TRUE model, cell.sim.conventions). So the limits are widened by a share of the inertial
+// load the model accounts for: allowance = kInertialShare * the peak of |inertial torque|
+// (per joint) or of |tool mass * tool acceleration|, held and decaying with kHoldTau, the
+// gear ringing's decay. At rest or at constant speed the allowance is zero and the limits
+// are exactly the configured ones. Pure computation, no allocation.
+class ContactMonitor {
+ public:
+  static constexpr double kInertialShare = 1.0;
+  static constexpr double kHoldTau = 0.030;  // s
+  static constexpr double kMaxGap = 0.020;   // s: a longer gap between samples restarts the
+                                             // differencing (no acceleration estimate)
+
+  explicit ContactMonitor(const Model* model) : model_(model) {}
+  void Reset() { have_prev_ = false; hold_t_ = Q::Zero(); hold_f_ = 0; }
+
+  // One joint measurement (t_ns: its time; a repeated t_ns is ignored and returns false).
+  bool Update(int64_t t_ns, const Q& q, const Q& qd, const Q& tau, double payload_kg);
+
+  // After Update: external joint torques and the torque allowance per joint (N m).
+  const Q& external_torque() const { return ext_; }
+  const Q& torque_allowance() const { return hold_t_; }
+  // Contact force (N, world) from a wrist force `f_sensor` (flange frame) at the last
+  // update's pose and acceleration, and the allowance for it (N).
+  Eigen::Vector3d ContactForce(const Eigen::Vector3d& f_sensor, double payload_kg) const;
+  double force_allowance() const { return hold_f_; }
+  bool ready() const { return have_prev_; }
+
+ private:
+  const Model* model_;
+  bool have_prev_ = false;
+  int64_t t_prev_ = 0;
+  Q qd_prev_ = Q::Zero(), q_ = Q::Zero(), ext_ = Q::Zero(), hold_t_ = Q::Zero();
+  Eigen::Vector3d a_tool_ = Eigen::Vector3d::Zero();
+  double hold_f_ = 0;
 };
 
 // ---- program files ----------------------------------------------------------------------

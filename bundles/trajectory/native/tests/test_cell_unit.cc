@@ -449,14 +449,74 @@ static void TestTool() {
          cycles);
 }
 
+// InverseDynamics against independent derivations: at rest it is GravityTorque; its inertial
+// part (the mass matrix, column by column) is symmetric and positive definite; its velocity
+// terms match Lagrange's equations with the kinetic energy 1/2 qd' M(q) qd differentiated
+// numerically; the tool's acceleration matches the Jacobian of the tool's centre of mass.
+static Eigen::Matrix<double, 6, 6> MassMatrix(const Model& m, const Q& q, double payload) {
+  Eigen::Matrix<double, 6, 6> mm;
+  const Q g = m.GravityTorque(q, payload);
+  for (int j = 0; j < 6; ++j) mm.col(j) = m.InverseDynamics(q, Q::Zero(), Q::Unit(j), payload) - g;
+  return mm;
+}
+
+static void TestDynamics() {
+  Model m;
+  const double payload = 40;
+  Q q, qd, qdd;
+  q << 0.3, -0.4, 0.9, -0.6, 0.7, 0.2;
+  qd << 0.5, -0.3, 0.8, 1.1, -0.9, 1.5;
+  qdd << 2.0, -1.5, 3.0, -4.0, 5.0, -6.0;
+  const Q g = m.GravityTorque(q, payload);
+  const double rest = (m.InverseDynamics(q, Q::Zero(), Q::Zero(), payload) - g).cwiseAbs().maxCoeff();
+  CHECK(rest < 1e-9, "at rest: inverse dynamics differs from GravityTorque by %g N m", rest);
+  const Eigen::Matrix<double, 6, 6> mm = MassMatrix(m, q, payload);
+  const double asym = (mm - mm.transpose()).cwiseAbs().maxCoeff();
+  CHECK(asym < 1e-9 * mm.cwiseAbs().maxCoeff(), "mass matrix not symmetric: %g", asym);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eig(mm);
+  CHECK(eig.eigenvalues().minCoeff() > 0, "mass matrix not positive definite: %g",
+        eig.eigenvalues().minCoeff());
+  for (int j = 0; j < 6; ++j)
+    CHECK(mm(j, j) > m.arm().links[j].armature, "M(%d,%d) %.1f does not hold the armature", j, j,
+          mm(j, j));
+  // Lagrange: tau = M qdd + dM/dt qd - dT/dq + g, with T = 1/2 qd' M qd.
+  const double h = 1e-6;
+  auto kinetic = [&](const Q& qq) { return 0.5 * qd.dot(MassMatrix(m, qq, payload) * qd); };
+  const Eigen::Matrix<double, 6, 6> mdot =
+      (MassMatrix(m, q + h * qd, payload) - MassMatrix(m, q - h * qd, payload)) / (2 * h);
+  Q dtdq;
+  for (int i = 0; i < 6; ++i)
+    dtdq[i] = (kinetic(q + h * Q::Unit(i)) - kinetic(q - h * Q::Unit(i))) / (2 * h);
+  Q friction;
+  for (int i = 0; i < 6; ++i) friction[i] = m.arm().links[i].damping * qd[i];
+  const Q lagrange = mm * qdd + mdot * qd - dtdq + g + friction;
+  Eigen::Vector3d a_tool;
+  const Q rne = m.InverseDynamics(q, qd, qdd, payload, &a_tool);
+  const double err = (rne - lagrange).cwiseAbs().maxCoeff();
+  CHECK(err < 1e-4 * lagrange.cwiseAbs().maxCoeff(),
+        "Newton-Euler and Lagrange differ by %g N m (torques up to %.0f N m)", err,
+        lagrange.cwiseAbs().maxCoeff());
+  // The tool's centre of mass: a = J qdd + dJ/dt qd (numerically along the motion).
+  Eigen::Isometry3d com = Eigen::Isometry3d::Identity();
+  com.translation() = Eigen::Vector3d(m.arm().tool_com[0], m.arm().tool_com[1], m.arm().tool_com[2]);
+  auto lin = [&](const Q& qq) { return Eigen::Matrix<double, 3, 6>(m.JacobianOf(qq, com).topRows<3>()); };
+  const Eigen::Matrix<double, 3, 6> jdot = (lin(q + h * qd) - lin(q - h * qd)) / (2 * h);
+  const Eigen::Vector3d want = lin(q) * qdd + jdot * qd;
+  CHECK((a_tool - want).norm() < 1e-4 * want.norm(), "tool acceleration (%.3f %.3f %.3f) want (%.3f %.3f %.3f)",
+        a_tool.x(), a_tool.y(), a_tool.z(), want.x(), want.y(), want.z());
+  printf("dynamics: M diag %.0f..%.0f kg m^2, Newton-Euler vs Lagrange %.2e N m, tool accel %.2e m/s^2\n",
+         mm.diagonal().minCoeff(), mm.diagonal().maxCoeff(), err, (a_tool - want).norm());
+}
+
 int main(int argc, char** argv) {
   if (argc != 2) {
-    fprintf(stderr, "usage: %s <kinematics|program|trajectory_limits|trajectory_pause|trajectory_via|trajectory_loop|builtin|tool>\n",
+    fprintf(stderr, "usage: %s <kinematics|dynamics|program|trajectory_limits|trajectory_pause|trajectory_via|trajectory_loop|builtin|tool>\n",
             argv[0]);
     return 2;
   }
   const std::string c = argv[1];
   if (c == "kinematics") TestKinematics();
+  else if (c == "dynamics") TestDynamics();
   else if (c == "program") TestProgram();
   else if (c == "trajectory_limits") TestTrajectoryLimits();
   else if (c == "trajectory_pause") TestTrajectoryPause();
