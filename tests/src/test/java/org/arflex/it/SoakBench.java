@@ -45,6 +45,8 @@ class SoakBench {
     private static final long T = 60_000;
 
     private final List<Double> detections = Collections.synchronizedList(new ArrayList<>());
+    /** From the exit seen (reaper thread) to the actor's handling of it, as the DRCR's line says. */
+    private final List<Double> handlings = Collections.synchronizedList(new ArrayList<>());
     private final List<long[]> samples = Collections.synchronizedList(new ArrayList<>()); // cycles, heapKB, threads, fds, shm, mq, procs
     private final AtomicInteger cycles = new AtomicInteger();
     private volatile long maxShellMs;
@@ -175,11 +177,30 @@ class SoakBench {
         if (!Signals.tryToSend(pid, "9")) {
             return false; // it went away by itself (an uninstall) in between
         }
-        double d = FaultBench.detection(rt, mark, at, name + " (pid " + pid + ") ");
+        String who = name + " (pid " + pid + ") ";
+        double d = FaultBench.detection(rt, mark, at, who);
         if (d >= 0) {
             detections.add(d);
         }
+        double h = handled(rt, mark, who);
+        if (h >= 0) {
+            handlings.add(h);
+        }
         return true;
+    }
+
+    /** The actor's "(handled X ms after the exit was seen)" for @who, or -1 (not within 10 s). */
+    private static double handled(Runtime rt, int mark, String who) {
+        Pattern p = Pattern.compile("\\(handled ([0-9.]+) ms after the exit was seen\\)");
+        double[] ms = {-1};
+        try {
+            rt.waitUntil("the DRCR's handling of " + who, 10_000, () -> rt.logSince(mark).stream()
+                    .filter(l -> l.contains(who)).map(p::matcher).filter(Matcher::find).findFirst()
+                    .map(m -> ms[0] = Double.parseDouble(m.group(1))).isPresent());
+        } catch (AssertionError e) {
+            return -1;
+        }
+        return ms[0];
     }
 
     private static CellChurnBench.Snap snap(Runtime rt) {
@@ -252,6 +273,8 @@ class SoakBench {
             throws Exception {
         List<Double> d = new ArrayList<>(detections);
         Collections.sort(d);
+        List<Double> h = new ArrayList<>(handlings);
+        Collections.sort(h);
         double slope = slopeKbPer1000(samples);
         long[] first = samples.get(0);
         long[] last = samples.get(samples.size() - 1);
@@ -264,6 +287,8 @@ class SoakBench {
                 us(quiet.quantileUs(0.99)), quiet.overruns, us(busy.quantileUs(0.99)), busy.overruns);
         System.out.printf(Locale.ROOT, "soak: exit detection     p50 %s ms, p99 %s ms, max %s ms (%d kills)%n", ms(pct(d, 50)),
                 ms(pct(d, 99)), ms(d.isEmpty() ? Double.NaN : d.get(d.size() - 1)), d.size());
+        System.out.printf(Locale.ROOT, "soak: exit handled after p50 %s ms, p99 %s ms, max %s ms (the actor's queue)%n",
+                ms(pct(h, 50)), ms(pct(h, 99)), ms(h.isEmpty() ? Double.NaN : h.get(h.size() - 1)));
         System.out.printf(Locale.ROOT, "soak: shell round trip   max %d ms (arflex:list behind the workers' Felix commands)%n",
                 maxShellMs);
         StringBuilder js = new StringBuilder();
@@ -276,8 +301,8 @@ class SoakBench {
         Files.createDirectories(out.toAbsolutePath().getParent());
         Files.writeString(out, String.format(Locale.ROOT,
                 "{\"cycles\":%d,\"kills\":%d,\"heap_slope_kb_per_1000\":%s,\"leaks\":%d,\"max_supervision_stall_ms\":%d,"
-                        + "\"detect_ms\":{\"p50\":%s,\"p99\":%s},\"quiet\":%s,\"churn\":%s,\"samples\":[%s]}%n",
-                cycles.get(), killed, num(slope), leaks, maxStallMs, maxShellMs, num(pct(d, 50)), num(pct(d, 99)), quiet.json(), busy.json(), js));
+                        + "\"max_shell_ms\":%d,\"detect_ms\":{\"p50\":%s,\"p99\":%s},\"handled_ms\":{\"p50\":%s,\"p99\":%s},\"quiet\":%s,\"churn\":%s,\"samples\":[%s]}%n",
+                cycles.get(), killed, num(slope), leaks, maxStallMs, maxShellMs, num(pct(d, 50)), num(pct(d, 99)), num(pct(h, 50)), num(pct(h, 99)), quiet.json(), busy.json(), js));
         System.out.println("JSON: " + out.toAbsolutePath());
         System.out.printf(Locale.ROOT, "soak: %d cycles, %d kills, heap slope %.0f KB/1000 cycles, leaks %d, max supervision stall %d ms%n",
                 cycles.get(), killed, slope, leaks, maxStallMs);

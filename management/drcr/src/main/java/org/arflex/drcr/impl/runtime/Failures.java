@@ -52,7 +52,8 @@ final class Failures {
         inst.cpu = -1;
         String what = inst.hangReason != null ? inst.hangReason : exit.description();
         inst.hangReason = null;
-        log.accept("arflex: " + inst.name + " (pid " + half.pid() + ") " + what);
+        log.accept(String.format(java.util.Locale.ROOT, "arflex: %s (pid %d) %s (handled %.1f ms after the exit was seen)",
+                inst.name, half.pid(), what, (System.nanoTime() - exit.seenNanos()) / 1e6));
         OutputRepair.dropDamaged(inst.name, inst.outputs, log);
         failed(inst, exit.abnormal(), "RT half " + what);
         cell.changed();

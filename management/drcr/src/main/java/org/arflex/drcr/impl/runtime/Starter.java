@@ -203,7 +203,13 @@ final class Starter {
         inst.everStarted = true;
         inst.life.to(State.ACTIVE, inst.awaitingReset ? "restarted: waits for an operator reset before motion" : null);
         RtHalf h = half;
-        half.exit().thenAccept(ex -> actor.submit(() -> failures.onExit(inst, h, ex)));
+        String who = inst.name + " (pid " + half.pid() + ")";
+        half.exit().thenAccept(ex -> {
+            if (!ex.requested()) { // seen now, on the reaper thread; the actor handles it next
+                log.accept("arflex: " + who + " exit seen: " + ex.description());
+            }
+            actor.submit(() -> failures.onExit(inst, h, ex));
+        });
         monitor.watch(inst.name, half, c.fault().heartbeatTimeoutMs(), cfg.monotonicNs().getAsLong(),
                 OutputRepair.probe(inst.name, inst.outputs));
         long t1 = cfg.monotonicNs().getAsLong();

@@ -193,13 +193,15 @@ public final class ProcessLauncher implements RtLauncher {
 
     /** Describes an exit status as the JVM reports it (128+n for signal n). */
     static RtHalf.Exit describe(int status, boolean requested) {
+        long seen = System.nanoTime();
         if (status > 128 && status < 160) {
-            return new RtHalf.Exit(status, true, "killed by signal " + (status - 128));
+            return new RtHalf.Exit(status, true, "killed by signal " + (status - 128), requested, seen);
         }
         if (status == 0) {
-            return new RtHalf.Exit(0, false, requested ? "exited normally after SHUTDOWN" : "exited with status 0");
+            return new RtHalf.Exit(0, false, requested ? "exited normally after SHUTDOWN" : "exited with status 0",
+                    requested, seen);
         }
-        return new RtHalf.Exit(status, true, "exited with status " + status);
+        return new RtHalf.Exit(status, true, "exited with status " + status, requested, seen);
     }
 
     static final class ProcessRtHalf implements RtHalf {

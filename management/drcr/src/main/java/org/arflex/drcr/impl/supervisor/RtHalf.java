@@ -126,7 +126,15 @@ public interface RtHalf {
     /** Removes the control block and the queues (after the exit). Idempotent. */
     void cleanup();
 
-    /** How a process ended. */
-    record Exit(int status, boolean abnormal, String description) {
+    /**
+     * How a process ended. {@code requested}: the supervisor had asked it to stop (SHUTDOWN,
+     * then KILL after the deadline); {@code seenNanos}: System.nanoTime() when the exit was
+     * seen (on the JDK's reaper thread, which waits in waitpid: the kernel's notice, no
+     * polling period).
+     */
+    record Exit(int status, boolean abnormal, String description, boolean requested, long seenNanos) {
+        public Exit(int status, boolean abnormal, String description) {
+            this(status, abnormal, description, false, System.nanoTime());
+        }
     }
 }

@@ -60,8 +60,8 @@ class ThreadActorTest {
             }
         });
         assertTrue(blocking.await(10, TimeUnit.SECONDS));
-        long queued = System.nanoTime();
         actor.submit(() -> { }); // waits behind the blocking task
+        long queued = System.nanoTime(); // after the actor's own stamp: its wait is at least ours
         // the wait to produce: 10 x the threshold, measured on the clock, not slept
         long produced = 10 * ThreadActor.LAG_LOG_MS;
         while (System.nanoTime() - queued < produced * 1_000_000L) {
