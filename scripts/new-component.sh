@@ -3,9 +3,13 @@
 # bundles/) from rt-core/template/component: pom.xml, contract, RT half in C, its unit test
 # (CTest rt.NAME.cycle), README.md. Called by `./arflex new component NAME`.
 #
-# The native superbuild finds bundles/*/native by itself. Maven cannot glob modules, so the
-# one line outside the folder, <module>NAME</module> in DIR/pom.xml, is added here (only if
-# that pom exists and does not list the module yet). Nothing else outside DIR/NAME is edited.
+# The native superbuild finds bundles/*/native by itself. Maven cannot glob modules, so
+# DIR/pom.xml (bundles/pom.xml, the one list of components: docs/DECISIONS.md D34) gets the
+# component twice, added here once each (only if that pom exists and does not list it yet):
+# <module>NAME</module>, which builds it, and its dependency, through which the runtime
+# assembly (cell/) and the integration tests (build order) get every component. Nothing else
+# outside DIR/NAME is edited: the runtime pom, conf/cell.gosh and tests/pom.xml name no
+# component by themselves.
 set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 TEMPLATE="$ROOT/rt-core/template/component"
@@ -67,6 +71,7 @@ trap - EXIT
 echo "created $target"
 
 pom="$dest/pom.xml"
+artifact="org.arflex.cell.$name" # the template's pom.xml
 if [ -f "$pom" ]; then
   if grep -q "<module>$name</module>" "$pom"; then
     echo "$pom already lists <module>$name</module>"
@@ -76,6 +81,17 @@ if [ -f "$pom" ]; then
     echo "added <module>$name</module> to $pom (Maven cannot find modules by itself)"
   else
     echo "new component: $pom has no <modules>; add <module>$name</module> yourself" >&2
+  fi
+  if grep -q "<artifactId>$artifact</artifactId>" "$pom"; then
+    echo "$pom already depends on $artifact"
+  elif grep -q '</dependencies>' "$pom"; then
+    awk -v a="$artifact" '/<\/dependencies>/ && !done {
+        print "    <dependency><groupId>org.arflex</groupId><artifactId>" a "</artifactId><version>${project.version}</version>"
+        print "      <exclusions><exclusion><groupId>*</groupId><artifactId>*</artifactId></exclusion></exclusions></dependency>"
+        done = 1 } { print }' "$pom" >"$pom.tmp" && mv "$pom.tmp" "$pom"
+    echo "added the dependency on $artifact to $pom (the runtime's cell/ and the tests get it from there)"
+  else
+    echo "new component: $pom has no <dependencies>; add a dependency on $artifact yourself" >&2
   fi
 fi
 cat <<MSG

@@ -10,6 +10,5 @@ exec mvn -B -q -o -Darflex.native.skip=true -pl tests test-compile exec:java -De
   -Dexec.mainClass=org.arflex.it.DrcrBench -Dexec.args="${1:-20}" \
   -Darflex.it.runtime="$ROOT/management/runtime/target/arflex-runtime" \
   -Darflex.it.bundles="$ROOT/management/drcr/target/org.arflex.drcr-$V.jar,$ROOT/management/planner/target/org.arflex.planner-$V.jar,$ROOT/contracts/target/org.arflex.contracts-$V.jar" \
-  -Darflex.it.counter="$ROOT/bundles/sample-counter/target/org.arflex.samples.counter-$V.jar" \
-  -Darflex.it.scaler="$ROOT/bundles/sample-scaler/target/org.arflex.samples.scaler-$V.jar" \
+  -Darflex.root="$ROOT" \
   -Darflex.it.work="$ROOT/tests/target/it"

@@ -3,7 +3,14 @@
  * bound to synthetic providers this test creates and writes itself (so every observed value
  * is known exactly).
  *
- *   test_debug_monitor <case> <debug-monitor exe>
+ *   test_debug_monitor <case> <debug-monitor exe> <debug-monitor.xml> <native/tests dir>
+ *
+ * The monitor's ports, parameter and safe mode come from a contract (arflex_host_load_contract,
+ * docs/DECISIONS.md D32/D34): rebind runs the bundle's own; mirror and noslot run the watcher
+ * contracts in native/tests/ (mirror.xml: slot 1 with its last value only; noslot.xml: no
+ * m<k>_last output), as a user writes one (README). Nothing is declared in this file. The
+ * harness's own choices: a 2 ms period, SCHED_OTHER, no mlock, no cpu_dma_latency, no
+ * heartbeat watchdog, and the case's window.
  *   cases:
  *     mirror   m0_last mirrors the provider verbatim; min/max/mean per window of 4 values;
  *              the provider's segment is never written by the monitor (consumer half of its
@@ -26,6 +33,7 @@
 #include <unistd.h>
 
 #include "arflex/host.h"
+#include "arflex/host_contract.h"
 #include "arflex_types/sample.h"
 #include "helper.h" /* rt-core test kit: leak checks */
 
@@ -42,7 +50,7 @@ static const struct arflex_port_type sample_type = {
 };
 
 static char rid[ARFLEX_ID_MAX + 1];
-static const char *mon_exe;
+static const char *mon_exe, *bundle_xml, *tests_dir;
 static struct arflex_host mon;
 static struct arflex_port src[2];    /* synthetic providers */
 static char src_name[2][ARFLEX_OBJ_NAME_SIZE];
@@ -75,36 +83,34 @@ static int make_src(unsigned i)
 	return ret;
 }
 
-/* The monitor with the given outputs (NULL-terminated list of port names). */
-static int make_monitor(const char *const *ports, int64_t window)
+/* The monitor as the contract @xml (a path, or a file name under tests_dir) declares it, its
+ * window starting at @window. */
+static int make_monitor(const char *xml, int64_t window)
 {
-	struct arflex_host_output out[ARFLEX_MAX_OUTPUTS];
-	struct arflex_param_slot p;
-	struct arflex_ctl_config c;
-	unsigned n = 0;
+	static const struct arflex_host_type types[] = { ARFLEX_HOST_TYPE(SAMPLE) };
+	static struct arflex_host_contract c;
+	struct arflex_host_opts o;
+	char path[512], err[512];
 	int ret;
 
-	for (; ports[n]; n++) {
-		out[n].port = ports[n];
-		out[n].spec = (struct arflex_port_spec){ .method = ARFLEX_PORT_STATE,
-							 .type = sample_type, .depth = 1 };
-	}
-	memset(&p, 0, sizeof(p));
-	snprintf(p.name, sizeof(p.name), "window");
-	p.type = ARFLEX_PARAM_INT64;
-	p.flags = ARFLEX_PARAM_MUTABLE;
-	p.min_bits = 1;
-	p.max_bits = 100000;
-	p.default_bits = (uint64_t)window;
-	memset(&c, 0, sizeof(c));
-	c.period_ns = 2 * MS;
-	c.priority = 0; /* tests share the machine: SCHED_OTHER */
-	c.safe_mode = ARFLEX_SAFE_HOLD;
-	c.cfg_flags = ARFLEX_CFG_NO_MLOCK | ARFLEX_CFG_NO_DMA_LATENCY;
-	struct arflex_host_opts o = {
-		.runtime = rid, .instance = "debug-monitor", .config = c,
-		.params = &p, .nparams = 1, .outputs = out, .noutputs = n,
-	};
+	if (strchr(xml, '/'))
+		snprintf(path, sizeof(path), "%s", xml);
+	else
+		snprintf(path, sizeof(path), "%s/%s", tests_dir, xml);
+	ret = arflex_host_load_contract(&c, path, types, 1, err, sizeof(err));
+	if (ret < 0)
+		return fprintf(stderr, "%s\n", err), ret;
+	if (c.nparams != 1 || strcmp(c.params[0].name, "window") != 0 ||
+	    window < (int64_t)c.params[0].min_bits || window > (int64_t)c.params[0].max_bits)
+		return fprintf(stderr, "%s: no window parameter admitting %lld\n", path,
+			       (long long)window), -EINVAL;
+	c.params[0].default_bits = (uint64_t)window;
+	arflex_host_contract_opts(&c, rid, "debug-monitor", &o);
+	o.config.period_ns = 2 * MS;
+	o.config.deadline_ns = 2 * MS;
+	o.config.priority = 0; /* tests share the machine: SCHED_OTHER */
+	o.config.hb_timeout_ns = 0;
+	o.config.cfg_flags |= ARFLEX_CFG_NO_MLOCK | ARFLEX_CFG_NO_DMA_LATENCY;
 	ret = arflex_host_create(&mon, &o);
 	if (ret < 0)
 		return ret;
@@ -239,9 +245,6 @@ static int feed(struct reader *last, double v)
 	return 0;
 }
 
-static const char *const all_ports[] = { "m0_last", "m0_min", "m0_max", "m0_mean", "m1_last",
-					 NULL };
-
 /* debugmon.mirror */
 static int case_mirror(void)
 {
@@ -255,7 +258,7 @@ static int case_mirror(void)
 	memset(&mean, 0, sizeof(mean));
 	memset(&last1, 0, sizeof(last1));
 	CHECK(make_src(0) == 0 && make_src(1) == 0, "create providers");
-	CHECK(make_monitor(all_ports, 4) == 0, "monitor create/spawn");
+	CHECK(make_monitor("mirror.xml", 4) == 0, "monitor create/spawn");
 	CHECK(start_monitor() == 0, "start");
 	CHECK(reader_open(&last, "m0_last") == 0, "open m0_last");
 	CHECK(reader_open(&mn, "m0_min") == 0, "open m0_min");
@@ -307,7 +310,7 @@ static int case_rebind(void)
 	memset(&last, 0, sizeof(last));
 	memset(&mean, 0, sizeof(mean));
 	CHECK(make_src(0) == 0 && make_src(1) == 0, "create providers");
-	CHECK(make_monitor(all_ports, 2) == 0, "monitor create/spawn");
+	CHECK(make_monitor(bundle_xml, 2) == 0, "monitor create/spawn");
 	CHECK(start_monitor() == 0, "start");
 	CHECK(reader_open(&last, "m0_last") == 0, "open m0_last");
 	CHECK(reader_open(&mean, "m0_mean") == 0, "open m0_mean");
@@ -364,10 +367,9 @@ out:
 /* debugmon.noslot */
 static int case_noslot(void)
 {
-	static const char *const ports[] = { "other", NULL };
 	int st;
 
-	CHECK(make_monitor(ports, 4) == 0, "monitor create/spawn");
+	CHECK(make_monitor("noslot.xml", 4) == 0, "monitor create/spawn");
 	CHECK(arflex_host_wait_exit(&mon, WAIT_TIMEOUT) == 0, "the monitor exits");
 	st = arflex_host_exit_status(&mon);
 	CHECK(WIFEXITED(st) && WEXITSTATUS(st) == ARFLEX_EXIT_CONFIGURE, "exit status %d", st);
@@ -390,8 +392,9 @@ int main(int argc, char **argv)
 	};
 	int (*fn)(void) = NULL;
 
-	if (argc != 3) {
-		fprintf(stderr, "usage: %s mirror|rebind|noslot <debug-monitor>\n", argv[0]);
+	if (argc != 5) {
+		fprintf(stderr, "usage: %s mirror|rebind|noslot <debug-monitor> <debug-monitor.xml> "
+			"<native/tests dir>\n", argv[0]);
 		return 2;
 	}
 	for (unsigned i = 0; i < sizeof(cases) / sizeof(cases[0]); i++)
@@ -402,6 +405,8 @@ int main(int argc, char **argv)
 		return 2;
 	}
 	mon_exe = argv[2];
+	bundle_xml = argv[3];
+	tests_dir = argv[4];
 	snprintf(rid, sizeof(rid), "t-debugmon-%ld", (long)getpid());
 	fn();
 	arflex_host_destroy(&mon);

@@ -3,9 +3,14 @@
  * host API (the DRCR does the same in Java). No timing is asserted: only that samples arrive
  * and that every count is exact.
  *
- *   test_latency_probe <case> <latency-probe exe> <latency-probe-reader exe>
+ *   test_latency_probe <case> <latency-probe exe> <latency-probe-reader exe> <latency-probe.xml>
+ *
+ * The probe's output, period and the rest come from its contract (arflex_host_load_contract,
+ * docs/DECISIONS.md D32/D34); the harness's own choices: SCHED_OTHER, no mlock, no
+ * cpu_dma_latency, no heartbeat watchdog, and, for the overflow and errors cases, a shallower
+ * queue and a wrong port type on purpose.
  *   cases:
- *     stream    depth 65536: a first reader takes exactly 200 samples while the probe runs,
+ *     stream    the contract's depth (65536): a first reader takes exactly 200 samples while the probe runs,
  *               a second one drains the rest after STOP; seqs 1..N without a gap, one sample
  *               per cycle (written == cycles of the control block), read == written,
  *               releases one period apart, lateness >= 0.
@@ -30,6 +35,7 @@
 #include <unistd.h>
 
 #include "arflex/host.h"
+#include "arflex/host_contract.h"
 
 #include "sample_type.h"
 #include "helper.h" /* rt-core test kit: leak checks */
@@ -41,7 +47,7 @@
 
 static char rid[ARFLEX_ID_MAX + 1];
 static char tmpdir[256];
-static const char *probe_exe, *reader_exe;
+static const char *probe_exe, *reader_exe, *probe_xml;
 static struct arflex_host host;
 static int failures;
 
@@ -63,22 +69,31 @@ static bool leaked(void)
 	return th_leftovers(rid) > 0 || !th_no_children();
 }
 
+/* The probe as its contract declares it; a @depth other than 0 replaces the stream's depth
+ * and a @type other than NULL the segment's port type (both on purpose, to test the reader). */
 static int make_probe(uint32_t depth, const struct arflex_port_type *type)
 {
-	struct arflex_host_output out = {
-		.port = "samples",
-		.spec = { .method = ARFLEX_PORT_STREAM, .type = *type, .depth = depth,
-			  .overflow = ARFLEX_OVERFLOW_DROP_NEWEST },
-	};
-	struct arflex_host_opts o = {
-		.runtime = rid, .instance = "probe",
-		/* tests share the machine: SCHED_OTHER, no mlock */
-		.config = { .period_ns = 1 * MS, .priority = 0,
-			    .cfg_flags = ARFLEX_CFG_NO_MLOCK | ARFLEX_CFG_NO_DMA_LATENCY },
-		.outputs = &out, .noutputs = 1,
-	};
-	int ret = arflex_host_create(&host, &o);
+	static const struct arflex_host_type types[] = { ARFLEX_HOST_TYPE(SAMPLE) };
+	static struct arflex_host_contract c;
+	struct arflex_host_opts o;
+	char err[512];
+	int ret = arflex_host_load_contract(&c, probe_xml, types, 1, err, sizeof(err));
 
+	if (ret < 0)
+		return fprintf(stderr, "%s\n", err), ret;
+	if (c.noutputs != 1 || strcmp(c.output_ports[0], "samples") != 0 ||
+	    c.outputs[0].spec.method != ARFLEX_PORT_STREAM)
+		return fprintf(stderr, "%s: expected one stream output 'samples'\n", probe_xml), -EINVAL;
+	if (depth)
+		c.outputs[0].spec.depth = depth;
+	if (type)
+		c.outputs[0].spec.type = *type;
+	arflex_host_contract_opts(&c, rid, "probe", &o);
+	/* tests share the machine: SCHED_OTHER, no mlock, and nobody writes the heartbeat */
+	o.config.priority = 0;
+	o.config.cfg_flags |= ARFLEX_CFG_NO_MLOCK | ARFLEX_CFG_NO_DMA_LATENCY;
+	o.config.hb_timeout_ns = 0;
+	ret = arflex_host_create(&host, &o);
 	if (ret < 0)
 		return ret;
 	return arflex_host_spawn(&host, probe_exe, NULL, NULL);
@@ -199,7 +214,7 @@ static int case_stream(void)
 	uint64_t written, cycles;
 	long n1, n2;
 
-	CHECK(make_probe(65536, &sample_port_type) == 0, "create/spawn");
+	CHECK(make_probe(0, NULL) == 0, "create/spawn");
 	CHECK(arflex_host_wait_state(&host, ARFLEX_STATE_READY, WAIT_TIMEOUT) == 0, "READY");
 	CHECK(arflex_host_start(&host, CALL_TIMEOUT) == 0, "START");
 	CHECK(run_reader("first", first) == 0, "first reader (--count 200) failed");
@@ -244,7 +259,7 @@ static int case_overflow(void)
 	uint64_t written;
 	long n;
 
-	CHECK(make_probe(64, &sample_port_type) == 0, "create/spawn");
+	CHECK(make_probe(64, NULL) == 0, "create/spawn");
 	CHECK(arflex_host_wait_state(&host, ARFLEX_STATE_READY, WAIT_TIMEOUT) == 0, "READY");
 	CHECK(arflex_host_start(&host, CALL_TIMEOUT) == 0, "START");
 	CHECK(wait_cycles(300) == 0, "cycles");
@@ -311,9 +326,9 @@ int main(int argc, char **argv)
 	int (*fn)(void) = NULL;
 	char cmd[300];
 
-	if (argc != 4) {
-		fprintf(stderr, "usage: %s stream|overflow|errors <latency-probe> <latency-probe-reader>\n",
-			argv[0]);
+	if (argc != 5) {
+		fprintf(stderr, "usage: %s stream|overflow|errors <latency-probe> <latency-probe-reader> "
+			"<latency-probe.xml>\n", argv[0]);
 		return 2;
 	}
 	for (unsigned i = 0; i < sizeof(cases) / sizeof(cases[0]); i++)
@@ -325,6 +340,7 @@ int main(int argc, char **argv)
 	}
 	probe_exe = argv[2];
 	reader_exe = argv[3];
+	probe_xml = argv[4];
 	snprintf(rid, sizeof(rid), "t-lat-%ld", (long)getpid());
 	snprintf(tmpdir, sizeof(tmpdir), "/tmp/arflex-latency-test.XXXXXX");
 	if (!mkdtemp(tmpdir)) {

@@ -2,8 +2,14 @@
  * test_samples - CTest rt.sample.*: sample-counter and sample-scaler under the rt-core host
  * API, wired together as the DRCR would wire them (counter.count -> scaler.x).
  *
- *   test_samples <case> <sample-counter exe> <sample-scaler exe>
+ *   test_samples <case> <sample-counter exe> <sample-scaler exe> <sample-counter.xml> <sample-scaler.xml>
  *   cases: counter, scale, set_param, unbind, safe, nan
+ *
+ * Ports, parameters (defaults, bounds, mutability) and safe modes come from the bundles'
+ * contracts (arflex_host_load_contract, docs/DECISIONS.md D32/D34); this file declares none.
+ * Its own choices on a shared machine: a 1 ms period, SCHED_OTHER, no mlockall, no
+ * cpu_dma_latency, the heartbeat watchdog off unless a case turns it on, and a case's
+ * starting gain.
  *
  * Every case creates its objects under its own runtime id, and ends by checking that no
  * /dev/shm/arflex.<rid>.* or /dev/mqueue/arflex.<rid>.* object and no child process is left.
@@ -24,6 +30,7 @@
 #include <unistd.h>
 
 #include "arflex/host.h"
+#include "arflex/host_contract.h"
 
 #include "sample_type.h"
 #include "helper.h" /* rt-core test kit: leak checks */
@@ -34,7 +41,8 @@
 #define WAIT_TIMEOUT (10 * SEC)
 
 static char rid[ARFLEX_ID_MAX + 1];
-static const char *counter_exe, *scaler_exe;
+static const char *counter_exe, *scaler_exe, *counter_xml, *scaler_xml;
+static struct arflex_host_contract counter_c, scaler_c;
 static struct arflex_host counter_h, scaler_h;
 static int failures;
 
@@ -49,73 +57,76 @@ static int failures;
 		}                                                                          \
 	} while (0)
 
-static struct arflex_param_slot param_f64(const char *name, double def, double lo, double hi,
-					  bool mutable_)
-{
-	struct arflex_param_slot s;
-
-	memset(&s, 0, sizeof(s));
-	snprintf(s.name, sizeof(s.name), "%s", name);
-	s.type = ARFLEX_PARAM_DOUBLE;
-	s.flags = mutable_ ? ARFLEX_PARAM_MUTABLE : 0;
-	s.min_bits = arflex_f64_bits(lo);
-	s.max_bits = arflex_f64_bits(hi);
-	s.default_bits = arflex_f64_bits(def);
-	return s;
-}
-
 /* Heartbeat timeout of both instances (0: watchdog off); the safe case sets it. While
  * keep_hb is true, every poll writes both runtime heartbeats. */
 static uint64_t hb_timeout_ns;
 static bool keep_hb;
 
-static struct arflex_ctl_config test_config(uint32_t safe_mode)
-{
-	struct arflex_ctl_config c;
+static const struct arflex_host_type types[] = { ARFLEX_HOST_TYPE(SAMPLE) };
 
-	memset(&c, 0, sizeof(c));
-	c.period_ns = 1 * MS;
-	c.hb_timeout_ns = hb_timeout_ns;
-	c.priority = 0; /* tests share the machine: SCHED_OTHER */
-	c.safe_mode = safe_mode;
-	c.cfg_flags = ARFLEX_CFG_NO_MLOCK | ARFLEX_CFG_NO_DMA_LATENCY;
-	return c;
+/* The parameter @name of a loaded contract, or NULL. */
+static struct arflex_param_slot *param(struct arflex_host_contract *c, const char *name)
+{
+	for (unsigned i = 0; i < c->nparams; i++)
+		if (strcmp(c->params[i].name, name) == 0)
+			return &c->params[i];
+	return NULL;
+}
+
+/* Loads @xml into @c and fills @o from it, with the harness's choices on top. */
+static int load(struct arflex_host_contract *c, const char *xml, const char *instance,
+		struct arflex_host_opts *o)
+{
+	char err[512];
+	int ret = arflex_host_load_contract(c, xml, types, 1, err, sizeof(err));
+
+	if (ret < 0)
+		return fprintf(stderr, "%s\n", err), ret;
+	arflex_host_contract_opts(c, rid, instance, o);
+	o->config.period_ns = 1 * MS;
+	o->config.deadline_ns = 1 * MS;
+	o->config.hb_timeout_ns = hb_timeout_ns;
+	o->config.priority = 0; /* tests share the machine: SCHED_OTHER */
+	o->config.cfg_flags |= ARFLEX_CFG_NO_MLOCK | ARFLEX_CFG_NO_DMA_LATENCY;
+	return 0;
+}
+
+/* The contract's default amplitude of sample-counter (the bound of its output). */
+static double amplitude(void)
+{
+	struct arflex_param_slot *p = param(&counter_c, "amplitude");
+
+	return p ? arflex_bits_f64(p->default_bits) : NAN;
 }
 
 static int make_counter(void)
 {
-	struct arflex_param_slot p[2] = {
-		param_f64("amplitude", 2.0, -100.0, 100.0, true),
-		param_f64("frequency", 5.0, 0.0, 500.0, true),
-	};
-	struct arflex_host_output out = {
-		.port = "count",
-		.spec = { .method = ARFLEX_PORT_STATE, .type = sample_port_type, .depth = 1 },
-	};
-	struct arflex_host_opts o = {
-		.runtime = rid, .instance = "counter", .config = test_config(ARFLEX_SAFE_HOLD),
-		.params = p, .nparams = 2, .outputs = &out, .noutputs = 1,
-	};
-	int ret = arflex_host_create(&counter_h, &o);
+	struct arflex_host_opts o;
+	int ret = load(&counter_c, counter_xml, "counter", &o);
 
+	if (ret < 0)
+		return ret;
+	ret = arflex_host_create(&counter_h, &o);
 	if (ret < 0)
 		return ret;
 	return arflex_host_spawn(&counter_h, counter_exe, NULL, NULL);
 }
 
+/* sample-scaler as its contract says, starting with gain @gain (within its bounds). */
 static int make_scaler(double gain)
 {
-	struct arflex_param_slot p[1] = { param_f64("gain", gain, -10.0, 10.0, true) };
-	struct arflex_host_output out = {
-		.port = "y",
-		.spec = { .method = ARFLEX_PORT_STATE, .type = sample_port_type, .depth = 1 },
-	};
-	struct arflex_host_opts o = {
-		.runtime = rid, .instance = "scaler", .config = test_config(ARFLEX_SAFE_ZERO),
-		.params = p, .nparams = 1, .outputs = &out, .noutputs = 1,
-	};
-	int ret = arflex_host_create(&scaler_h, &o);
+	struct arflex_host_opts o;
+	struct arflex_param_slot *g;
+	int ret = load(&scaler_c, scaler_xml, "scaler", &o);
 
+	if (ret < 0)
+		return ret;
+	g = param(&scaler_c, "gain");
+	if (!g || gain < arflex_bits_f64(g->min_bits) || gain > arflex_bits_f64(g->max_bits))
+		return fprintf(stderr, "no gain parameter admitting %g in %s\n", gain, scaler_xml),
+		       -EINVAL;
+	g->default_bits = arflex_f64_bits(gain);
+	ret = arflex_host_create(&scaler_h, &o);
 	if (ret < 0)
 		return ret;
 	return arflex_host_spawn(&scaler_h, scaler_exe, NULL, NULL);
@@ -232,14 +243,15 @@ static int case_counter(void)
 		CHECK(x.v.seq > last_seq, "seq %llu after %llu", (unsigned long long)x.v.seq,
 		      (unsigned long long)last_seq);
 		CHECK(x.v.t_ns > last_t, "t_ns not increasing");
-		CHECK(fabs(x.v.value) <= 2.0, "value %g beyond amplitude 2", x.v.value);
+		CHECK(fabs(x.v.value) <= amplitude(), "value %g beyond amplitude %g", x.v.value,
+		      amplitude());
 		if (fabs(x.v.value) > maxabs)
 			maxabs = fabs(x.v.value);
 		last_seq = x.v.seq;
 		last_t = x.v.t_ns;
 	}
 	CHECK(x.n >= 300, "only %llu values seen", (unsigned long long)x.n);
-	CHECK(maxabs > 0.5, "the sine does not move (max |value| %g)", maxabs);
+	CHECK(maxabs > amplitude() / 4, "the sine does not move (max |value| %g)", maxabs);
 	CHECK(arflex_host_set_param(&counter_h, "amplitude", arflex_f64_bits(0.25), &applied,
 				    CALL_TIMEOUT) == 0, "SET_PARAM amplitude");
 	CHECK(arflex_bits_f64(applied) == 0.25, "applied %g", arflex_bits_f64(applied));
@@ -656,9 +668,9 @@ int main(int argc, char **argv)
 	};
 	int (*fn)(void) = NULL;
 
-	if (argc != 4) {
+	if (argc != 6) {
 		fprintf(stderr, "usage: %s counter|scale|set_param|unbind|safe|nan <sample-counter> "
-			"<sample-scaler>\n", argv[0]);
+			"<sample-scaler> <sample-counter.xml> <sample-scaler.xml>\n", argv[0]);
 		return 2;
 	}
 	for (unsigned i = 0; i < sizeof(cases) / sizeof(cases[0]); i++)
@@ -670,6 +682,8 @@ int main(int argc, char **argv)
 	}
 	counter_exe = argv[2];
 	scaler_exe = argv[3];
+	counter_xml = argv[4];
+	scaler_xml = argv[5];
 	snprintf(rid, sizeof(rid), "t-sample-%ld", (long)getpid());
 	fn();
 	arflex_host_destroy(&scaler_h);

@@ -3,7 +3,9 @@
 # and checks its result:
 #   - a bad name and an existing folder are refused, and change nothing;
 #   - the generated folder has every file, with no template token left;
-#   - <module> lines are added to a copy of bundles/pom.xml once, in front of </modules>;
+#   - <module> lines and dependencies are added to a copy of bundles/pom.xml once each, in front
+#     of </modules> and </dependencies> (the one list of components, docs/DECISIONS.md D34),
+#     every entry already there kept;
 #   - the generated RT half and its unit test build against rt-core (this build tree) with the
 #     project's warnings as errors, and the unit test passes.
 #   SRC_ROOT  the repository;  BUILD_DIR  the superbuild's build tree;  WORK  a dir under it
@@ -71,6 +73,23 @@ list(LENGTH m n)
 if(NOT n EQUAL 1 OR NOT pom MATCHES "<module>${name}</module>\n    <module>second</module>\n  </modules>")
   message(FATAL_ERROR "bundles/pom.xml copy not as expected:\n${pom}")
 endif()
+set(dep_gen "<dependency><groupId>org.arflex</groupId><artifactId>org.arflex.cell.${name}</artifactId><version>\\\${project.version}</version>")
+set(dep_second "<dependency><groupId>org.arflex</groupId><artifactId>org.arflex.cell.second</artifactId><version>\\\${project.version}</version>")
+string(REGEX MATCHALL "<artifactId>org.arflex.cell.${name}</artifactId>" d "${pom}")
+list(LENGTH d n)
+if(NOT n EQUAL 1 OR NOT pom MATCHES "${dep_gen}\n      <exclusions><exclusion><groupId>\\*</groupId><artifactId>\\*</artifactId></exclusion></exclusions></dependency>\n    ${dep_second}\n[^\n]*\n  </dependencies>")
+  message(FATAL_ERROR "bundles/pom.xml copy: the dependencies are not as expected:\n${pom}")
+endif()
+# the module and the dependency of every component already there are kept, in order
+file(READ ${SRC_ROOT}/bundles/pom.xml orig)
+string(REGEX MATCHALL "<(module|artifactId)>[^<]+</(module|artifactId)>" before "${orig}")
+string(REGEX MATCHALL "<(module|artifactId)>[^<]+</(module|artifactId)>" after "${pom}")
+foreach(x IN LISTS before)
+  list(FIND after "${x}" i)
+  if(i LESS 0)
+    message(FATAL_ERROR "bundles/pom.xml copy lost ${x}")
+  endif()
+endforeach()
 
 # 4. Build the generated RT half and its test against this build tree, run the test.
 set(bin ${WORK}/build)

@@ -3,8 +3,14 @@
 // the plant: the measured TCP is the nominal TCP of the corrected output, shifted by a fixed
 // error (what the true arm does differently from the nominal model).
 //
-//   tcpcorr_comp_test <case> <tcp-correction exe>     cases: converge, hold, invalid
+//   tcpcorr_comp_test <case> <tcp-correction exe> <contract>     cases: converge, hold, invalid
 //
+// The corrector's ports, parameters (max_rate, max_sigma, track_tol, orientation, ... with
+// their defaults), period and safe mode come from the bundle's contract
+// (arflex_host_load_contract, docs/DECISIONS.md D32/D34); the rate-limit check uses the
+// contract's max_rate. The harness's own choices: SCHED_OTHER, no mlock or cpu_dma_latency, no
+// heartbeat watchdog. The feeder plays the motion source, vision and the robot: it is the
+// test's own provider, not a component, and its segments are declared here.
 // Every case ends by checking that no /dev/shm or /dev/mqueue object of its runtime id and no
 // child process is left. Waits are on conditions with deadlines; nothing asserts on timing.
 #include <dirent.h>
@@ -19,6 +25,7 @@
 
 extern "C" {
 #include "arflex/host.h"
+#include "arflex/host_contract.h"
 #include "helper.h" /* rt-core test kit: leak checks */
 }
 #include "arflex_cellmodel/kinematics.h"
@@ -31,8 +38,9 @@ namespace {
 
 constexpr uint64_t kSec = 1000000000ull;
 constexpr uint64_t kMs = 1000000ull;
-constexpr double kMaxRate = 0.02;  // rad/s, the parameter given below
-constexpr double kPeriod = 0.001;  // s
+double max_rate;            // rad/s: the contract's default of max_rate
+double period_s;            // s: the contract's period
+const char* contract_xml;
 
 char rid[ARFLEX_ID_MAX + 1];
 int failures = 0;
@@ -47,22 +55,6 @@ int failures = 0;
       goto out;                                                            \
     }                                                                      \
   } while (0)
-
-arflex_param_slot Param(const char* name, uint32_t type, uint64_t def, uint64_t lo, uint64_t hi) {
-  arflex_param_slot s;
-  std::memset(&s, 0, sizeof(s));
-  std::snprintf(s.name, sizeof(s.name), "%s", name);
-  s.type = type;
-  s.flags = ARFLEX_PARAM_MUTABLE;
-  s.min_bits = lo;
-  s.max_bits = hi;
-  s.default_bits = def;
-  return s;
-}
-
-arflex_param_slot F64(const char* name, double def, double lo, double hi) {
-  return Param(name, ARFLEX_PARAM_DOUBLE, arflex_f64_bits(def), arflex_f64_bits(lo), arflex_f64_bits(hi));
-}
 
 arflex_ctl_config Config() {
   arflex_ctl_config c;
@@ -124,27 +116,27 @@ struct Rig {
     o.noutputs = 3;
     int r = arflex_host_create(&feeder, &o);
     if (r < 0) return r;
-    arflex_param_slot p[6] = {
-        F64("gain", 0.6, 0.01, 1.0), F64("max_step", 2e-3, 1e-6, 0.1), F64("max_rate", kMaxRate, 1e-6, 1.0),
-        F64("max_correction", 0.02, 1e-6, 0.2), Param("enable", ARFLEX_PARAM_BOOL, 1, 0, 1),
-        Param("orientation", ARFLEX_PARAM_BOOL, 1, 0, 1)};
-    struct arflex_host_output co[3];
-    std::memset(co, 0, sizeof(co));
-    co[0].port = "corrected";
-    co[0].spec.method = ARFLEX_PORT_STATE;
-    co[0].spec.type = {ARFLEX_TYPE_JOINT_REF_NAME, 1, 0, ARFLEX_TYPE_JOINT_REF_SIZE};
-    co[0].spec.depth = 1;
-    co[1].port = "error";
-    co[1].spec.method = ARFLEX_PORT_STATE;
-    co[1].spec.type = {ARFLEX_TYPE_SAMPLE_NAME, 1, 0, ARFLEX_TYPE_SAMPLE_SIZE};
-    co[1].spec.depth = 1;
-    co[2] = co[1];
-    co[2].port = "correction";
-    o.instance = "corr";
-    o.params = p;
-    o.nparams = 6;
-    o.outputs = co;
-    o.noutputs = 3;
+    static const arflex_host_type types[] = {ARFLEX_HOST_TYPE(JOINT_REF), ARFLEX_HOST_TYPE(JOINT_STATE),
+                                             ARFLEX_HOST_TYPE(POSE), ARFLEX_HOST_TYPE(SAMPLE)};
+    static arflex_host_contract c;
+    char err[512];
+    r = arflex_host_load_contract(&c, contract_xml, types, 4, err, sizeof(err));
+    if (r < 0) {
+      std::fprintf(stderr, "%s\n", err);
+      return r;
+    }
+    max_rate = -1;
+    for (unsigned i = 0; i < c.nparams; ++i)
+      if (std::strcmp(c.params[i].name, "max_rate") == 0) max_rate = arflex_bits_f64(c.params[i].default_bits);
+    if (max_rate <= 0) {
+      std::fprintf(stderr, "%s: no max_rate\n", contract_xml);
+      return -EINVAL;
+    }
+    arflex_host_contract_opts(&c, rid, "corr", &o);
+    period_s = 1e-9 * static_cast<double>(o.config.period_ns);
+    o.config.priority = 0;
+    o.config.hb_timeout_ns = 0;
+    o.config.cfg_flags |= ARFLEX_CFG_NO_MLOCK | ARFLEX_CFG_NO_DMA_LATENCY;
     r = arflex_host_create(&corr, &o);
     if (r < 0) return r;
     r = arflex_host_spawn(&corr, exe, nullptr, nullptr);
@@ -195,7 +187,7 @@ struct Rig {
     if (last.seq != 0) {
       const double cycles = static_cast<double>(v.seq - last.seq);
       for (int i = 0; i < 6; ++i) {
-        const double excess = std::abs(v.q[i] - last.q[i]) - kMaxRate * kPeriod * cycles;
+        const double excess = std::abs(v.q[i] - last.q[i]) - max_rate * period_s * cycles;
         if (excess > max_jump_excess) max_jump_excess = excess;
       }
     }
@@ -469,10 +461,11 @@ out:
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 3) {
-    std::fprintf(stderr, "usage: tcpcorr_comp_test <converge|hold|invalid> <tcp-correction exe>\n");
+  if (argc != 4) {
+    std::fprintf(stderr, "usage: tcpcorr_comp_test <converge|hold|invalid> <tcp-correction exe> <contract>\n");
     return 2;
   }
+  contract_xml = argv[3];
   std::snprintf(rid, sizeof(rid), "tcc%d", static_cast<int>(getpid()));
   const std::string name = argv[1];
   if (name != "converge" && name != "hold" && name != "invalid") {

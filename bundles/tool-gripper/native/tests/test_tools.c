@@ -3,7 +3,13 @@
  * processes under the rt-core host API, their safety input bound to a guard the test owns (a
  * thread that publishes a fresh arflex.SafetyState every millisecond with the mode it is told,
  * or stays silent).
- *   test_tools <unguarded|stop|lost|command_input> <gripper|spindle> <tool executable>
+ *   test_tools <unguarded|stop|lost|command_input> <gripper|spindle> <tool executable> <contract>
+ * The tool's ports, parameters, safe mode and movesHardware come from its bundle's contract
+ * (arflex_host_load_contract, docs/DECISIONS.md D32/D34). The harness's own choices: a 2 ms
+ * period, SCHED_OTHER, no mlock or cpu_dma_latency, no heartbeat watchdog, and a safety
+ * freshness of 100 ms (the contract's 20 ms would stop the tool whenever this shared machine
+ * delays the test's guard thread). The guard and the command script are the test's own
+ * providers, not components: their segments are declared here.
  * Each case checks the tool's output (level, status), its hold word (ctl.hold) and its flags
  * (RESET_REQUIRED), and ends with no /dev/shm/arflex.<rid>.*, queue or child left. Waits are
  * conditions with deadlines; "does not move" is observed over a number of the tool's outputs.
@@ -19,6 +25,7 @@
 #include <time.h>
 
 #include "arflex/host.h"
+#include "arflex/host_contract.h"
 #include "arflex/safety_gate.h"
 #include "arflex_types/safety_state.h"
 #include "arflex_types/sample.h"
@@ -30,13 +37,14 @@
 #define T_CALL (5 * SEC)
 #define T_WAIT (30 * SEC)
 #define PERIOD (2 * MS) /* the tools' period here (10 ms in the contracts) */
-#define RATE 2.0        /* parameter rate, 1/s */
+#define MAX_AGE_MS 100.0 /* safety_max_age_ms here (20 ms in the contracts) */
 #define STILL 100       /* outputs a held level must stay unchanged for */
 
 static char rid[64];
 static int failures;
 static bool spindle;
-static const char *exe;
+static const char *exe, *contract_xml;
+static double rate; /* parameter rate, 1/s: the contract's default */
 
 #define CHECK(c, ...)                                                           \
 	do {                                                                    \
@@ -129,40 +137,37 @@ static struct arflex_host tool_h;
 static struct arflex_port tool_port; /* the consumer's reader of `tool` */
 static struct arflex_tool_state last;
 
-static struct arflex_param_slot pd(const char *name, double def, double lo, double hi)
-{
-	struct arflex_param_slot s;
-
-	memset(&s, 0, sizeof(s));
-	snprintf(s.name, sizeof(s.name), "%s", name);
-	s.type = ARFLEX_PARAM_DOUBLE;
-	s.flags = ARFLEX_PARAM_MUTABLE;
-	s.min_bits = arflex_f64_bits(lo);
-	s.max_bits = arflex_f64_bits(hi);
-	s.default_bits = arflex_f64_bits(def);
-	return s;
-}
-
-/* Creates, spawns and starts the tool as the DRCR would (movesHardware), unguarded. */
+/* Creates, spawns and starts the tool as its contract declares it, unguarded. */
 static int tool_create(void)
 {
-	struct arflex_host_output o = { "tool", { ARFLEX_PORT_STATE, tool_t, 1, ARFLEX_OVERFLOW_NONE } };
-	struct arflex_param_slot p[3] = { pd("command", 0, 0, 1), pd("rate", RATE, 0.01, 100),
-					  pd("safety_max_age_ms", 100, 2, 1000) };
+	static const struct arflex_host_type types[] = {
+		ARFLEX_HOST_TYPE(SAFETY_STATE), ARFLEX_HOST_TYPE(SAMPLE), ARFLEX_HOST_TYPE(TOOL_STATE),
+	};
+	static struct arflex_host_contract c;
 	struct arflex_host_opts opts;
+	struct arflex_param_slot *age = NULL, *rt = NULL;
+	char err[512];
 	int r;
 
-	memset(&opts, 0, sizeof(opts));
-	opts.runtime = rid;
-	opts.instance = spindle ? "spindle" : "gripper";
+	if ((r = arflex_host_load_contract(&c, contract_xml, types, 3, err, sizeof(err))) < 0)
+		return fprintf(stderr, "%s\n", err), r;
+	for (unsigned i = 0; i < c.nparams; i++) {
+		if (strcmp(c.params[i].name, "safety_max_age_ms") == 0)
+			age = &c.params[i];
+		else if (strcmp(c.params[i].name, "rate") == 0)
+			rt = &c.params[i];
+	}
+	if (!age || !rt || !(c.config.cfg_flags & ARFLEX_CFG_MOVES_HARDWARE))
+		return fprintf(stderr, "%s: no rate/safety_max_age_ms, or not movesHardware\n",
+			       contract_xml), -EINVAL;
+	age->default_bits = arflex_f64_bits(MAX_AGE_MS);
+	rate = arflex_bits_f64(rt->default_bits);
+	arflex_host_contract_opts(&c, rid, spindle ? "spindle" : "gripper", &opts);
 	opts.config.period_ns = PERIOD;
-	opts.config.safe_mode = ARFLEX_SAFE_HOLD; /* both contracts: hold / zero; the tool decides */
-	opts.config.cfg_flags = ARFLEX_CFG_NO_MLOCK | ARFLEX_CFG_NO_DMA_LATENCY |
-				ARFLEX_CFG_MOVES_HARDWARE;
-	opts.params = p;
-	opts.nparams = 3;
-	opts.outputs = &o;
-	opts.noutputs = 1;
+	opts.config.deadline_ns = PERIOD;
+	opts.config.priority = 0;
+	opts.config.hb_timeout_ns = 0;
+	opts.config.cfg_flags |= ARFLEX_CFG_NO_MLOCK | ARFLEX_CFG_NO_DMA_LATENCY;
 	if ((r = arflex_host_create(&tool_h, &opts)) < 0 ||
 	    (r = arflex_host_spawn(&tool_h, exe, NULL, NULL)) < 0 ||
 	    (r = arflex_host_wait_state(&tool_h, ARFLEX_STATE_READY, 10 * SEC)) < 0)
@@ -261,7 +266,7 @@ static bool holds(uint32_t cause, int detail)
  * period; the gripper keeps @level exactly. Then stays there. */
 static bool stops_from(double level)
 {
-	const double max_step = (RATE > 2.0 ? RATE : 2.0) * (double)PERIOD * 1e-9 + 1e-12;
+	const double max_step = (rate > 2.0 ? rate : 2.0) * (double)PERIOD * 1e-9 + 1e-12;
 	const uint64_t dl = now() + T_WAIT;
 	double prev = level;
 	uint64_t prev_seq = last.seq;
@@ -425,13 +430,14 @@ int main(int argc, char **argv)
 {
 	int r;
 
-	if (argc != 4 || (strcmp(argv[2], "gripper") != 0 && strcmp(argv[2], "spindle") != 0)) {
-		fprintf(stderr, "usage: %s <unguarded|stop|lost|command_input> <gripper|spindle> <exe>\n",
-			argv[0]);
+	if (argc != 5 || (strcmp(argv[2], "gripper") != 0 && strcmp(argv[2], "spindle") != 0)) {
+		fprintf(stderr, "usage: %s <unguarded|stop|lost|command_input> <gripper|spindle> <exe> "
+			"<contract>\n", argv[0]);
 		return 2;
 	}
 	spindle = strcmp(argv[2], "spindle") == 0;
 	exe = argv[3];
+	contract_xml = argv[4];
 	th_rid(rid, sizeof(rid), "tool");
 	th_track(rid, "gripper");
 	th_track(rid, "spindle");

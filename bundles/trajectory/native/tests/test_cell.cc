@@ -1,7 +1,18 @@
 // test_cell - CTest cell.*: the cell's RT halves as processes under the rt-core host API,
 // wired as the DRCR would wire them; the test itself plays the robot and the sensors through
 // "script" instances whose output segments it writes.
-//   test_cell <trajectory|program_switch|late_robot|invalid_input|bad_program|force_guard|teach_replay|tools> <bin dir>
+//   test_cell <trajectory|program_switch|late_robot|invalid_input|bad_program|force_guard|teach_replay|tools> <bin dir> <bundles dir>
+// Each component (trajectory, force-guard, teach, tool-gripper, tool-spindle) is created from
+// its bundle's contract, <bundles dir>/<name>/src/main/resources/OSGI-INF/arflex/<name>.xml
+// (arflex_host_load_contract, docs/DECISIONS.md D32/D34): its ports, parameters with their
+// defaults and bounds, safe mode, movesHardware and executable; no port or parameter of a
+// component is declared here. The harness's own choices: a 1 ms period for every component
+// but the guard (20 ms, so that the test sees each of its outputs), deadline = period,
+// SCHED_OTHER, no mlock or cpu_dma_latency, no heartbeat watchdog, and in the tools case a
+// tool safety freshness of 1000 ms where the contracts say 20 ms (the test's guard writes only
+// while the test polls; checked against the contract's bounds). The scripts play the robot,
+// the sensors, a guard and a command source: they are the test's own providers, not
+// components, and their segments are declared here.
 // Every case uses its own runtime id and ends by checking that no /dev/shm/arflex.<rid>.*,
 // no queue and no child process is left. Waits are conditions with deadlines (counted in the
 // components' cycles where the brief is about cycles); nothing asserts on timing.
@@ -21,6 +32,7 @@
 #include <vector>
 
 #include "arflex/host.h"
+#include "arflex/host_contract.h"
 #include "arflex_types/joint_ref.h"
 #include "arflex_types/joint_state.h"
 #include "arflex_types/safety_state.h"
@@ -39,7 +51,7 @@ constexpr uint64_t kSec = 1000000000ull, kMs = 1000000ull;
 constexpr uint64_t kCall = 2 * kSec, kWait = 30 * kSec;
 
 char rid[ARFLEX_ID_MAX + 1];
-std::string bindir;
+std::string bindir, bundlesdir;
 int failures;
 std::vector<struct arflex_host*> hosts;
 
@@ -61,34 +73,6 @@ const struct arflex_port_type kST = {ARFLEX_TYPE_SAFETY_STATE_NAME, 1, 0, sizeof
 const struct arflex_port_type kToolT = {ARFLEX_TYPE_TOOL_STATE_NAME, 1, 0, sizeof(arflex_tool_state)};
 const struct arflex_port_type kSampleT = {ARFLEX_TYPE_SAMPLE_NAME, 1, 0, sizeof(arflex_sample)};
 
-struct arflex_param_slot P(const char* name, uint32_t type, double def, double lo, double hi,
-                           bool mut) {
-  struct arflex_param_slot s;
-  memset(&s, 0, sizeof(s));
-  snprintf(s.name, sizeof(s.name), "%s", name);
-  s.type = type;
-  s.flags = mut ? ARFLEX_PARAM_MUTABLE : 0;
-  if (type == ARFLEX_PARAM_DOUBLE) {
-    s.min_bits = arflex_f64_bits(lo);
-    s.max_bits = arflex_f64_bits(hi);
-    s.default_bits = arflex_f64_bits(def);
-  } else {
-    s.min_bits = (uint64_t)(int64_t)lo;
-    s.max_bits = (uint64_t)(int64_t)hi;
-    s.default_bits = (uint64_t)(int64_t)def;
-  }
-  return s;
-}
-struct arflex_param_slot PB(const char* n, bool def, bool mut) {
-  return P(n, ARFLEX_PARAM_BOOL, def, 0, 1, mut);
-}
-struct arflex_param_slot PD(const char* n, double def, double lo, double hi, bool mut) {
-  return P(n, ARFLEX_PARAM_DOUBLE, def, lo, hi, mut);
-}
-struct arflex_param_slot PI(const char* n, double def, double lo, double hi, bool mut) {
-  return P(n, ARFLEX_PARAM_INT64, def, lo, hi, mut);
-}
-
 struct arflex_ctl_config Config(uint64_t period) {
   struct arflex_ctl_config c;
   memset(&c, 0, sizeof(c));
@@ -102,10 +86,8 @@ struct Out {
   struct arflex_port_type type;
 };
 
-// Creates an instance with state outputs; spawns `exe` (from bindir) unless it is NULL.
-int Make(struct arflex_host* h, const char* inst, uint64_t period, const std::vector<Out>& outs,
-         const std::vector<struct arflex_param_slot>& params, const char* exe,
-         char* const* envp = nullptr) {
+// A script instance: the test's own provider, with the state outputs `outs` it writes itself.
+int MakeScript(struct arflex_host* h, const std::vector<Out>& outs) {
   struct arflex_host_output o[8];
   memset(h, 0, sizeof(*h));
   for (size_t i = 0; i < outs.size(); ++i) {
@@ -115,17 +97,60 @@ int Make(struct arflex_host* h, const char* inst, uint64_t period, const std::ve
   struct arflex_host_opts opts;
   memset(&opts, 0, sizeof(opts));
   opts.runtime = rid;
-  opts.instance = inst;
-  opts.config = Config(period);
-  opts.params = params.empty() ? nullptr : params.data();
-  opts.nparams = (unsigned)params.size();
+  opts.instance = "script";
+  opts.config = Config(kMs);
   opts.outputs = o;
   opts.noutputs = (unsigned)outs.size();
   int r = arflex_host_create(h, &opts);
+  if (r == 0) hosts.push_back(h);
+  return r;
+}
+
+// A parameter default the harness chooses itself instead of the contract's.
+struct Default {
+  const char* name;
+  double value;
+};
+
+// Creates instance `inst` of the component `comp` from its bundle's contract, with the
+// harness's period and flags and the defaults `defs` (double parameters, within the
+// contract's bounds); spawns the contract's executable from bindir and waits for READY.
+int Make(struct arflex_host* h, const char* inst, const char* comp, uint64_t period,
+         char* const* envp = nullptr, const std::vector<Default>& defs = {}) {
+  static const struct arflex_host_type types[] = {
+      ARFLEX_HOST_TYPE(JOINT_REF),    ARFLEX_HOST_TYPE(JOINT_STATE), ARFLEX_HOST_TYPE(WRENCH),
+      ARFLEX_HOST_TYPE(SAFETY_STATE), ARFLEX_HOST_TYPE(TOOL_STATE),  ARFLEX_HOST_TYPE(SAMPLE)};
+  static struct arflex_host_contract c;  // read again for each instance
+  const std::string xml = bundlesdir + "/" + comp + "/src/main/resources/OSGI-INF/arflex/" + comp + ".xml";
+  char err[512];
+  memset(h, 0, sizeof(*h));
+  int r = arflex_host_load_contract(&c, xml.c_str(), types, sizeof(types) / sizeof(types[0]), err, sizeof(err));
+  if (r < 0) {
+    fprintf(stderr, "%s\n", err);
+    return r;
+  }
+  for (const Default& d : defs) {
+    struct arflex_param_slot* s = nullptr;
+    for (unsigned i = 0; i < c.nparams; ++i)
+      if (strcmp(c.params[i].name, d.name) == 0) s = &c.params[i];
+    if (!s || s->type != ARFLEX_PARAM_DOUBLE || d.value < arflex_bits_f64(s->min_bits) ||
+        d.value > arflex_bits_f64(s->max_bits)) {
+      fprintf(stderr, "%s: no double parameter %s admitting %g\n", xml.c_str(), d.name, d.value);
+      return -EINVAL;
+    }
+    s->default_bits = arflex_f64_bits(d.value);
+  }
+  struct arflex_host_opts opts;
+  arflex_host_contract_opts(&c, rid, inst, &opts);
+  opts.config.period_ns = period;
+  opts.config.deadline_ns = period;
+  opts.config.priority = 0;
+  opts.config.hb_timeout_ns = 0;
+  opts.config.cfg_flags |= ARFLEX_CFG_NO_MLOCK | ARFLEX_CFG_NO_DMA_LATENCY;
+  r = arflex_host_create(h, &opts);
   if (r < 0) return r;
   hosts.push_back(h);
-  if (!exe) return 0;
-  const std::string path = bindir + "/" + exe;
+  const std::string path = bindir + "/" + c.executable;
   if ((r = arflex_host_spawn(h, path.c_str(), nullptr, envp)) < 0) return r;
   return arflex_host_wait_state(h, ARFLEX_STATE_READY, 10 * kSec);
 }
@@ -172,15 +197,6 @@ uint64_t Now() { return arflex_sys_now_ns(); }
 
 int SetI(struct arflex_host* h, const char* n, int64_t v) {
   return arflex_host_set_param(h, n, (uint64_t)v, nullptr, kCall);
-}
-
-std::vector<struct arflex_param_slot> TrajectoryParams() {
-  return {PI("program", 0, 0, 99, true),       PB("run", true, true),
-          PB("loop", false, true),             PI("profile", 0, 0, 1, true),
-          PD("speed", 1, 0.01, 1, true),       PD("accel", 3, 0.1, 50, true),
-          PD("accel_max", 20, 0.1, 200, true), PD("lin_speed", 0.25, 0.001, 2, true),
-          PD("lin_accel", 1, 0.01, 10, true),  PD("stop_time", 0.3, 0.001, 5, true),
-          PD("safety_max_age_ms", 20, 2, 1000, true)};
 }
 
 std::string MakeDataDir() {
@@ -230,8 +246,7 @@ void CaseTrajectory() {
   bool ok = WriteText(arflex::cellkin::ProgramPath(dir, 1), prog);
   std::string env = "ARFLEX_DATA_DIR=" + dir;
   char* envp[] = {const_cast<char*>(env.c_str()), nullptr};
-  int r = ok ? Make(&traj, "trajectory", kMs, {{"joint_ref", kRefT}, {"tool_id", kSampleT}}, TrajectoryParams(),
-                    "trajectory", envp)
+  int r = ok ? Make(&traj, "trajectory", "trajectory", kMs, envp)
              : -EIO;
   RemoveDir(dir);  // loaded at configure: the process does not need the file any more
   CHECK(r == 0, "create/spawn trajectory: %d", r);
@@ -313,8 +328,7 @@ void CaseProgramSwitch() {
                       "arflex-program 1\nptp 0.3 0.3 0 0 0 0 speed 0.3\n");
   std::string env = "ARFLEX_DATA_DIR=" + dir;
   char* envp[] = {const_cast<char*>(env.c_str()), nullptr};
-  int r = ok ? Make(&traj, "trajectory", kMs, {{"joint_ref", kRefT}, {"tool_id", kSampleT}}, TrajectoryParams(),
-                    "trajectory", envp)
+  int r = ok ? Make(&traj, "trajectory", "trajectory", kMs, envp)
              : -EIO;
   RemoveDir(dir);
   CHECK(r == 0, "create/spawn trajectory: %d", r);
@@ -372,10 +386,9 @@ void CaseLateRobot() {
                       "arflex-program 1\nptp 0.5 0 0 0 0 0 speed 0.3\nptp 0.5 0.3 0 0 0 0 speed 0.3\n");
   std::string env = "ARFLEX_DATA_DIR=" + dir;
   char* envp[] = {const_cast<char*>(env.c_str()), nullptr};
-  int r = ok ? Make(&script, "script", kMs, {{"joint_state", kJsT}}, {}, nullptr) : -EIO;
+  int r = ok ? MakeScript(&script, {{"joint_state", kJsT}}) : -EIO;
   CHECK(r == 0, "script: %d", r);
-  r = Make(&traj, "trajectory", kMs, {{"joint_ref", kRefT}, {"tool_id", kSampleT}}, TrajectoryParams(),
-           "trajectory", envp);
+  r = Make(&traj, "trajectory", "trajectory", kMs, envp);
   RemoveDir(dir);
   CHECK(r == 0, "create/spawn trajectory: %d", r);
   CHECK(SetI(&traj, "program", 1) == 0 && arflex_host_start(&traj, kCall) == 0, "start program 1");
@@ -508,12 +521,6 @@ void CaseLateRobot() {
 
 // ---- force-guard ----------------------------------------------------------------------------
 
-std::vector<struct arflex_param_slot> GuardParams() {
-  return {PD("force_limit_n", 150, 1, 10000, true), PD("torque_limit_nm", 3000, 1, 100000, true),
-          PD("safe_power_fraction", 0.1, 0, 1, true), PB("reset", false, true),
-          PD("payload_kg", 0, 0, 500, true)};
-}
-
 // Writes a resting robot at q (torques = nominal gravity) plus extra joint torque, and a
 // wrench = tool weight + extra contact force (world frame, what a push adds).
 void WriteRobot(struct arflex_host* script, const Model& m, const Q& q, const Q& extra_tau,
@@ -581,12 +588,12 @@ void CaseForceGuard() {
   static struct arflex_host script, guard, traj;
   Model m;
   uint64_t wseq = 0;
-  int r = Make(&script, "script", kMs, {{"joint_state", kJsT}, {"wrench", kWT}}, {}, nullptr);
+  int r = MakeScript(&script, {{"joint_state", kJsT}, {"wrench", kWT}});
   CHECK(r == 0, "script: %d", r);
   // A slower guard period (20 ms) lets the test see each of its outputs.
-  r = Make(&guard, "guard", 20 * kMs, {{"safety", kST}}, GuardParams(), "force-guard");
+  r = Make(&guard, "guard", "force-guard", 20 * kMs);
   CHECK(r == 0, "guard: %d", r);
-  r = Make(&traj, "trajectory", kMs, {{"joint_ref", kRefT}, {"tool_id", kSampleT}}, TrajectoryParams(), "trajectory");
+  r = Make(&traj, "trajectory", "trajectory", kMs);
   CHECK(r == 0, "trajectory: %d", r);
   CHECK(SetI(&traj, "loop", 1) == 0, "loop");
   // the guard writes every 20 ms here: fresh means younger than 100 ms
@@ -734,21 +741,14 @@ void CaseTeachReplay() {
   CHECK(!dir.empty(), "mkdtemp");
   std::string env = "ARFLEX_DATA_DIR=" + dir;
   char* envp[] = {const_cast<char*>(env.c_str()), nullptr};
-  int r = Make(&script, "script", kMs, {{"joint_state", kJsT}, {"wrench", kWT}, {"safety", kST}}, {},
-               nullptr);
+  int r = MakeScript(&script, {{"joint_state", kJsT}, {"wrench", kWT}, {"safety", kST}});
   CHECK(r == 0, "script: %d", r);
   struct arflex_safety_state safety;
   memset(&safety, 0, sizeof(safety));
   safety.mode = ARFLEX_SAFETY_STATE_MODE_NORMAL;
   safety.power_scale = 1;
   arflex_state_write(arflex_host_output(&script, "safety"), &safety, sizeof(safety));
-  r = Make(&teach, "teach", kMs, {{"joint_ref", kRefT}},
-           {PB("teach", false, true), PD("mass", 20, 0.1, 1000, true),
-            PD("damping", 400, 1, 100000, true), PD("deadband_n", 5, 0, 1000, true),
-            PD("max_speed", 0.25, 0.001, 2, true), PD("payload_kg", 0, 0, 500, true),
-            PD("record_step", 0.005, 1e-5, 1, true), PB("save", false, true),
-            PI("save_slot", 1, 1, 99, true)},
-           "teach", envp);
+  r = Make(&teach, "teach", "teach", kMs, envp);
   if (r != 0) RemoveDir(dir);
   CHECK(r == 0, "teach: %d", r);
   Q q;
@@ -841,7 +841,7 @@ void CaseTeachReplay() {
     worst_rec = std::max(worst_rec, best);
   }
   // Replay: trajectory with the saved program, no joint_state bound: starts at `start`.
-  r = Make(&traj, "trajectory", kMs, {{"joint_ref", kRefT}, {"tool_id", kSampleT}}, TrajectoryParams(), "trajectory", envp);
+  r = Make(&traj, "trajectory", "trajectory", kMs, envp);
   RemoveDir(dir);
   CHECK(worst_rec < 1e-4, "a waypoint is %.5f rad from the taught path", worst_rec);
   CHECK(r == 0, "trajectory: %d", r);
@@ -896,7 +896,7 @@ void CaseTeachReplay() {
 // a tool holds without a fresh guard; bundles/tool-gripper/native/tests/test_tools.c).
 void CaseTools() {
   static struct arflex_host script, grip, spin, traj;
-  int r = Make(&script, "script", kMs, {{"command", kSampleT}, {"safety", kST}}, {}, nullptr);
+  int r = MakeScript(&script, {{"command", kSampleT}, {"safety", kST}});
   CHECK(r == 0, "script: %d", r);
   struct arflex_safety_state guard;
   memset(&guard, 0, sizeof(guard));
@@ -913,8 +913,7 @@ void CaseTools() {
   speak();
   // The consumer the cell has: trajectory's tool input, bound to each tool in turn (the
   // DRCR's rebinding); its tool_id output tells which tool lin motions are planned for.
-  r = Make(&traj, "trajectory", kMs, {{"joint_ref", kRefT}, {"tool_id", kSampleT}}, TrajectoryParams(),
-           "trajectory");
+  r = Make(&traj, "trajectory", "trajectory", kMs);
   CHECK(r == 0 && arflex_host_start(&traj, kCall) == 0, "trajectory: %d", r);
   Reader tid;
   CHECK(tid.Open(&traj, "tool_id", &kSampleT) == 0, "open tool_id");
@@ -927,10 +926,7 @@ void CaseTools() {
   const char* exes[2] = {"tool-gripper", "tool-spindle"};
   const uint32_t ids[2] = {1, 2};
   for (int i = 0; i < 2; ++i) {
-    r = Make(tools[i], exes[i] + 5, kMs, {{"tool", kToolT}},
-             {PD("command", 0, 0, 1, true), PD("rate", 2, 0.01, 100, true),
-              PD("safety_max_age_ms", 1000, 2, 1000, true)},
-             exes[i]);
+    r = Make(tools[i], exes[i] + 5, exes[i], kMs, nullptr, {{"safety_max_age_ms", 1000}});
     CHECK(r == 0, "%s: %d", exes[i], r);
     CHECK(arflex_host_bind(tools[i], "command", arflex_host_output_name(&script, "command"), kCall) == 0, "bind");
     speak();
@@ -980,10 +976,9 @@ void CaseTools() {
 // keeps what the valid values gave; a valid value afterwards is used again.
 void CaseInvalidInput() {
   static struct arflex_host script, traj;
-  int r = Make(&script, "script", kMs, {{"joint_state", kJsT}, {"tool", kToolT}}, {}, nullptr);
+  int r = MakeScript(&script, {{"joint_state", kJsT}, {"tool", kToolT}});
   CHECK(r == 0, "script: %d", r);
-  r = Make(&traj, "trajectory", kMs, {{"joint_ref", kRefT}, {"tool_id", kSampleT}}, TrajectoryParams(),
-           "trajectory");
+  r = Make(&traj, "trajectory", "trajectory", kMs);
   CHECK(r == 0, "create/spawn trajectory: %d", r);
   CHECK(arflex_host_set_param(&traj, "run", 0, nullptr, kCall) == 0, "run=0");  // idle: the output stays put
   Reader rd, tid;
@@ -1137,14 +1132,14 @@ void CaseBadProgram() {
   char* envp[] = {const_cast<char*>(env.c_str()), nullptr};
   bool ok = WriteText(arflex::cellkin::ProgramPath(dir, 2),
                       "arflex-program 1\nptp 0 0 0 0 0 0\nptp 0 0 0 0 0 7\n");
-  int r = ok ? Make(&bad, "bad", kMs, {{"joint_ref", kRefT}, {"tool_id", kSampleT}}, TrajectoryParams(), "trajectory", envp)
+  int r = ok ? Make(&bad, "bad", "trajectory", kMs, envp)
              : -EIO;
   RemoveDir(dir);
   CHECK(r == -ECHILD, "a bad program file was accepted (%d)", r);
   const int st = arflex_host_exit_status(&bad);
   CHECK(WIFEXITED(st) && WEXITSTATUS(st) == ARFLEX_EXIT_CONFIGURE, "exit status 0x%x", st);
   // No data dir: only program 0; START of program 5 is refused, program 0 starts.
-  r = Make(&good, "good", kMs, {{"joint_ref", kRefT}, {"tool_id", kSampleT}}, TrajectoryParams(), "trajectory");
+  r = Make(&good, "good", "trajectory", kMs);
   CHECK(r == 0, "spawn: %d", r);
   CHECK(SetI(&good, "program", 5) == 0, "set program 5");
   r = arflex_host_start(&good, kCall);
@@ -1156,11 +1151,12 @@ void CaseBadProgram() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 3) {
-    fprintf(stderr, "usage: %s <trajectory|program_switch|late_robot|invalid_input|bad_program|force_guard|teach_replay|tools> <bin dir>\n", argv[0]);
+  if (argc != 4) {
+    fprintf(stderr, "usage: %s <trajectory|program_switch|late_robot|invalid_input|bad_program|force_guard|teach_replay|tools> <bin dir> <bundles dir>\n", argv[0]);
     return 2;
   }
   bindir = argv[2];
+  bundlesdir = argv[3];
   snprintf(rid, sizeof(rid), "cell-%d", (int)getpid());
   const std::string c = argv[1];
   if (c == "trajectory") CaseTrajectory();

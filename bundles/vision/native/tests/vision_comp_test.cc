@@ -3,8 +3,13 @@
 // state) it writes itself, with synthetic frames of the board and the tool tags drawn through
 // the cell's camera model, spawns the vision component, binds it and reads tcp_pose.
 //
-//   vision_comp_test <case> <vision exe>      cases: pose, loss, invalid
+//   vision_comp_test <case> <vision exe> <contract>      cases: pose, loss, invalid
 //
+// The vision instance's ports, parameters, task type and safe mode come from the bundle's
+// contract (arflex_host_load_contract, docs/DECISIONS.md D32/D34). The harness's own choices:
+// a 20 ms period (the contract's 200 ms would make the cases ten times slower), SCHED_OTHER,
+// no mlock or cpu_dma_latency, no heartbeat watchdog. The feeder plays sim-camera-0..3 and
+// sim-robot: it is the test's own provider, not a component, and its segments are declared here.
 // Every case ends by checking that no /dev/shm or /dev/mqueue object of its runtime id and no
 // child process is left. Waits are on conditions with deadlines; nothing asserts on timing.
 #include <dirent.h>
@@ -20,6 +25,7 @@
 
 extern "C" {
 #include "arflex/host.h"
+#include "arflex/host_contract.h"
 #include "helper.h" /* rt-core test kit: leak checks */
 }
 #include "arflex_cellmodel/kinematics.h"
@@ -40,6 +46,7 @@ constexpr uint32_t kFrameBytes = ARFLEX_TYPE_IMAGE_FRAME_SIZE + kW * kH;
 constexpr uint32_t kFrameElem = ARFLEX_TYPE_IMAGE_FRAME_SIZE + ARFLEX_TYPE_IMAGE_FRAME_MAX_PAYLOAD;
 
 char rid[ARFLEX_ID_MAX + 1];
+const char* contract_xml;
 int failures = 0;
 
 #define CHECK(cond, ...)                                                        \
@@ -52,30 +59,6 @@ int failures = 0;
       goto out;                                                                 \
     }                                                                           \
   } while (0)
-
-arflex_param_slot ParamF64(const char* name, double def, double lo, double hi) {
-  arflex_param_slot s;
-  std::memset(&s, 0, sizeof(s));
-  std::snprintf(s.name, sizeof(s.name), "%s", name);
-  s.type = ARFLEX_PARAM_DOUBLE;
-  s.flags = ARFLEX_PARAM_MUTABLE;
-  s.min_bits = arflex_f64_bits(lo);
-  s.max_bits = arflex_f64_bits(hi);
-  s.default_bits = arflex_f64_bits(def);
-  return s;
-}
-
-arflex_param_slot ParamI64(const char* name, int64_t def) {
-  arflex_param_slot s;
-  std::memset(&s, 0, sizeof(s));
-  std::snprintf(s.name, sizeof(s.name), "%s", name);
-  s.type = ARFLEX_PARAM_INT64;
-  s.flags = ARFLEX_PARAM_MUTABLE;
-  s.min_bits = static_cast<uint64_t>(INT64_C(0));
-  s.max_bits = static_cast<uint64_t>(INT64_C(1000000));
-  s.default_bits = static_cast<uint64_t>(def);
-  return s;
-}
 
 arflex_ctl_config Config(uint64_t period_ns) {
   arflex_ctl_config c;
@@ -191,26 +174,25 @@ class Feeder {
   cv::Mat blank_[4], tagged_[4];
 };
 
+// The vision instance as its contract declares it, with the harness's period and flags.
 int MakeVision(arflex_host* h, const char* exe) {
-  arflex_param_slot p[6] = {ParamF64("fovy_deg", 50.0, 1.0, 170.0), ParamF64("tcp_x", 0.3, -1, 1),
-                            ParamF64("tcp_y", 0.0, -1, 1),         ParamF64("tcp_z", 0.0, -1, 1),
-                            ParamF64("roi_margin_px", 30.0, 0, 500), ParamI64("calibrate", 0)};
-  struct arflex_host_output out;
-  std::memset(&out, 0, sizeof(out));
-  out.port = "tcp_pose";
-  out.spec.method = ARFLEX_PORT_STATE;
-  out.spec.type = {ARFLEX_TYPE_POSE_NAME, 1, 0, ARFLEX_TYPE_POSE_SIZE};
-  out.spec.depth = 1;
+  static const arflex_host_type types[] = {ARFLEX_HOST_FRAME_TYPE(IMAGE_FRAME), ARFLEX_HOST_TYPE(JOINT_STATE),
+                                           ARFLEX_HOST_TYPE(POSE)};
+  static arflex_host_contract c;
+  char err[512];
+  int r = arflex_host_load_contract(&c, contract_xml, types, 3, err, sizeof(err));
+  if (r < 0) {
+    std::fprintf(stderr, "%s\n", err);
+    return r;
+  }
   arflex_host_opts o;
-  std::memset(&o, 0, sizeof(o));
-  o.runtime = rid;
-  o.instance = "vision";
-  o.config = Config(20 * kMs);
-  o.params = p;
-  o.nparams = 6;
-  o.outputs = &out;
-  o.noutputs = 1;
-  int r = arflex_host_create(h, &o);
+  arflex_host_contract_opts(&c, rid, "vision", &o);
+  o.config.period_ns = 20 * kMs;
+  o.config.deadline_ns = 20 * kMs;
+  o.config.priority = 0;
+  o.config.hb_timeout_ns = 0;
+  o.config.cfg_flags |= ARFLEX_CFG_NO_MLOCK | ARFLEX_CFG_NO_DMA_LATENCY;
+  r = arflex_host_create(h, &o);
   if (r < 0) return r;
   return arflex_host_spawn(h, exe, nullptr, nullptr);
 }
@@ -324,10 +306,11 @@ out:
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 3) {
-    std::fprintf(stderr, "usage: vision_comp_test <pose|loss|invalid> <vision exe>\n");
+  if (argc != 4) {
+    std::fprintf(stderr, "usage: vision_comp_test <pose|loss|invalid> <vision exe> <contract>\n");
     return 2;
   }
+  contract_xml = argv[3];
   std::snprintf(rid, sizeof(rid), "vct%d", static_cast<int>(getpid()));
   const std::string name = argv[1];
   if (name != "pose" && name != "loss" && name != "invalid") {

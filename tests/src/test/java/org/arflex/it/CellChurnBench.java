@@ -300,7 +300,7 @@ class CellChurnBench {
             }
             assertEquals("trajectory.loop = true", rt.cmd("arflex:set trajectory loop true"));
             monitorJar = rt.dir.resolve("debug-monitor-tcp.jar");
-            Jars.withContract(Path.of(System.getProperty("arflex.it.debugmon")), monitorJar,
+            Jars.withContract(Components.jar("debug-monitor"), monitorJar,
                     c -> c.replace("<bind component=\"sample-counter\" port=\"count\"/>",
                             "<bind component=\"tcp-correction\" port=\"error\"/>")
                             .replace("<bind component=\"sample-scaler\" port=\"y\"/>",

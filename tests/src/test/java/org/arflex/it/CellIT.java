@@ -19,8 +19,8 @@ import org.junit.jupiter.api.Test;
  */
 class CellIT {
 
-    static final Path COUNTER = Path.of(System.getProperty("arflex.it.counter"));
-    static final Path SCALER = Path.of(System.getProperty("arflex.it.scaler"));
+    static final Path COUNTER = Components.jar("sample-counter");
+    static final Path SCALER = Components.jar("sample-scaler");
     static final long T = 30_000;
 
     /** Waits until y = gain * x holds for a sample seen on both ports (data flows through the port). */

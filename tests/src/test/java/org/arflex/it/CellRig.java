@@ -28,24 +28,13 @@ final class CellRig {
 
     static final long T = 60_000;
 
-    /** A cell bundle jar: -Darflex.it.&lt;key&gt;, else bundles/&lt;dir&gt;/target/&lt;bsn&gt;-&lt;version&gt;.jar of this tree. */
-    static Path jar(String key, String dir, String bsn) {
-        String p = System.getProperty("arflex.it." + key);
-        if (p != null) {
-            return Path.of(p);
-        }
-        Path counter = CellIT.COUNTER; // bundles/sample-counter/target/org.arflex.samples.counter-V.jar
-        String version = counter.getFileName().toString().replace("org.arflex.samples.counter-", "");
-        return counter.getParent().getParent().getParent().resolve(dir).resolve("target").resolve(bsn + "-" + version);
-    }
-
-    static final Path SIM_ROBOT = jar("simrobot", "sim-robot", "org.arflex.sim.robot");
-    static final Path TRAJECTORY = jar("trajectory", "trajectory", "org.arflex.cell.trajectory");
-    static final Path FORCE_GUARD = jar("forceguard", "force-guard", "org.arflex.cell.forceguard");
-    static final Path TEACH = jar("teach", "teach", "org.arflex.cell.teach");
-    static final Path GRIPPER = jar("gripper", "tool-gripper", "org.arflex.cell.tool.gripper");
-    static final Path SPINDLE = jar("spindle", "tool-spindle", "org.arflex.cell.tool.spindle");
-    static final Path TCP_CORRECTION = jar("tcpcorrection", "tcp-correction", "org.arflex.cell.tcpcorrection");
+    static final Path SIM_ROBOT = Components.jar("sim-robot");
+    static final Path TRAJECTORY = Components.jar("trajectory");
+    static final Path FORCE_GUARD = Components.jar("force-guard");
+    static final Path TEACH = Components.jar("teach");
+    static final Path GRIPPER = Components.jar("tool-gripper");
+    static final Path SPINDLE = Components.jar("tool-spindle");
+    static final Path TCP_CORRECTION = Components.jar("tcp-correction");
 
     static void assertBuilt(Path... jars) {
         for (Path j : jars) {

@@ -63,7 +63,7 @@ final class CodeDoors implements AutoCloseable {
         this.rt = rt;
         Runtime.deleteTree(outside); // what an earlier run left
         this.outside = Files.createDirectories(outside);
-        Path counter = Path.of(System.getProperty("arflex.it.counter"));
+        Path counter = Components.jar("sample-counter");
         this.trusted = Files.copy(counter, Files.createDirectories(rt.dir.resolve("tools")).resolve("counter.jar"));
         this.evil = withExtraEntry(counter, outside.resolve("evil.jar"), null);
         http = HttpServer.create(new InetSocketAddress("127.0.0.1", 0), 0);
@@ -116,7 +116,7 @@ final class CodeDoors implements AutoCloseable {
                 "arflex:deploy " + extra.toUri() + " " + Jars.sha256(evil));
         freshInstall("deploy http:// with its right pin", "arflex:deploy " + url("/evil.jar") + " " + Jars.sha256(evil));
         // A bundle from the trusted folder whose manifest says where its updates come from.
-        Path withUl = withExtraEntry(Path.of(System.getProperty("arflex.it.counter")),
+        Path withUl = withExtraEntry(Components.jar("sample-counter"),
                 rt.dir.resolve("tools/counter-ul.jar"), url("/evil.jar"));
         updateOf(withUl, "felix update <id> (Bundle-UpdateLocation: http://)", id -> "felix:update " + id);
         updateOf(withUl, "update <id> (Bundle-UpdateLocation: http://)", id -> "update " + id);
@@ -234,7 +234,7 @@ final class CodeDoors implements AutoCloseable {
     static Attempt umask000(Path work) throws Exception {
         String door = "umask 000: writable cache, replaced RT executable";
         try (Runtime rt = new Runtime("attack-umask", null, true, "bundle,cell,tools", "000")) {
-            Path jar = Files.copy(Path.of(System.getProperty("arflex.it.counter")),
+            Path jar = Files.copy(Components.jar("sample-counter"),
                     Files.createDirectories(rt.dir.resolve("tools")).resolve("counter.jar"));
             long id = rt.installAndStart(jar);
             rt.awaitState("ACTIVE", CellIT.T, COMPONENT);

@@ -33,11 +33,8 @@ class DebugMonitorIT {
 
     static final Path COUNTER = CellIT.COUNTER;
     static final Path SCALER = CellIT.SCALER;
-    /** The debug-monitor bundle: -Darflex.it.debugmon, or next to the sample bundles in the tree. */
-    static final Path DEBUGMON = System.getProperty("arflex.it.debugmon") != null
-            ? Path.of(System.getProperty("arflex.it.debugmon"))
-            : COUNTER.getParent().getParent().getParent().resolve("debug-monitor").resolve("target")
-                    .resolve(COUNTER.getFileName().toString().replace("org.arflex.samples.counter", "org.arflex.debug.monitor"));
+    /** The debug-monitor bundle as built in this tree. */
+    static final Path DEBUGMON = Components.jar("debug-monitor");
     static final long T = 30_000;
     static final String[] PAIR = {"sample-counter", "sample-scaler"};
 

@@ -53,7 +53,7 @@ class DoorsIT {
             String out = rt.cmd("install " + outside.resolve("evil.jar").toUri());
             long evil = Long.parseLong(out.replaceAll("(?s).*Bundle ID: (\\d+).*", "$1"));
             rt.cmd("start " + evil);
-            Path scaler = java.nio.file.Files.copy(Path.of(System.getProperty("arflex.it.scaler")),
+            Path scaler = java.nio.file.Files.copy(Components.jar("sample-scaler"),
                     rt.dir.resolve("tools/scaler.jar"));
             long ok = rt.installAndStart(scaler);
             assertEquals("32", rt.cmd("(bundle " + ok + ") state").strip(), "a trusted bundle still starts");
@@ -70,7 +70,7 @@ class DoorsIT {
     @Test
     void forgedRequestsAndSquattedNamesChangeNothing() throws Exception {
         try (Runtime rt = new Runtime("mailbox-doors", null, true, "bundle,cell,tools")) {
-            Path jar = java.nio.file.Files.copy(Path.of(System.getProperty("arflex.it.counter")),
+            Path jar = java.nio.file.Files.copy(Components.jar("sample-counter"),
                     java.nio.file.Files.createDirectories(rt.dir.resolve("tools")).resolve("counter.jar"));
             MailboxDoors mb = new MailboxDoors(rt);
             mb.trySquat(jar);

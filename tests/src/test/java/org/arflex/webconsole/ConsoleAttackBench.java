@@ -56,7 +56,7 @@ class ConsoleAttackBench {
     @Test
     void attack() throws Exception {
         Path work = Path.of(System.getProperty("arflex.it.work", "target/it")).resolve("console-attack").toAbsolutePath();
-        Path counter = Path.of(System.getProperty("arflex.sample.counter"));
+        Path counter = org.arflex.it.Components.jar("sample-counter");
         try (RuntimeUnderTest r = new RuntimeUnderTest(work)) {
             rt = r;
             rt.awaitUp(Duration.ofSeconds(90));

@@ -84,7 +84,7 @@ final class RuntimeUnderTest implements AutoCloseable {
         // The debug monitor the console installs from its Debug page: where the assembly ships it
         // (tools/), from the freshly built bundle when the assembly does not carry one yet.
         Path tools = Files.createDirectories(runtimeDir.resolve("tools"));
-        String debugmon = System.getProperty("arflex.it.debugmon");
+        String debugmon = org.arflex.it.Components.jar("debug-monitor").toString();
         boolean shipped;
         try (Stream<Path> s = Files.list(tools)) {
             shipped = s.anyMatch(p -> p.getFileName().toString().startsWith("org.arflex.debug.monitor"));
@@ -99,8 +99,7 @@ final class RuntimeUnderTest implements AutoCloseable {
                 "org.osgi.service.http.port=" + port);
         // stage-url reads file: URLs only from configured folders: those of the sample bundles
         String stageDirs = String.join(",", Stream.of("counter", "scaler")
-                .map(w -> System.getProperty("arflex.sample." + w)).filter(v -> v != null && !v.isBlank())
-                .map(v -> Path.of(v).toAbsolutePath().normalize().getParent().toString()).distinct().toList());
+                .map(w -> org.arflex.it.Components.jar("sample-" + w).getParent().toString()).distinct().toList());
         props += "\narflex.console.stage.dirs=" + stageDirs + "\n";
         // The tests install cell bundles from the assembly they were copied from and from the
         // build: the code gate (D12) trusts those folders as it trusts the runtime's own.

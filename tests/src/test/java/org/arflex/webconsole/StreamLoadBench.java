@@ -56,8 +56,8 @@ class StreamLoadBench {
             Matcher m = Pattern.compile("data-csrf='([^']+)'").matcher(page.body());
             assertTrue(m.find(), "page carries the CSRF token");
             token = m.group(1);
-            install(Path.of(System.getProperty("arflex.sample.counter")).toAbsolutePath().normalize());
-            install(Path.of(System.getProperty("arflex.sample.scaler")).toAbsolutePath().normalize());
+            install(org.arflex.it.Components.jar("sample-counter").toAbsolutePath().normalize());
+            install(org.arflex.it.Components.jar("sample-scaler").toAbsolutePath().normalize());
 
             result.put("idle", window());
 

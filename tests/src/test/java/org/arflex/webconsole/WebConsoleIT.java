@@ -164,7 +164,7 @@ class WebConsoleIT {
     }
 
     private static Path sample(String which) {
-        Path p = Path.of(System.getProperty("arflex.sample." + which, "")).toAbsolutePath().normalize();
+        Path p = org.arflex.it.Components.jar("sample-" + which);
         assertTrue(Files.isRegularFile(p), "sample bundle " + which + " not built: " + p);
         return p;
     }
