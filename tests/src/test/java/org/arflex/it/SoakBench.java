@@ -127,6 +127,7 @@ class SoakBench {
                     Matcher m = p.matcher(l);
                     if (m.find()) {
                         maxStallMs = Math.max(maxStallMs, Long.parseLong(m.group(1)));
+                        System.out.println("soak: log " + l); // which stall, and when
                     }
                 }
             }
