@@ -15,6 +15,9 @@ final class Signals {
 
     /** As {@link #send}, for a process that may be gone already: true when it was signalled. */
     static boolean tryToSend(long pid, String sig) throws Exception {
+        if ("9".equals(sig)) { // SIGKILL from this JVM directly: no kill(1) to spawn first
+            return ProcessHandle.of(pid).map(ProcessHandle::destroyForcibly).orElse(false);
+        }
         Process p = new ProcessBuilder("kill", "-" + sig, Long.toString(pid)).inheritIO().start();
         return p.waitFor() == 0;
     }

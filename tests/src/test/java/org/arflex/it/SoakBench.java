@@ -51,6 +51,9 @@ class SoakBench {
     private final AtomicInteger cycles = new AtomicInteger();
     private volatile long maxShellMs;
     private long maxStallMs;
+    /** The bench's own full GCs (jcmd GC.run, for heap after GC): [start, end] wall time. */
+    private final List<java.time.LocalTime[]> forcedGcs = Collections.synchronizedList(new ArrayList<>());
+    private long maxForcedGcStallMs;
 
     /** The 1 kHz unrelated component. */
     private static Path counter1kHz() throws Exception {
@@ -126,8 +129,14 @@ class SoakBench {
                 for (Pattern p : new Pattern[] {SILENT, ACTOR}) {
                     Matcher m = p.matcher(l);
                     if (m.find()) {
-                        maxStallMs = Math.max(maxStallMs, Long.parseLong(m.group(1)));
-                        System.out.println("soak: log " + l); // which stall, and when
+                        long ms = Long.parseLong(m.group(1));
+                        if (p == SILENT && duringForcedGc(l, ms)) {
+                            maxForcedGcStallMs = Math.max(maxForcedGcStallMs, ms);
+                            System.out.println("soak: log (the bench's own full GC) " + l);
+                        } else {
+                            maxStallMs = Math.max(maxStallMs, ms);
+                            System.out.println("soak: log " + l); // which stall, and when
+                        }
                     }
                 }
             }
@@ -204,13 +213,32 @@ class SoakBench {
         return ms[0];
     }
 
+    /**
+     * True when a silence of @ms reported by @line (at the heartbeat round right after it
+     * ended, 100 ms slack for the round and the report) overlaps one of the bench's own full GCs.
+     */
+    private boolean duringForcedGc(String line, long ms) {
+        java.time.LocalTime end;
+        try {
+            end = java.time.LocalTime.parse(line.replace("err| ", "").split(" ", 2)[0]);
+        } catch (java.time.format.DateTimeParseException e) {
+            return false;
+        }
+        java.time.LocalTime start = end.minusNanos((ms + 100) * 1_000_000L);
+        synchronized (forcedGcs) {
+            return forcedGcs.stream().anyMatch(w -> !w[1].isBefore(start) && !w[0].isAfter(end));
+        }
+    }
+
     private static CellChurnBench.Snap snap(Runtime rt) {
         return CellChurnBench.Snap.of(rt.instance("sample-counter"), System.nanoTime());
     }
 
     /** Heap after a full GC (KB), threads and fds of the JVM; the cell's shm, mq and RT processes. */
     private void sample(Runtime rt, long jvm, String rid) throws Exception {
+        java.time.LocalTime gc0 = java.time.LocalTime.now();
         Jcmd.run(jvm, "GC.run");
+        forcedGcs.add(new java.time.LocalTime[] {gc0, java.time.LocalTime.now()});
         String info = Jcmd.run(jvm, "GC.heap_info");
         Matcher m = Pattern.compile("used (\\d+)K").matcher(info);
         long heapKb = m.find() ? Long.parseLong(m.group(1)) : -1;
@@ -290,6 +318,8 @@ class SoakBench {
                 ms(pct(d, 99)), ms(d.isEmpty() ? Double.NaN : d.get(d.size() - 1)), d.size());
         System.out.printf(Locale.ROOT, "soak: exit handled after p50 %s ms, p99 %s ms, max %s ms (the actor's queue)%n",
                 ms(pct(h, 50)), ms(pct(h, 99)), ms(h.isEmpty() ? Double.NaN : h.get(h.size() - 1)));
+        System.out.printf(Locale.ROOT, "soak: JVM silent in the bench's own full GCs (jcmd GC.run): max %d ms, not counted%n",
+                maxForcedGcStallMs);
         System.out.printf(Locale.ROOT, "soak: shell round trip   max %d ms (arflex:list behind the workers' Felix commands)%n",
                 maxShellMs);
         StringBuilder js = new StringBuilder();

@@ -224,7 +224,24 @@ public final class ProcessLauncher implements RtLauncher {
             this.ctl = ctl;
             this.mb = mb;
             this.supervisorPipe = supervisorPipe;
-            this.exit = process.onExit().thenApply(pr -> describe(pr.exitValue(), stopping));
+            this.exit = new CompletableFuture<>();
+            // Its own waiter, woken by the JDK's reaper (which waits in waitpid) directly:
+            // Process.onExit() would complete on the common fork-join pool (one thread on two
+            // cores), so an exit would wait behind whatever else that pool runs.
+            Thread waiter = new Thread(() -> {
+                int status;
+                while (true) {
+                    try {
+                        status = process.waitFor();
+                        break;
+                    } catch (InterruptedException e) {
+                        // not ours to stop: the process is what ends this thread
+                    }
+                }
+                exit.complete(describe(status, stopping));
+            }, "arflex-exit-" + inst);
+            waiter.setDaemon(true);
+            waiter.start();
         }
 
         void pumpOutput(Consumer<String> log) {
