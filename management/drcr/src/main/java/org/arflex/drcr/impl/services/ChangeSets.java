@@ -117,7 +117,10 @@ public final class ChangeSets implements ChangeSetService {
         // the bundles behind the named components, before the set (an uninstalled one leaves the cell)
         java.util.Map<String, Long> bundleIds = new java.util.HashMap<>();
         for (String[] a : parsed) {
-            cell.instance(a[1]).ifPresent(i -> bundleIds.put(a[1], i.bundleId));
+            Instance i = find(a[1]);
+            if (i != null) {
+                bundleIds.put(a[1], i.bundleId);
+            }
         }
         ChangeSet set;
         try {
@@ -156,7 +159,7 @@ public final class ChangeSets implements ChangeSetService {
     }
 
     private Path executable(String name) {
-        Instance inst = cell.instance(name).orElse(null);
+        Instance inst = find(name);
         Bundle bundle = inst == null || context == null ? null : context.getBundle(inst.bundleId);
         if (bundle == null) {
             return Path.of("/nonexistent/" + name); // the cell refuses the set and says why
@@ -187,7 +190,7 @@ public final class ChangeSets implements ChangeSetService {
             if (a[0].equals("set")) {
                 continue;
             }
-            Instance inst = cell.instance(a[1]).orElse(null);
+            Instance inst = find(a[1]);
             if (inst == null) {
                 continue; // the cell says so
             }
@@ -240,6 +243,11 @@ public final class ChangeSets implements ChangeSetService {
             }
         }
         return sb.toString();
+    }
+
+    /** The instance of that name, looked up on the actor (which alone changes the registry). */
+    private Instance find(String name) {
+        return cell.actor().call(() -> cell.instance(name).orElse(null), Services.CALL_MS);
     }
 
     private static ChangeSetDTO dto(List<String> actions, ChangeSetResult r) {
