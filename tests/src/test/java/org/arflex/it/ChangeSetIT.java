@@ -53,6 +53,15 @@ class ChangeSetIT {
         return CellRig.maxDiff(b.q(), a.q()) / cycles;
     }
 
+    @SuppressWarnings("unchecked")
+    static java.util.Map<String, Object> stats(Runtime rt, String name) {
+        return (java.util.Map<String, Object>) rt.instance(name).get("stats");
+    }
+
+    static long delta(java.util.Map<String, Object> a, java.util.Map<String, Object> b, String field) {
+        return ((Number) b.get(field)).longValue() - ((Number) a.get(field)).longValue();
+    }
+
     @Test
     void teachReplacesTrajectoryOnTheMovingArmWithoutSafeStopOrReset() throws Exception {
         CellRig.assertBuilt(CellRig.SIM_ROBOT, CellRig.TRAJECTORY, CellRig.FORCE_GUARD, CellRig.TEACH);
@@ -68,6 +77,15 @@ class ChangeSetIT {
             assertTrue(dry.contains("START    teach") && dry.contains("STOP     trajectory")
                     && dry.contains("REBIND   tcp-correction"), dry);
             assertEquals("INSTALLED", rt.state("teach"), "a dry run changes nothing");
+            // teach beside trajectory would make tcp-correction's reference ambiguous and stop it:
+            // the set is refused whole, naming the component, and nothing is spawned
+            String refused = rt.cmd("arflex:change apply install teach");
+            System.out.println("ChangeSetIT: refused:\n" + refused);
+            assertTrue(refused.startsWith("error: change set: install teach\nrefused: the set would stop 'tcp-correction'"),
+                    refused);
+            assertEquals("INSTALLED", rt.state("teach"));
+            assertTrue(Runtime.rtProcesses(rt.rid).stream().noneMatch(p -> p.contains("--instance teach ")));
+            assertFalse(java.nio.file.Files.exists(rt.segment("teach", "joint_ref")), "no segment of a refused set");
 
             long robotPid = rt.pid("sim-robot");
             long guardPid = rt.pid("force-guard");
@@ -90,6 +108,7 @@ class ChangeSetIT {
                         () -> FailSafeIT.moving(js) && ref.size() > 1000);
                 assertTrue(CellRig.awaitingReset(rt).isEmpty(), "before: " + CellRig.awaitingReset(rt));
 
+                java.util.Map<String, Object> robot0 = stats(rt, "sim-robot");
                 int mark = ref.size();
                 int logMark = rt.logMark();
                 int jsMark = js.size();
@@ -179,6 +198,12 @@ class ChangeSetIT {
                 assertEquals(List.of(), CellRig.awaitingReset(rt));
                 assertEquals(List.of(), CellRig.awaitingCommand(rt));
                 assertNull(FailSafeIT.holding(rt, "sim-robot"));
+                java.util.Map<String, Object> robot1 = stats(rt, "sim-robot");
+                System.out.printf(Locale.ROOT, "ChangeSetIT: sim-robot from the apply to 2000 references after: "
+                        + "%d cycles, %d overruns, %d safe cycles, %d update errors%n",
+                        delta(robot0, robot1, "cycles"), delta(robot0, robot1, "overruns"),
+                        delta(robot0, robot1, "safeCycles"), delta(robot0, robot1, "updateErrors"));
+                assertEquals(0, delta(robot0, robot1, "safeCycles"), "sim-robot ran safe cycles");
             }
             rt.awaitState("ACTIVE", T, "teach", "tcp-correction", "sim-robot", "force-guard");
             assertEquals(robotPid, rt.pid("sim-robot"));
