@@ -247,6 +247,30 @@ class CellChangeSetTest {
     }
 
     @Test
+    void aCellThatChangedWhileTheSetWasPreparedIsNotSwitchedAndTheChangeStands() throws Exception {
+        runningCell();
+        held.add("new");
+        CompletableFuture<ChangeSetResult> f = actor.call(() -> cell.applyChangeSet(replaceOldByNew()), 0);
+        actor.runAll();
+        // meanwhile a second provider with role=src is installed the ordinary way: user's input
+        // is ambiguous and user stops (the planner's rule), so the set's plan is not the one shown
+        install(contract("rival", "src", OUT, "50us"));
+        rig.stepUntil("user stopped by the ambiguity", () -> rig.state("user") != State.ACTIVE);
+        release.countDown();
+        rig.stepUntil("the change set's outcome", f::isDone);
+        ChangeSetResult r = f.join();
+        assertFalse(r.applied());
+        assertTrue(r.refusal().startsWith("preparation failed, nothing changed: the cell changed while the set was prepared"),
+                r.refusal());
+        rig.stepUntil("new's prepared half stopped", () -> !fake.running.containsKey("new")
+                && !fake.openOutputs.containsKey("/arflex.t.new.out.y"));
+        assertFalse(fake.events.contains("new START"), fake.events::toString);
+        assertEquals(Set.of("old", "rival"), cell.planner().active());
+        assertEquals(State.ACTIVE, rig.state("old"));
+        assertEquals(State.INSTALLED, rig.state("new"));
+    }
+
+    @Test
     void aPreparedHalfThatExitsBeforeTheSwitchTearsTheSetDown() throws Exception {
         runningCell();
         register(contract("new2", null, OUT.replace("\"y\"", "\"w\""), "50us"));
