@@ -122,6 +122,11 @@ public final class ChangeSets implements ChangeSetService {
                 bundleIds.put(a[1], i.bundleId);
             }
         }
+        // refused sets are refused before anything is extracted from a bundle
+        ChangeSetResult dry = cell.actor().call(() -> cell.planChangeSet(build(parsed, false)), Services.CALL_MS);
+        if (!dry.admitted()) {
+            return dto(actions, dry);
+        }
         ChangeSet set;
         try {
             set = build(parsed, true);
