@@ -35,6 +35,14 @@ namespace {
 
 using arflex::cellkin::Q;
 constexpr size_t kMaxPoints = 20000;
+// Taking over a moving arm (docs/DECISIONS.md D35: teach replaces trajectory while the arm
+// moves): the reference starts at the measured joints and, from the measured joint speeds,
+// ramps the speed down to zero over kTakeoverStopS (trajectory's default stop_time), along the
+// path the arm was on. Holding the first measured pose at once would leave the stop to the
+// servo, which brakes a 0.2 rad/s base joint hard enough for the force guard to read 800 N and
+// latch a protective stop (ChangeSetIT, before this). An arm slower than kRestSpeed is at rest.
+constexpr double kTakeoverStopS = 0.3;
+constexpr double kRestSpeed = 1e-3;
 
 struct State {
   arflex::cellkin::Model model;
@@ -50,6 +58,8 @@ struct State {
   bool have_js = false, have_w = false, initialized = false;
   bool teach_prev = false, save_prev = false;
   Q q_ref = Q::Zero();
+  Q brake_v0 = Q::Zero();        // measured joint speeds when the reference was taken over
+  double brake_t = kTakeoverStopS;  // time into the take-over ramp; >= kTakeoverStopS: none
   Eigen::Vector3d x = Eigen::Vector3d::Zero(), v = Eigen::Vector3d::Zero();
   Eigen::Matrix3d r_hold = Eigen::Matrix3d::Identity();
   uint64_t seq = 0;
@@ -204,7 +214,11 @@ int Update(struct arflex_component* c, void*, uint64_t release_ns) {
   if (arflex_input_state_read(g.in_w, &g.w, sizeof(g.w), nullptr) == 1) g.have_w = true;
   if (!g.initialized) {
     if (!g.have_js) return 0;  // nothing is commanded before the arm's position is known
-    for (int j = 0; j < 6; ++j) g.q_ref[j] = g.js.q[j];
+    for (int j = 0; j < 6; ++j) {
+      g.q_ref[j] = g.js.q[j];
+      g.brake_v0[j] = g.js.qd[j];
+    }
+    g.brake_t = g.brake_v0.cwiseAbs().maxCoeff() > kRestSpeed ? 0.0 : kTakeoverStopS;
     g.initialized = true;
   }
   if (arflex_input_state_read(g.in_safety, &g.safety, sizeof(g.safety), nullptr) == 1)
@@ -215,7 +229,14 @@ int Update(struct arflex_component* c, void*, uint64_t release_ns) {
   const bool stopped = arflex_input_bound(g.in_safety) &&
                        (!g.have_safety || g.safety.mode == ARFLEX_SAFETY_STATE_MODE_PROTECTIVE_STOP);
   const double dt = arflex_component_ctl(c)->config.period_ns * 1e-9;
-  const bool teach = arflex_param_bool(c, g.p_teach);
+  if (g.brake_t < kTakeoverStopS) {
+    // Bringing a moving arm to rest (see kTakeoverStopS); a protective stop ends it where it is
+    // (the robot makes its own stop); teach mode begins once the arm is at rest.
+    g.brake_t = stopped ? kTakeoverStopS : g.brake_t + dt;
+    const double s = std::max(0.0, 1.0 - g.brake_t / kTakeoverStopS);
+    if (!stopped) g.q_ref += g.brake_v0 * (s * dt);
+  }
+  const bool teach = arflex_param_bool(c, g.p_teach) && g.brake_t >= kTakeoverStopS;
   if (teach && !g.teach_prev) {
     // Teach mode begins: a new recording from here, holding the orientation.
     const Eigen::Isometry3d t = g.model.Tcp(g.q_ref);

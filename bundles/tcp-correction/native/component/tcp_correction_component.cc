@@ -29,6 +29,17 @@
 //     correction stays where it is, it is neither updated nor dropped).
 //   joint_state: not finite -> the robot's position is unknown: measurements are held as by the
 //     tracking interlock until a valid joint state comes.
+//
+// Bumpless transfer (docs/DECISIONS.md D35): when the reference input gets another provider
+// (arflex_input_binding changes: a change set replaced the motion source, e.g. teach for
+// trajectory on the moving arm), the first value from the new provider is not taken as a step.
+// The difference between the reference written last (old provider, with any blend still in
+// progress) and the new value is added to the new reference and faded out over kBlendSeconds
+// with a quintic (zero speed and acceleration at both ends), as sim-robot takes up an acquired
+// reference (D9). A robot on a stiff servo turns a reference step into a torque step: the 6 mrad
+// by which the moving arm lags trajectory's reference was read as 770 N by the force guard
+// (ChangeSetIT). Only differences up to kBlendMaxOffset are faded; a larger one (a provider
+// somewhere else entirely) is passed on as before, for the robot's own acquisition to judge.
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -45,6 +56,9 @@ extern "C" {
 #include "arflex_types/sample.h"
 
 namespace {
+
+constexpr double kBlendSeconds = 0.5;
+constexpr double kBlendMaxOffset = 0.05;  // rad, any joint: sim-robot's ref_acquire_tol default
 
 using arflex::tcpcorr::CorrectionLaw;
 using arflex::tcpcorr::CorrectionOptions;
@@ -69,12 +83,22 @@ struct TcpCorrection {
   uint64_t error_seq = 0;
   double last_out[6] = {0, 0, 0, 0, 0, 0};  // the corrected reference written last
   arflex_joint_state js{};                   // the robot's newest joint state (seq 0: none)
+  uint32_t ref_binding = 0;  // binding of the reference input the last value came through
+  double blend_offset[6] = {0, 0, 0, 0, 0, 0};  // faded out after a provider change
+  double blend_t = kBlendSeconds;               // s since that change; >= kBlendSeconds: none
   bool ref_invalid = false;  // the newest reference was rejected: the output holds
   bool js_invalid = false;   // the newest joint state was rejected: measurements are held
   double dt = 0.001;
 };
 
 TcpCorrection g;
+
+// What is left of a blend's offset now: 1 - s(u), s the quintic 10u^3 - 15u^4 + 6u^5.
+double BlendRest() {
+  if (g.blend_t >= kBlendSeconds) return 0.0;
+  const double u = g.blend_t / kBlendSeconds;
+  return 1.0 - u * u * u * (10.0 - 15.0 * u + 6.0 * u * u);
+}
 
 const arflex_port_type kRefType = {ARFLEX_TYPE_JOINT_REF_NAME, 1, 0, ARFLEX_TYPE_JOINT_REF_SIZE};
 const arflex_port_type kPoseType = {ARFLEX_TYPE_POSE_NAME, 1, 0, ARFLEX_TYPE_POSE_SIZE};
@@ -149,6 +173,8 @@ int Start(arflex_component* c, void*) {
   g.law = CorrectionLaw(g.law.options());
   ApplyParams(c);
   g.have_ref = false;
+  g.ref_binding = 0;
+  g.blend_t = kBlendSeconds;
   g.ref_invalid = false;
   g.js_invalid = false;
   g.js = arflex_joint_state{};
@@ -168,6 +194,23 @@ int Update(arflex_component* c, void*, uint64_t) {
       arflex_input_reject(g.reference);
       err = -EINVAL;  // never passed on: the output holds (below)
     } else {
+      const uint32_t binding = arflex_input_binding(g.reference);
+      if (g.have_ref && g.ref_binding != 0 && binding != g.ref_binding) {
+        // Another provider: fade the difference out (see the file comment).
+        const double rest = BlendRest();
+        double offset[6], biggest = 0;
+        for (int i = 0; i < 6; ++i) {
+          offset[i] = g.ref.q[i] + g.blend_offset[i] * rest - ref.q[i];
+          biggest = std::max(biggest, std::abs(offset[i]));
+        }
+        if (std::isfinite(biggest) && biggest <= kBlendMaxOffset) {
+          for (int i = 0; i < 6; ++i) g.blend_offset[i] = offset[i];
+          g.blend_t = 0;
+        } else {
+          g.blend_t = kBlendSeconds;
+        }
+      }
+      g.ref_binding = binding;
       g.ref = ref;
       g.have_ref = true;
     }
@@ -186,8 +229,11 @@ int Update(arflex_component* c, void*, uint64_t) {
     const int w = arflex_state_write(g.out, &out, sizeof(out));
     return w < 0 ? w : err;
   }
+  // The reference part of the output: the newest reference plus what is left of a blend.
+  const double rest = BlendRest();
+  if (g.blend_t < kBlendSeconds) g.blend_t += g.dt;
   arflex::cellmodel::JointVector q;
-  for (int i = 0; i < 6; ++i) q[i] = g.ref.q[i];
+  for (int i = 0; i < 6; ++i) q[i] = g.ref.q[i] + g.blend_offset[i] * rest;
   arflex_joint_state js{};
   if (arflex_input_state_read(g.robot, &js, sizeof(js), nullptr) == 1 && js.seq != 0) {
     g.js_invalid = !arflex_joint_state_valid(&js);
@@ -244,7 +290,7 @@ int Update(arflex_component* c, void*, uint64_t) {
   }
   const arflex::tcpcorr::Vector6d& dq = g.law.Tick(g.dt);
   arflex_joint_ref out = g.ref;
-  for (int i = 0; i < 6; ++i) out.q[i] = g.ref.q[i] + dq(i);
+  for (int i = 0; i < 6; ++i) out.q[i] = q[i] + dq(i);
   out.seq = ++g.out_seq;
   arflex_sample size{};
   size.seq = out.seq;

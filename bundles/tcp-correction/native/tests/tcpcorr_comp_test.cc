@@ -3,7 +3,7 @@
 // the plant: the measured TCP is the nominal TCP of the corrected output, shifted by a fixed
 // error (what the true arm does differently from the nominal model).
 //
-//   tcpcorr_comp_test <case> <tcp-correction exe> <contract>     cases: converge, hold, invalid
+//   tcpcorr_comp_test <case> <tcp-correction exe> <contract>   cases: converge, hold, invalid, switch
 //
 // The corrector's ports, parameters (max_rate, max_sigma, track_tol, orientation, ... with
 // their defaults), period and safe mode come from the bundle's contract
@@ -80,7 +80,8 @@ const arflex::cellmodel::JointVector kRef = {0.2, 0.5, 0.3, 0.1, 0.8, -0.2};
 const Eigen::Vector3d kPlantError(1.2e-3, -0.8e-3, 0.6e-3);  // true arm vs nominal, at the TCP
 
 struct Rig {
-  arflex_host feeder{}, corr{};
+  arflex_host feeder{}, corr{}, feeder2{};
+  bool feeder2_made = false;
   arflex_port out{}, err_out{}, size_out{};
   bool out_open = false, err_open = false, size_open = false;
   double first_error_mm = -1;  // the first value of the `error` output
@@ -172,6 +173,7 @@ struct Rig {
     if (size_open) arflex_port_close(&size_out);
     arflex_host_destroy(&corr);
     arflex_host_destroy(&feeder);
+    if (feeder2_made) arflex_host_destroy(&feeder2);
   }
 
   // Reads the newest output; checks that it never jumps. Returns true on a new value.
@@ -406,6 +408,70 @@ int RunCase(const std::string& name, const char* exe) {
     }
     printf("invalid: %llu invalid values counted as update errors\n", (unsigned long long)rig.Errors());
   }
+  if (name == "switch") {
+    // Bumpless transfer (D35): the reference input moves to another provider whose value is
+    // 10 mrad away on joint 0: the output takes the new value over 0.5 s, never by a step; a
+    // provider 200 mrad away is passed on at once (not faded: the robot's acquisition judges).
+    rig.Watch(200 * kMs, false, true, Eigen::Vector3d::Zero());  // the correction's ramp done
+    const arflex_joint_ref before = rig.last;
+    const double excess = rig.max_jump_excess;
+    struct arflex_host_output fo;
+    std::memset(&fo, 0, sizeof(fo));
+    fo.port = "reference";
+    fo.spec.method = ARFLEX_PORT_STATE;
+    fo.spec.type = {ARFLEX_TYPE_JOINT_REF_NAME, 1, 0, ARFLEX_TYPE_JOINT_REF_SIZE};
+    fo.spec.depth = 1;
+    arflex_host_opts o;
+    std::memset(&o, 0, sizeof(o));
+    o.runtime = rid;
+    o.instance = "feeder2";
+    o.config = Config();
+    o.outputs = &fo;
+    o.noutputs = 1;
+    CHECK(arflex_host_create(&rig.feeder2, &o) == 0, "feeder2");
+    rig.feeder2_made = true;
+    arflex_joint_ref ref2;
+    std::memset(&ref2, 0, sizeof(ref2));
+    ref2.t_ns = 1;
+    ref2.seq = 1;
+    for (int i = 0; i < 6; ++i) ref2.q[i] = kRef[i] + (i == 0 ? 0.01 : 0.0);
+    arflex_state_write(arflex_host_output(&rig.feeder2, "reference"), &ref2, sizeof(ref2));
+    CHECK(arflex_host_bind(&rig.corr, "reference", arflex_host_output_name(&rig.feeder2, "reference"), 2 * kSec) == 0,
+          "BIND reference to feeder2");
+    double worst = 0;  // the largest output step per cycle, any joint
+    {
+      arflex_joint_ref prev = rig.last;
+      const uint64_t end = arflex_sys_now_ns() + 800 * kMs;
+      while (arflex_sys_now_ns() < end) {
+        if (!rig.Read()) continue;
+        const double cycles = static_cast<double>(rig.last.seq - prev.seq);
+        for (int i = 0; i < 6; ++i) worst = std::max(worst, std::abs(rig.last.q[i] - prev.q[i]) / cycles);
+        prev = rig.last;
+      }
+    }
+    printf("switch: 10 mrad provider change, largest output step %.4f mrad per cycle\n", 1e3 * worst);
+    // the quintic's peak speed is 1.875 * 10 mrad / 0.5 s = 0.0375 mrad per 1 ms cycle
+    CHECK(worst < 0.05e-3, "a step of %.4f mrad per cycle after the provider change", 1e3 * worst);
+    CHECK(std::abs(rig.last.q[0] - before.q[0] - 0.01) < 1e-9, "joint 0 at %.9f, expected %.9f after the blend",
+          rig.last.q[0], before.q[0] + 0.01);
+    for (int i = 1; i < 6; ++i) CHECK(rig.last.q[i] == before.q[i], "joint %d moved", i);
+    // 200 mrad away: passed on at once
+    arflex_joint_ref far = ref2;
+    far.seq = 7;
+    far.q[0] = kRef[0] + 0.2;
+    arflex_state_write(arflex_host_output(&rig.feeder, "reference"), &far, sizeof(far));
+    CHECK(arflex_host_bind(&rig.corr, "reference", arflex_host_output_name(&rig.feeder, "reference"), 2 * kSec) == 0,
+          "BIND reference back to feeder");
+    {
+      const uint64_t deadline = arflex_sys_now_ns() + 20 * kSec;
+      bool there = false;
+      while (!there && arflex_sys_now_ns() < deadline) {
+        if (rig.Read()) there = std::abs(rig.last.q[0] - before.q[0] - 0.2) < 1e-9;
+      }
+      CHECK(there, "a provider 200 mrad away was not passed on (joint 0 at %.6f)", rig.last.q[0]);
+    }
+    rig.max_jump_excess = excess;  // the steps above are the references' own
+  }
   if (name == "hold") {
     // Vision drops out: invalid measurements far off are held, the output does not move.
     const arflex_joint_ref before = rig.last;
@@ -462,13 +528,13 @@ out:
 
 int main(int argc, char** argv) {
   if (argc != 4) {
-    std::fprintf(stderr, "usage: tcpcorr_comp_test <converge|hold|invalid> <tcp-correction exe> <contract>\n");
+    std::fprintf(stderr, "usage: tcpcorr_comp_test <converge|hold|invalid|switch> <tcp-correction exe> <contract>\n");
     return 2;
   }
   contract_xml = argv[3];
   std::snprintf(rid, sizeof(rid), "tcc%d", static_cast<int>(getpid()));
   const std::string name = argv[1];
-  if (name != "converge" && name != "hold" && name != "invalid") {
+  if (name != "converge" && name != "hold" && name != "invalid" && name != "switch") {
     std::fprintf(stderr, "tcpcorr_comp_test: unknown case '%s'\n", argv[1]);
     return 2;
   }

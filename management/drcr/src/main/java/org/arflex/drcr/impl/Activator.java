@@ -176,6 +176,8 @@ public final class Activator implements BundleActivator {
         regs.add(ctx.registerService(DrcrService.class, services, null));
         regs.add(ctx.registerService(UpdateService.class, services, null));
         regs.add(ctx.registerService(ResourceManager.class, rm[0], null));
+        org.arflex.drcr.impl.services.ChangeSets changeSets = new org.arflex.drcr.impl.services.ChangeSets(cell, ctx, log);
+        regs.add(ctx.registerService(org.arflex.drcr.ChangeSetService.class, changeSets, null));
         Hashtable<String, Object> shell = new Hashtable<>();
         shell.put("osgi.command.scope", Commands.SCOPE);
         shell.put("osgi.command.function", Commands.FUNCTIONS);
@@ -191,7 +193,7 @@ public final class Activator implements BundleActivator {
                     public String deploy(String location, String sha256) {
                         return installer.deploy(location, sha256);
                     }
-                }, (component, port) -> readPort(ctx, component, port), watch), shell));
+                }, (component, port) -> readPort(ctx, component, port), watch, changeSets), shell));
         // The runtime heartbeat is what keeps the RT halves out of safe mode: its thread runs at a
         // low SCHED_FIFO priority (below every component, above all ordinary load) so that a
         // busy machine cannot starve it past a 100 ms heartbeat timeout.
@@ -231,7 +233,7 @@ public final class Activator implements BundleActivator {
         }, HEARTBEAT_MS, HEARTBEAT_MS, TimeUnit.MILLISECONDS);
         ticker.scheduleAtFixedRate(() -> actor.submit(() -> rm[0].overruns(cell.sample())), SAMPLE_MS, SAMPLE_MS,
                 TimeUnit.MILLISECONDS);
-        tracker = new BundleTracker<>(ctx, ContractExtender.MASK, new ContractExtender(cell, reader, ctx,
+        ContractExtender extender = new ContractExtender(cell, reader, ctx,
                 new ContractExtender.Extractor() {
                     @Override
                     public java.nio.file.Path extract(java.nio.file.Path dir, String name, ContractExtender.Opener source)
@@ -243,7 +245,9 @@ public final class Activator implements BundleActivator {
                     public void forget(java.nio.file.Path exe) {
                         executables.forget(exe);
                     }
-                }, gateHook::refusal, log));
+                }, gateHook::refusal, log);
+        changeSets.executables(extender::executable);
+        tracker = new BundleTracker<>(ctx, ContractExtender.MASK, extender);
         tracker.open();
         log.accept("arflex: DRCR started, runtime id " + rid + ", cpus " + cpus + ", memory " + memory + ", network "
                 + network);

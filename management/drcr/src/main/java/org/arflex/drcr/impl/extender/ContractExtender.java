@@ -219,6 +219,22 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
         log.accept("arflex: " + why + ": destroyed " + names);
     }
 
+    /**
+     * For a change set (D35), off the actor: the executable of component {@code c} of a bundle
+     * that is installed but not started, once the code gate admitted the bundle (the same check
+     * and the same extraction as its start). When the set is switched the bundle is started and
+     * {@link Cell#install} adopts the component the set started.
+     *
+     * @throws IOException saying why the gate refused the bundle or the extraction failed
+     */
+    public Path executable(Bundle bundle, Contract c) throws IOException {
+        String refused = admission.refusal(bundle);
+        if (refused != null) {
+            throw new IOException(refused + "; its RT halves are not started");
+        }
+        return extract(bundle, c.executable());
+    }
+
     /** Copies an executable out of its bundle into a folder; returns where it is. */
     public interface Extractor {
         Path extract(Path dir, String name, Opener source) throws IOException;

@@ -65,6 +65,7 @@ public final class Cell {
     private final Starter starter;
     private final PlanExecutor plans;
     private final WcetMonitor wcet;
+    private final ChangeSetExecutor changeSets;
 
     /** A cell whose launches and stops run inline, on the caller (tests with a steppable actor). */
     public Cell(Config cfg, Actor actor, RtLauncher launcher, Planner planner, Consumer<String> log) {
@@ -92,6 +93,7 @@ public final class Cell {
                 planner, this::changed, this::resume);
         this.plans = new PlanExecutor(this, stops, segments, starter, log);
         this.wcet = new WcetMonitor(this, log);
+        this.changeSets = new ChangeSetExecutor(this, stops, segments, starter, plans, failures, log);
     }
 
     // Callbacks into parts built after the part that calls them (a crash re-plans, a plan's
@@ -275,6 +277,14 @@ public final class Cell {
         if (existing == null && !validName(c, bundleId)) {
             return false;
         }
+        if (existing != null && existing.planned && existing.contract == c && existing.life.target() == State.ACTIVE) {
+            // The bundle of a component a change set installed is started after the switch (D35):
+            // the component runs already with this very contract; only the extracted copy is new.
+            existing.executable = exe;
+            log.accept("arflex: " + c.name() + ": bundle " + bundleId + " started; the component was installed by a "
+                    + "change set and keeps running");
+            return true;
+        }
         boolean replace = existing != null && existing.planned;
         Plan plan;
         try {
@@ -404,6 +414,35 @@ public final class Cell {
         execute(p);
         changed();
         return p;
+    }
+
+    /**
+     * The dry run of a change set (D35): its plan and whether it is admitted whole, with the
+     * refusal naming the action and the component when not. Changes nothing.
+     *
+     * @return the text the shell prints, first line {@code change set: ...}, then
+     *         {@code refused: ...} or {@code admitted ...}, then the plan
+     */
+    public ChangeSetResult planChangeSet(ChangeSet set) {
+        actor.checkThread();
+        return ChangeSetResult.of(set, changeSets.plan(set));
+    }
+
+    /**
+     * Applies a change set all or nothing (D35): its new halves are prepared while the cell runs,
+     * then switched in one actor turn, then the old halves stop. Completes (on the actor) once
+     * switched, refused or torn down; when not applied nothing of the cell changed.
+     */
+    public CompletableFuture<ChangeSetResult> applyChangeSet(ChangeSet set) {
+        actor.checkThread();
+        CompletableFuture<ChangeSetResult> f = new CompletableFuture<>();
+        changeSets.apply(set, o -> f.complete(ChangeSetResult.of(set, o)));
+        return f;
+    }
+
+    /** Removes an instance from the registry (actor thread); a change set uninstalled it. */
+    void forget(Instance inst) {
+        instances.remove(inst.name, inst);
     }
 
     /** A dry run. */

@@ -23,16 +23,7 @@ final class Parameters {
     static String set(Instance inst, String param, String text) {
         String name = inst.name;
         Contract c = inst.contract;
-        int idx = -1;
-        for (int i = 0; i < c.properties().size(); i++) {
-            if (c.properties().get(i).name().equals(param)) {
-                idx = i;
-            }
-        }
-        if (idx < 0) {
-            throw new IllegalArgumentException(name + ": no parameter '" + param + "' (has "
-                    + c.properties().stream().map(PropertySpec::name).toList() + ")");
-        }
+        int idx = index(inst, param);
         PropertySpec p = c.properties().get(idx);
         long bits = Params.parse(p, text);
         RtHalf half = inst.half;
@@ -53,6 +44,31 @@ final class Parameters {
         v[idx] = applied;
         inst.params = v;
         return Params.format(p, applied);
+    }
+
+    /**
+     * Checks what {@link #set} would: the name, the value's type and range and, when the half
+     * will be running ({@code running}), the mutability. Changes nothing.
+     *
+     * @throws IllegalArgumentException as {@link #set}
+     */
+    static void check(Instance inst, String param, String text, boolean running) {
+        PropertySpec p = inst.contract.properties().get(index(inst, param));
+        Params.parse(p, text);
+        if ((running || inst.half != null || inst.launching) && !p.mutable()) {
+            throw new IllegalArgumentException(inst.name + "." + param + " is immutable while it runs (mutable=false)");
+        }
+    }
+
+    private static int index(Instance inst, String param) {
+        Contract c = inst.contract;
+        for (int i = 0; i < c.properties().size(); i++) {
+            if (c.properties().get(i).name().equals(param)) {
+                return i;
+            }
+        }
+        throw new IllegalArgumentException(inst.name + ": no parameter '" + param + "' (has "
+                + c.properties().stream().map(PropertySpec::name).toList() + ")");
     }
 
     /** Reads a parameter as applied (control block when running, configuration otherwise). */

@@ -128,19 +128,82 @@ final class Starter {
     /** The launch of {@code seq} ended (actor thread): finish it, or stop a half nobody wants. */
     private void launched(Instance inst, long seq, int cpu, long[] params, RtHalf half, Exception error, long t0,
                           long tLaunched) {
-        byName.computeIfPresent(inst.name, (k, n) -> n == 1 ? null : n - 1);
         try {
             record(inst, seq, cpu, params, half, error, t0, tLaunched);
         } finally {
-            List<CompletableFuture<Void>> done = List.of();
-            synchronized (this) {
-                if (--inFlight == 0) {
-                    done = List.copyOf(idleWaiters);
-                    idleWaiters.clear();
-                }
-            }
-            done.forEach(f -> f.complete(null));
+            landed(inst.name);
         }
+    }
+
+    /** Bookkeeping of a launch whose outcome is being recorded (actor thread). */
+    private void landed(String name) {
+        byName.computeIfPresent(name, (k, n) -> n == 1 ? null : n - 1);
+        List<CompletableFuture<Void>> done = List.of();
+        synchronized (this) {
+            if (--inFlight == 0) {
+                done = List.copyOf(idleWaiters);
+                idleWaiters.clear();
+            }
+        }
+        done.forEach(f -> f.complete(null));
+    }
+
+    /** Where a change set's launch reports (actor thread): the READY half, or why there is none. */
+    interface Prepared {
+        void ready(RtHalf half, Exception error, long spawnToReadyNs);
+    }
+
+    /**
+     * A change set's launch (D35): the output segments and the spawn request on the actor, the
+     * spawn and the wait for READY on the launch thread (one at a time, as every launch), the
+     * outcome back on the actor to {@code done}. The half is neither bound nor started and the
+     * instance is not touched otherwise: the change set starts it at its switch
+     * ({@link #activate}) or stops it. Counted as a launch: a start of the name waits for it and
+     * {@link #idle()} completes only after {@code done} ran.
+     */
+    void prepare(Instance inst, int cpu, Prepared done) {
+        Contract c = inst.contract;
+        RtLauncher.Spec spec;
+        try {
+            segments.ensure(inst);
+            spec = new RtLauncher.Spec(cfg.runtimeId(), inst.name, inst.executable,
+                    ControlSetup.config(c, cpu, cfg.noMlock()), ControlSetup.params(c, inst.params.clone()), false,
+                    cfg.readyTimeoutMs());
+        } catch (IOException | RuntimeException e) {
+            done.ready(null, e, 0);
+            return;
+        }
+        inst.launching = true;
+        byName.merge(inst.name, 1, Integer::sum);
+        synchronized (this) {
+            inFlight++;
+        }
+        long t0 = cfg.monotonicNs().getAsLong();
+        launches.execute(() -> {
+            RtHalf half = null;
+            Exception error = null;
+            try {
+                half = launcher.launch(spec);
+            } catch (IOException | RuntimeException e) {
+                error = e;
+            }
+            long took = cfg.monotonicNs().getAsLong() - t0;
+            RtHalf h = half;
+            Exception err = error;
+            Runnable back = () -> {
+                inst.launching = false;
+                try {
+                    done.ready(h, err, took);
+                } finally {
+                    landed(inst.name);
+                }
+            };
+            if (actor.inActor()) {
+                back.run();
+            } else {
+                actor.submit(back);
+            }
+        });
     }
 
     private void record(Instance inst, long seq, int cpu, long[] params, RtHalf half, Exception error, long t0,
@@ -174,9 +237,21 @@ final class Starter {
             changed.run();
             return;
         }
+        activate(inst, half, cpu, params, planner.current().wiringOf(inst.name), t0, tLaunched);
+    }
+
+    /**
+     * Makes a READY half the instance's running half (actor thread): a BIND per input of
+     * {@code wiring}, the parameters written since {@code params} were sent, the runtime
+     * heartbeat, START; then ACTIVE, watched, its exit to {@link Failures}. A refused command
+     * stops the half on a stop thread and fails the instance as a crash would.
+     *
+     * @return true when it runs
+     */
+    boolean activate(Instance inst, RtHalf half, int cpu, long[] params, List<Wire> wiring, long t0, long tLaunched) {
         try {
             inst.bound.clear();
-            for (Wire w : planner.current().wiringOf(inst.name)) {
+            for (Wire w : wiring) {
                 String seg = segments.name(w.provider(), w.outPort());
                 half.bind(w.inPort(), seg);
                 inst.bound.put(w.inPort(), seg);
@@ -194,7 +269,7 @@ final class Starter {
             stops.submit(List.of(new Stops.Going(inst, half, List.of(), 0, "start failed")));
             fail(inst, e);
             changed.run();
-            return;
+            return false;
         }
         Contract c = inst.contract;
         inst.half = half;
@@ -205,7 +280,7 @@ final class Starter {
         RtHalf h = half;
         String who = inst.name + " (pid " + half.pid() + ")";
         half.exit().thenAccept(ex -> {
-            if (!ex.requested()) { // seen now, on the reaper thread; the actor handles it next
+            if (!ex.requested()) { // seen now (its waiter thread, woken by the reaper); the actor handles it next
                 log.accept("arflex: " + who + " exit seen: " + ex.description());
             }
             actor.submit(() -> failures.onExit(inst, h, ex));
@@ -216,6 +291,7 @@ final class Starter {
         log.accept("arflex: " + inst.name + " ACTIVE (pid " + half.pid() + ", cpu " + cpu + ", inputs " + inst.bound
                 + "; spawn to READY " + (tLaunched - t0) / 1000 + " us, bind+start " + (t1 - tLaunched) / 1000 + " us)");
         changed.run();
+        return true;
     }
 
     private void fail(Instance inst, Exception e) {

@@ -6,6 +6,7 @@ import java.util.List;
 import java.util.Optional;
 import java.util.function.Function;
 import org.arflex.drcr.CellReset;
+import org.arflex.drcr.ChangeSetService;
 import org.arflex.drcr.ComponentManagement;
 import org.arflex.drcr.DrcrService;
 import org.arflex.drcr.ResourceManager;
@@ -30,7 +31,7 @@ public final class Commands {
     /** Service property values for the Gogo registration. */
     public static final String SCOPE = "arflex";
     public static final String[] FUNCTIONS = {"list", "info", "bindings", "get", "set", "plan", "update", "deploy",
-        "resources", "stats", "port", "reset", "dto", "summary", "await"};
+        "resources", "stats", "port", "reset", "dto", "summary", "await", "change"};
 
     private final DrcrService drcr;
     private final ResourceManager resources;
@@ -39,6 +40,7 @@ public final class Commands {
     private final BundleUpdater bundles;
     private final CellSummary.Ports ports;
     private final Readiness readiness;
+    private final ChangeSetService changeSets;
 
     /** Bundle installs and updates through the DRCR's fetch and code gate. */
     public interface BundleUpdater {
@@ -67,6 +69,14 @@ public final class Commands {
     public Commands(DrcrService drcr, ResourceManager resources, UpdateService updates,
                     Function<String, Optional<ComponentManagement>> management, BundleUpdater bundles,
                     CellSummary.Ports ports, CellWatch watch) {
+        this(drcr, resources, updates, management, bundles, ports, watch, null);
+    }
+
+    /** As above, with the change sets of {@code arflex:change} (D35). */
+    public Commands(DrcrService drcr, ResourceManager resources, UpdateService updates,
+                    Function<String, Optional<ComponentManagement>> management, BundleUpdater bundles,
+                    CellSummary.Ports ports, CellWatch watch, ChangeSetService changeSets) {
+        this.changeSets = changeSets;
         this.drcr = drcr;
         this.resources = resources;
         this.updates = updates;
@@ -190,6 +200,27 @@ public final class Commands {
                 return drcr.planCapacity(caps.cpus, caps.memory, caps.network);
             }
             return "usage: plan install <jar-url> | plan update <name> | plan uninstall <name> | plan [cpus <list>] [memory <bytes>] [network <B/s>]";
+        });
+    }
+
+    /**
+     * Change sets (D35): {@code change plan <actions>} is the dry run of the whole set,
+     * {@code change apply <actions>} applies it all or nothing; actions are
+     * {@code install <component>} (its bundle installed, not started), {@code uninstall <component>}
+     * and {@code set <component> <parameter> <value>}, in any number, e.g.
+     * {@code change apply install teach uninstall trajectory}.
+     */
+    public String change(String... args) {
+        return guard(() -> {
+            String usage = "usage: change plan|apply <action>... (actions: install <component>, uninstall <component>,"
+                    + " set <component> <parameter> <value>)";
+            if (changeSets == null || args.length < 2 || !(args[0].equals("plan") || args[0].equals("apply"))) {
+                return usage;
+            }
+            List<String> actions = List.of(Arrays.copyOfRange(args, 1, args.length));
+            org.arflex.drcr.dto.ChangeSetDTO d = args[0].equals("plan") ? changeSets.plan(actions)
+                    : changeSets.apply(actions);
+            return d.refusal != null ? "error: " + d.text.stripTrailing() : d.text.stripTrailing();
         });
     }
 

@@ -328,6 +328,15 @@ class CommandsTest {
     }
 
     @Test
+    void changeWithoutActionsPrintsItsUsage() {
+        String usage = "usage: change plan|apply <action>... (actions: install <component>, uninstall <component>,"
+                + " set <component> <parameter> <value>)";
+        assertEquals(usage, cmd.change());
+        assertEquals(usage, cmd.change("apply"));
+        assertEquals(usage, cmd.change("do", "install", "x"));
+    }
+
+    @Test
     void dtoIsOneLineOfValidJson() {
         String json = cmd.dto();
         assertFalse(json.contains("\n"), json);

@@ -1,0 +1,31 @@
+package org.arflex.drcr;
+
+import java.util.List;
+import org.arflex.drcr.dto.ChangeSetDTO;
+
+/**
+ * Change sets (docs/DECISIONS.md D35): several actions planned, admitted and applied together,
+ * all or nothing. An action is one of
+ * <ul>
+ * <li>{@code install <component>}: a component whose bundle is installed but not started (it
+ * shows as INSTALLED); the set starts it, and its bundle once the set is switched;</li>
+ * <li>{@code uninstall <component>}: a running component; the set stops it, and its bundle once
+ * the set is switched (the bundle must carry no other running component);</li>
+ * <li>{@code set <component> <parameter> <value>}: a parameter write, applied in the switch
+ * (or, for a component the set installs, before its RT half starts).</li>
+ * </ul>
+ * Rewiring follows from the plan. {@link #plan} is the dry run; {@link #apply} prepares the new RT
+ * halves while the cell runs and switches the consumers to them in one turn of the DRCR's actor.
+ */
+@org.osgi.annotation.versioning.ProviderType
+public interface ChangeSetService {
+
+    /** The plan of the whole set and whether it would be admitted; changes nothing. */
+    ChangeSetDTO plan(List<String> actions);
+
+    /**
+     * Applies the set, or refuses it whole (then nothing changed). Returns once switched,
+     * refused or torn down.
+     */
+    ChangeSetDTO apply(List<String> actions);
+}

@@ -1,0 +1,19 @@
+package org.arflex.drcr.dto;
+
+/** What planning or applying a change set gave (docs/DECISIONS.md D35). */
+public class ChangeSetDTO {
+    /** The actions, as given ({@code install teach}, {@code uninstall trajectory}, {@code set teach mass 30}). */
+    public String[] actions;
+    /** True when the whole set is admitted (a dry run that would apply, or an applied set). */
+    public boolean admitted;
+    /** True when the set was switched in. */
+    public boolean applied;
+    /** Why it was refused or torn down, naming the action and the component; null otherwise. */
+    public String refusal;
+    /** The text {@code arflex:change} prints: the set, the outcome, then the plan of the whole set. */
+    public String text;
+    /** From the start of the preparation to the switch, ms (0 for a dry run or a refusal). */
+    public double prepareMs;
+    /** The switch's actor turn, µs (0 for a dry run or a refusal). */
+    public double switchUs;
+}

@@ -1,0 +1,117 @@
+package org.arflex.drcr.impl.runtime;
+
+import java.nio.file.Path;
+import java.util.ArrayList;
+import java.util.List;
+import java.util.Objects;
+
+/**
+ * Several actions on the cell planned, admitted and applied together (docs/DECISIONS.md D35):
+ * installs of components that are known to the cell but not running (their bundle is installed,
+ * not started), uninstalls of running ones, and parameter writes. Rewiring follows from the plan.
+ * Immutable; build one with {@link #builder()}.
+ */
+public final class ChangeSet {
+
+    /** One action of a change set. */
+    public sealed interface Step {
+        /** The component it acts on. */
+        String component();
+
+        /** The action as it is written, e.g. {@code install teach}. */
+        String text();
+    }
+
+    /** Starts a component the cell knows as INSTALLED, running the executable {@code exe}. */
+    public record Install(String component, Path exe) implements Step {
+        public Install {
+            Objects.requireNonNull(component, "component");
+            Objects.requireNonNull(exe, "exe");
+        }
+
+        @Override
+        public String text() {
+            return "install " + component;
+        }
+    }
+
+    /** Removes a running (or planned) component. */
+    public record Uninstall(String component) implements Step {
+        public Uninstall {
+            Objects.requireNonNull(component, "component");
+        }
+
+        @Override
+        public String text() {
+            return "uninstall " + component;
+        }
+    }
+
+    /**
+     * Writes a parameter: for a component the set installs, before its half starts (an
+     * immutable one too); for a running one, in the switch.
+     */
+    public record Set(String component, String param, String value) implements Step {
+        public Set {
+            Objects.requireNonNull(component, "component");
+            Objects.requireNonNull(param, "param");
+            Objects.requireNonNull(value, "value");
+        }
+
+        @Override
+        public String text() {
+            return "set " + component + " " + param + " " + value;
+        }
+    }
+
+    private final List<Step> steps;
+
+    private ChangeSet(List<Step> steps) {
+        this.steps = List.copyOf(steps);
+    }
+
+    public static Builder builder() {
+        return new Builder();
+    }
+
+    public List<Step> steps() {
+        return steps;
+    }
+
+    /** The actions as written, separated by {@code ; }. */
+    public String describe() {
+        return String.join("; ", steps.stream().map(Step::text).toList());
+    }
+
+    @Override
+    public String toString() {
+        return describe();
+    }
+
+    /** Collects the steps of a change set. Not thread-safe. */
+    public static final class Builder {
+        private final List<Step> steps = new ArrayList<>();
+
+        private Builder() {
+        }
+
+        public Builder install(String name, Path exe) {
+            steps.add(new Install(name, exe));
+            return this;
+        }
+
+        public Builder uninstall(String name) {
+            steps.add(new Uninstall(name));
+            return this;
+        }
+
+        public Builder set(String name, String param, String value) {
+            steps.add(new Set(name, param, value));
+            return this;
+        }
+
+        public ChangeSet build() {
+            return new ChangeSet(steps);
+        }
+    }
+}

@@ -1,0 +1,20 @@
+package org.arflex.drcr.impl.runtime;
+
+/**
+ * What planning or applying a {@link ChangeSet} gave (D35).
+ *
+ * @param applied   true when the set was switched
+ * @param admitted  true when the whole set was admitted (a dry run that would apply it, or an applied set)
+ * @param refusal   why it was refused or torn down (null otherwise)
+ * @param text      the text the shell prints: the set, the outcome, the plan
+ * @param prepareMs from the start of preparation to the switch
+ * @param switchUs  the switch's actor turn
+ */
+public record ChangeSetResult(boolean applied, boolean admitted, String refusal, String text, double prepareMs,
+                              double switchUs) {
+
+    static ChangeSetResult of(ChangeSet set, ChangeSetExecutor.Outcome o) {
+        return new ChangeSetResult(o.applied(), o.refusal() == null, o.refusal(), o.text(set), o.prepareNs() / 1e6,
+                o.switchNs() / 1e3);
+    }
+}
