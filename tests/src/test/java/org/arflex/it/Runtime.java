@@ -120,7 +120,10 @@ final class Runtime implements AutoCloseable {
             command.addAll(List.of("sh", "-c", "umask " + umask + " && exec \"$@\"", "sh"));
         }
         command.addAll(List.of(Path.of(System.getProperty("java.home"), "bin", "java").toString(),
-                "-XX:+UseG1GC", "-XX:MaxGCPauseMillis=20", "-Darflex.runtime.id=" + rid, "-Darflex.nomlock=" + !mlock, "-Dorg.osgi.service.http.port=0",
+                "-XX:+UseG1GC", "-XX:MaxGCPauseMillis=20",
+                // the JVM's own pauses (GC, safepoints), in the runtime's folder, for whoever reads a stall
+                "-Xlog:gc,safepoint:file=jvm-pauses.log:time,uptime",
+                "-Darflex.runtime.id=" + rid, "-Darflex.nomlock=" + !mlock, "-Dorg.osgi.service.http.port=0",
                 "-Darflex.code.trusted=" + trusted));
         properties.forEach(p -> command.add("-D" + p));
         command.addAll(List.of("-jar", "bin/felix.jar"));

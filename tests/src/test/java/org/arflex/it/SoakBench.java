@@ -130,7 +130,7 @@ class SoakBench {
                     Matcher m = p.matcher(l);
                     if (m.find()) {
                         long ms = Long.parseLong(m.group(1));
-                        if (p == SILENT && duringForcedGc(l, ms)) {
+                        if (duringForcedGc(l, ms, p == SILENT ? 100 : 10)) {
                             maxForcedGcStallMs = Math.max(maxForcedGcStallMs, ms);
                             System.out.println("soak: log (the bench's own full GC) " + l);
                         } else {
@@ -214,17 +214,18 @@ class SoakBench {
     }
 
     /**
-     * True when a silence of @ms reported by @line (at the heartbeat round right after it
-     * ended, 100 ms slack for the round and the report) overlaps one of the bench's own full GCs.
+     * True when a stall of @ms reported by @line (a heartbeat round's silence, reported at the
+     * round after it, or an actor's wait, reported when it ends; @slackMs for the report)
+     * overlaps one of the bench's own full GCs.
      */
-    private boolean duringForcedGc(String line, long ms) {
+    private boolean duringForcedGc(String line, long ms, long slackMs) {
         java.time.LocalTime end;
         try {
             end = java.time.LocalTime.parse(line.replace("err| ", "").split(" ", 2)[0]);
         } catch (java.time.format.DateTimeParseException e) {
             return false;
         }
-        java.time.LocalTime start = end.minusNanos((ms + 100) * 1_000_000L);
+        java.time.LocalTime start = end.minusNanos((ms + slackMs) * 1_000_000L);
         synchronized (forcedGcs) {
             return forcedGcs.stream().anyMatch(w -> !w[1].isBefore(start) && !w[0].isAfter(end));
         }
@@ -318,7 +319,7 @@ class SoakBench {
                 ms(pct(d, 99)), ms(d.isEmpty() ? Double.NaN : d.get(d.size() - 1)), d.size());
         System.out.printf(Locale.ROOT, "soak: exit handled after p50 %s ms, p99 %s ms, max %s ms (the actor's queue)%n",
                 ms(pct(h, 50)), ms(pct(h, 99)), ms(h.isEmpty() ? Double.NaN : h.get(h.size() - 1)));
-        System.out.printf(Locale.ROOT, "soak: JVM silent in the bench's own full GCs (jcmd GC.run): max %d ms, not counted%n",
+        System.out.printf(Locale.ROOT, "soak: stalls in the bench's own full GCs (jcmd GC.run): max %d ms, not counted%n",
                 maxForcedGcStallMs);
         System.out.printf(Locale.ROOT, "soak: shell round trip   max %d ms (arflex:list behind the workers' Felix commands)%n",
                 maxShellMs);
