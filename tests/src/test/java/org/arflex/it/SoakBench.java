@@ -51,6 +51,8 @@ class SoakBench {
     private final AtomicInteger cycles = new AtomicInteger();
     private volatile long maxShellMs;
     private long maxStallMs;
+    private int frozenEvery;
+    private final AtomicInteger frozenDone = new AtomicInteger();
     /** The bench's own full GCs (jcmd GC.run, for heap after GC): [start, end] wall time. */
     private final List<java.time.LocalTime[]> forcedGcs = Collections.synchronizedList(new ArrayList<>());
     private long maxForcedGcStallMs;
@@ -67,6 +69,9 @@ class SoakBench {
         int kills = Integer.getInteger("arflex.bench.kills", 30);
         int threads = Math.max(1, Math.min(2, Integer.getInteger("arflex.bench.threads", 2)));
         int every = Math.max(1, Integer.getInteger("arflex.bench.every", Math.max(1, total / 10)));
+        // every N-th cycle of a worker: its half is SIGSTOPped and the bundle uninstalled (issue 17:
+        // the supervision must not stall while a frozen half is stopped); 0: never
+        frozenEvery = Integer.getInteger("arflex.bench.frozen", 10);
         Path[] churn = {CellIT.SCALER, DebugMonitorIT.DEBUGMON};
         String[] names = {"sample-scaler", "debug-monitor"};
         String rid;
@@ -94,8 +99,10 @@ class SoakBench {
             for (int w = 0; w < threads; w++) {
                 int k = w;
                 workers.add(pool.submit(() -> {
+                    int mine = 0;
                     while (cycles.get() < total) {
-                        cycle(rt, churn[k], names[k]);
+                        boolean frozen = frozenEvery > 0 && ++mine % frozenEvery == 0;
+                        cycle(rt, churn[k], names[k], frozen);
                         int c = cycles.incrementAndGet();
                         if (c % every == 0) {
                             sample(rt, jvm, rid);
@@ -151,10 +158,21 @@ class SoakBench {
     }
 
     /** One install -> update -> uninstall of one component. */
-    private void cycle(Runtime rt, Path jar, String name) {
+    private void cycle(Runtime rt, Path jar, String name, boolean frozen) throws Exception {
         long id = rt.installAndStart(jar);
         rt.awaitState("ACTIVE", T, name);
         long pid = rt.pid(name);
+        if (frozen && Signals.tryToSend(pid, "STOP")) {
+            // a frozen half answers nothing: the DRCR kills it after its shutdown deadline
+            String r = rt.cmd("uninstall " + id);
+            if (!r.isBlank()) {
+                throw new AssertionError("uninstall of a frozen half " + id + ": " + r);
+            }
+            rt.waitUntil(name + " (frozen) gone", T, () -> rt.instance(name) == null
+                    && ProcessHandle.of(pid).map(h -> !h.isAlive()).orElse(true));
+            frozenDone.incrementAndGet();
+            return;
+        }
         String u = rt.cmd("update " + id);
         if (!u.isBlank()) {
             throw new AssertionError("update " + id + ": " + u);
@@ -319,6 +337,8 @@ class SoakBench {
                 ms(pct(d, 99)), ms(d.isEmpty() ? Double.NaN : d.get(d.size() - 1)), d.size());
         System.out.printf(Locale.ROOT, "soak: exit handled after p50 %s ms, p99 %s ms, max %s ms (the actor's queue)%n",
                 ms(pct(h, 50)), ms(pct(h, 99)), ms(h.isEmpty() ? Double.NaN : h.get(h.size() - 1)));
+        System.out.printf(Locale.ROOT, "soak: frozen halves      %d SIGSTOPped and uninstalled (every %d-th cycle of a worker)%n",
+                frozenDone.get(), frozenEvery);
         System.out.printf(Locale.ROOT, "soak: stalls in the bench's own full GCs (jcmd GC.run): max %d ms, not counted%n",
                 maxForcedGcStallMs);
         System.out.printf(Locale.ROOT, "soak: shell round trip   max %d ms (arflex:list behind the workers' Felix commands)%n",
