@@ -133,6 +133,9 @@ class SoakBench {
             busy.add(b0, b1, periodNs, false);
             sample(rt, jvm, rid);
             for (String l : rt.logSince(0)) {
+                if (l.contains("rewiring failed") || l.contains("did not answer")) {
+                    System.out.println("soak: log " + l); // a half that did not take a command in time
+                }
                 for (Pattern p : new Pattern[] {SILENT, ACTOR}) {
                     Matcher m = p.matcher(l);
                     if (m.find()) {
