@@ -9,9 +9,11 @@ import java.util.Optional;
 /**
  * The manager side of rt-core/include/arflex/mailbox.h: the queue pair
  * {@code /arflex.<rid>.<inst>.cmd} (requests, manager to RT) and {@code .rsp} (replies), each
- * message one 512-byte struct arflex_msg. One request is outstanding at a time (calls are
- * serialised); a reply whose seq is not the awaited one is a late reply to a request that timed
- * out and is discarded.
+ * message one 512-byte struct arflex_msg. A request is sent ({@link #send}) and its reply awaited
+ * ({@link #await}) apart, so a caller may stop waiting and another thread wait for the rest
+ * (D39: the actor does not wait on a half that does not answer at once). Several requests may
+ * be outstanding; whoever reads the reply queue keeps the replies of the others until they are
+ * taken, and a reply to a request nobody awaits any more (it timed out) is discarded.
  *
  * <p>Every request carries the instance's token (ABI.md 5, DECISIONS.md D13), which the RT half
  * got as the first 8 bytes on its supervisor pipe; it ignores requests with another token, and
@@ -84,6 +86,11 @@ public final class Mailbox implements AutoCloseable {
     private final MessageQueue rsp;
     private final long token;
     private int seq;
+    /** Requests whose reply is still awaited, and replies read for them by another waiter. */
+    private final java.util.Set<Integer> awaited = new java.util.HashSet<>();
+    private final java.util.Map<Integer, Reply> arrived = new java.util.HashMap<>();
+    /** One reader of the reply queue at a time, for at most {@link #PEER_CHECK_MS} per turn. */
+    private final java.util.concurrent.locks.ReentrantLock reader = new java.util.concurrent.locks.ReentrantLock();
     /** Whether the RT half at the other end still runs: a call to a dead one ends early. */
     private volatile java.util.function.BooleanSupplier peerAlive = () -> true;
     /** How often a waiting call looks whether its peer still runs. */
@@ -148,6 +155,23 @@ public final class Mailbox implements AutoCloseable {
         }, timeoutMs);
     }
 
+    /** Sends BIND of {@code port} to {@code shmName}; returns its seq for {@link #await}. */
+    public int sendBind(String port, String shmName, long timeoutMs) throws IOException {
+        return send(Cmd.BIND, b -> {
+            putName(b, BIND_PORT, ControlBlock.NAME_SIZE, port);
+            putName(b, BIND_SHM_NAME, OBJ_NAME_SIZE, shmName);
+            b.putInt(OFF_PAYLOAD_LEN, BIND_SIZE);
+        }, timeoutMs);
+    }
+
+    /** Sends UNBIND of {@code port}; returns its seq for {@link #await}. */
+    public int sendUnbind(String port, long timeoutMs) throws IOException {
+        return send(Cmd.UNBIND, b -> {
+            putName(b, BIND_PORT, ControlBlock.NAME_SIZE, port);
+            b.putInt(OFF_PAYLOAD_LEN, BIND_SIZE);
+        }, timeoutMs);
+    }
+
     /** SET_PARAM of slot {@code index}; the reply carries the applied value. */
     public Reply setParam(int index, long bits, long timeoutMs) throws IOException {
         return call(Cmd.SET_PARAM, b -> {
@@ -177,39 +201,104 @@ public final class Mailbox implements AutoCloseable {
      *
      * @throws IOException on transport failure or when no reply came in time
      */
-    public synchronized Reply call(Cmd c, java.util.function.Consumer<ByteBuffer> fill, long timeoutMs)
+    public Reply call(Cmd c, java.util.function.Consumer<ByteBuffer> fill, long timeoutMs)
             throws IOException {
-        int s = ++seq;
-        ByteBuffer req = message(c, s);
-        fill.accept(req);
-        req.putLong(OFF_TOKEN, token);
+        int s = send(c, fill, timeoutMs);
+        Optional<Reply> r;
+        try {
+            r = await(c, s, timeoutMs);
+        } finally {
+            forget(s);
+        }
+        return r.orElseThrow(() -> new IOException(c + " (seq " + s + "): no reply within " + timeoutMs + " ms on " + rsp.name()));
+    }
+
+    /** Sends a request (waiting at most {@code timeoutMs} for room in the queue); returns its seq, now awaited. */
+    public int send(Cmd c, java.util.function.Consumer<ByteBuffer> fill, long timeoutMs) throws IOException {
+        int s;
+        ByteBuffer req;
+        synchronized (this) {
+            s = ++seq;
+            req = message(c, s);
+            fill.accept(req);
+            req.putLong(OFF_TOKEN, token);
+            awaited.add(s);
+        }
+        try {
+            cmd.send(req.array(), timeoutMs);
+        } catch (IOException | RuntimeException e) {
+            forget(s);
+            throw e;
+        }
+        return s;
+    }
+
+    /**
+     * Waits up to {@code timeoutMs} for the reply to request {@code s} of command {@code c}:
+     * empty when none came in that time (the request stays awaited: wait again, or
+     * {@link #forget} it).
+     *
+     * @throws IOException on transport failure, or when the RT half exited before it answered
+     */
+    public Optional<Reply> await(Cmd c, int s, long timeoutMs) throws IOException {
         long deadline = System.nanoTime() + timeoutMs * 1_000_000L;
-        cmd.send(req.array(), timeoutMs);
         while (true) {
+            synchronized (this) {
+                Reply got = arrived.remove(s);
+                if (got != null) {
+                    return Optional.of(got);
+                }
+            }
             long left = (deadline - System.nanoTime()) / 1_000_000L;
             if (left <= 0) {
-                throw new IOException(c + " (seq " + s + "): no reply within " + timeoutMs + " ms on " + rsp.name());
+                return Optional.empty();
             }
-            Optional<byte[]> got = rsp.receive(Math.min(left, PEER_CHECK_MS));
-            if (got.isEmpty()) {
-                if (!peerAlive.getAsBoolean()) {
-                    throw new IOException(c + " (seq " + s + "): the RT half exited before it answered (" + rsp.name() + ")");
-                }
+            if (!reader.tryLock()) {
+                // another waiter reads the queue for this turn; it keeps our reply for us
+                java.util.concurrent.locks.LockSupport.parkNanos(200_000);
                 continue;
             }
-            ByteBuffer r = ByteBuffer.wrap(got.get()).order(ByteOrder.LITTLE_ENDIAN);
-            if (got.get().length < OFF_PAYLOAD || r.getInt(OFF_MAGIC) != MSG_MAGIC
-                    || r.getShort(OFF_ABI_MAJOR) != ControlBlock.ABI_MAJOR) {
-                continue; // not a message of ours: discarded
+            Optional<byte[]> got;
+            try {
+                got = rsp.receive(Math.min(left, PEER_CHECK_MS));
+                if (got.isPresent()) {
+                    keep(got.get());
+                }
+            } finally {
+                reader.unlock();
             }
-            if (r.getLong(OFF_TOKEN) != token) {
-                continue; // not from our RT half
+            if (got.isEmpty() && !peerAlive.getAsBoolean()) {
+                synchronized (this) {
+                    if (arrived.containsKey(s)) {
+                        continue;
+                    }
+                }
+                throw new IOException(c + " (seq " + s + "): the RT half exited before it answered (" + rsp.name() + ")");
             }
-            if (r.getInt(OFF_SEQ) != s || (r.getShort(OFF_FLAGS) & FLAG_REPLY) == 0) {
-                continue; // a late reply to an earlier request
-            }
-            return new Reply(r.getInt(OFF_STATUS), r);
         }
+    }
+
+    /** Request {@code s} is not awaited any more: its reply, now or later, is discarded. */
+    public synchronized void forget(int s) {
+        awaited.remove(s);
+        arrived.remove(s);
+    }
+
+    /** A message from the reply queue: kept when it is our RT half's reply to an awaited request. */
+    private synchronized void keep(byte[] m) {
+        ByteBuffer r = ByteBuffer.wrap(m).order(ByteOrder.LITTLE_ENDIAN);
+        if (m.length < OFF_PAYLOAD || r.getInt(OFF_MAGIC) != MSG_MAGIC
+                || r.getShort(OFF_ABI_MAJOR) != ControlBlock.ABI_MAJOR) {
+            return; // not a message of ours: discarded
+        }
+        if (r.getLong(OFF_TOKEN) != token) {
+            return; // not from our RT half
+        }
+        int s = r.getInt(OFF_SEQ);
+        if ((r.getShort(OFF_FLAGS) & FLAG_REPLY) == 0 || !awaited.contains(s)) {
+            return; // a late reply to a request nobody awaits any more
+        }
+        arrived.put(s, new Reply(r.getInt(OFF_STATUS), r));
     }
 
     public String cmdName() {

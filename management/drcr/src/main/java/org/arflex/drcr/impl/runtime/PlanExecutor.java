@@ -45,8 +45,9 @@ final class PlanExecutor {
         // Live rewiring: inputs whose provider changes or goes are unbound before any stop, so
         // no consumer reads a provider while it goes away; new bindings come after the starts,
         // when every provider's segment exists.
+        List<java.util.concurrent.CompletableFuture<Void>> unbinding = new ArrayList<>();
         for (Plan.Action a : plan.rewires()) {
-            rebind(cell.find(a.component()), plan.wiringOf(a.component()), false, a.reason());
+            unbinding.addAll(rebind(cell.find(a.component()), plan.wiringOf(a.component()), false, a.reason()));
         }
         // The plan's stops in three sweeps, so that their waits overlap: every half to stop is
         // detached and its inputs unbound, then each is given its cycles to run its safe
@@ -63,7 +64,7 @@ final class PlanExecutor {
                 going.add(g);
             }
         }
-        stops.submit(going);
+        stops.submit(going, unbinding);
         // A component whose previous half is still on its way out starts when it is gone (its
         // objects have the same names), and so does one bound to such a component.
         Set<String> later = new LinkedHashSet<>();
@@ -121,39 +122,83 @@ final class PlanExecutor {
     /**
      * One phase of a REBIND: unbind (bindPhase false) the inputs whose segment changes or goes,
      * or bind (bindPhase true) the inputs to their new segments. The RT half picks a binding up
-     * at a cycle boundary and keeps running. A refused command means the half cannot follow
-     * the new wiring: it is restarted through the normal failure path, as a crash would be.
+     * at a cycle boundary and keeps running. The actor waits at most {@link #ANSWER_MS} for each
+     * answer (D39): a half that is slower (a long period) or frozen answers later, on a confirmer
+     * thread, and the plan goes on meanwhile. A refusal, or no answer within the call timeout,
+     * means the half cannot follow the new wiring: it is restarted through the normal failure
+     * path, as a crash would be. UNBINDs still unanswered are returned: the plan's stops wait for
+     * them before any provider is stopped.
      */
-    private void rebind(Instance inst, List<Wire> wires, boolean bindPhase, String why) {
+    private List<java.util.concurrent.CompletableFuture<Void>> rebind(Instance inst, List<Wire> wires, boolean bindPhase,
+                                                                     String why) {
+        List<java.util.concurrent.CompletableFuture<Void>> open = new ArrayList<>();
         if (inst == null || inst.half == null) {
-            return;
+            return open;
         }
         Map<String, String> target = new TreeMap<>();
         for (Wire w : wires) {
             target.put(w.inPort(), segments.name(w.provider(), w.outPort()));
         }
-        try {
-            if (!bindPhase) {
-                for (String port : List.copyOf(inst.bound.keySet())) {
-                    if (!inst.bound.get(port).equals(target.get(port))) {
-                        inst.half.unbind(port);
-                        inst.bound.remove(port);
-                    }
+        RtHalf h = inst.half;
+        Map<String, String> changes = new TreeMap<>();
+        if (!bindPhase) {
+            for (String port : List.copyOf(inst.bound.keySet())) {
+                if (!inst.bound.get(port).equals(target.get(port))) {
+                    changes.put(port, null);
                 }
-                return;
             }
+        } else {
             for (var e : target.entrySet()) {
                 if (!e.getValue().equals(inst.bound.get(e.getKey()))) {
-                    inst.half.bind(e.getKey(), e.getValue());
-                    inst.bound.put(e.getKey(), e.getValue());
+                    changes.put(e.getKey(), e.getValue());
                 }
             }
-            log.accept("arflex: " + inst.name + " rewired while running (" + why + "); inputs " + inst.bound);
-        } catch (IOException | RuntimeException e) {
-            log.accept("arflex: " + inst.name + ": rewiring failed: " + e.getMessage() + "; restarting it");
-            RtHalf h = inst.half;
-            h.kill();
         }
+        for (var e : changes.entrySet()) {
+            String port = e.getKey();
+            java.util.concurrent.CompletableFuture<Void> f = h.rebind(port, e.getValue(), ANSWER_MS);
+            if (f.isCompletedExceptionally()) {
+                rewiringFailed(inst, h, f);
+                return open;
+            }
+            if (e.getValue() == null) {
+                inst.bound.remove(port);
+            } else {
+                inst.bound.put(port, e.getValue());
+            }
+            if (!f.isDone()) {
+                log.accept("arflex: " + inst.name + " has not answered " + (e.getValue() == null ? "UNBIND " : "BIND ")
+                        + port + " within " + ANSWER_MS + " ms; the plan goes on, its answer is awaited apart");
+                f.whenComplete((v, ex) -> {
+                    if (ex != null) {
+                        cell.actor().submit(() -> rewiringFailed(inst, h, f));
+                    }
+                });
+                if (e.getValue() == null) {
+                    open.add(f);
+                }
+            }
+        }
+        if (bindPhase) {
+            log.accept("arflex: " + inst.name + " rewired while running (" + why + "); inputs " + inst.bound);
+        }
+        return open;
+    }
+
+    /** The actor waits this long for a running half's answer to BIND or UNBIND (D39). */
+    static final long ANSWER_MS = 20;
+
+    /** A rebind of {@code h} was refused or not answered: it is restarted as a crash would be (actor). */
+    private void rewiringFailed(Instance inst, RtHalf h, java.util.concurrent.CompletableFuture<Void> f) {
+        if (inst.half != h) {
+            return; // gone or replaced meanwhile
+        }
+        Throwable t = f.handle((v, ex) -> ex).join();
+        if (t instanceof java.util.concurrent.CompletionException && t.getCause() != null) {
+            t = t.getCause();
+        }
+        log.accept("arflex: " + inst.name + ": rewiring failed: " + (t == null ? "?" : t.getMessage()) + "; restarting it");
+        h.kill();
     }
 
     /**

@@ -34,6 +34,8 @@ final class Stops {
 
     /** Deadline of each UNBIND on the way out. */
     static final long UNBIND_MS = 250;
+    /** How long a stop waits for consumers' UNBINDs the actor did not wait for (the call timeout). */
+    static final long UNBIND_WAIT_MS = 2_500;
 
     /** One RT half on its way out, detached from its instance on the actor. */
     static final class Going {
@@ -78,8 +80,16 @@ final class Stops {
         /** Completes when the actor has recorded every outcome. */
         final CompletableFuture<Void> done = new CompletableFuture<>();
 
-        Batch(List<Going> halves) {
+        /**
+         * Consumers' UNBINDs of the same plan still unanswered when it was submitted (D39): the
+         * providers of this batch are stopped only once they are answered (or failed, or the
+         * call timeout passed), so no consumer reads a provider while it goes away.
+         */
+        final List<CompletableFuture<Void>> before;
+
+        Batch(List<Going> halves, List<CompletableFuture<Void>> before) {
             this.halves = List.copyOf(halves);
+            this.before = List.copyOf(before);
         }
     }
 
@@ -111,8 +121,13 @@ final class Stops {
 
     /** Hands detached halves to a stop thread (actor thread); empty: nothing happens. */
     Batch submit(List<Going> halves) {
+        return submit(halves, List.of());
+    }
+
+    /** The same, after the consumers' UNBINDs in {@code before} are answered (see {@link Batch#before}). */
+    Batch submit(List<Going> halves, List<CompletableFuture<Void>> before) {
         actor.checkThread();
-        Batch b = new Batch(halves);
+        Batch b = new Batch(halves, before);
         if (halves.isEmpty()) {
             b.settled.complete(null);
             b.done.complete(null);
@@ -168,6 +183,17 @@ final class Stops {
     /** The stop thread's part. Never throws; every half ends with an outcome. */
     private void run(Batch b) {
         try {
+            // 0. The consumers that had not answered their UNBIND on the actor: wait for them.
+            if (!b.before.isEmpty()) {
+                try {
+                    CompletableFuture.allOf(b.before.toArray(CompletableFuture[]::new))
+                            .get(UNBIND_WAIT_MS, java.util.concurrent.TimeUnit.MILLISECONDS);
+                } catch (java.util.concurrent.ExecutionException | java.util.concurrent.TimeoutException e) {
+                    // refused or unanswered: that consumer is restarted by the failure path
+                } catch (InterruptedException e) {
+                    Thread.currentThread().interrupt();
+                }
+            }
             // 1. Every input unbound, so every consumer runs its safe behaviour from now on.
             for (Going g : b.halves) {
                 for (String port : g.inputs) {

@@ -11,6 +11,7 @@ import java.security.SecureRandom;
 import java.util.ArrayDeque;
 import java.util.Deque;
 import java.util.List;
+import java.util.Optional;
 import java.util.concurrent.CompletableFuture;
 import java.util.concurrent.TimeUnit;
 import java.util.concurrent.locks.LockSupport;
@@ -34,6 +35,12 @@ public final class ProcessLauncher implements RtLauncher {
 
     /** Mailbox call timeout. */
     static final long CALL_TIMEOUT_MS = 2_000;
+    /** Waits for the answers the actor did not wait for (D39); daemon threads, made as needed. */
+    private static final java.util.concurrent.ExecutorService CONFIRMER = java.util.concurrent.Executors.newCachedThreadPool(r -> {
+        Thread t = new Thread(r, "arflex-mailbox-confirm");
+        t.setDaemon(true);
+        return t;
+    });
     /**
      * Deadline of each mailbox command on the way out (UNBIND, STOP, SHUTDOWN): a cooperating
      * half answers within a cycle or two; one that does not is terminated, not waited for.
@@ -309,6 +316,54 @@ public final class ProcessLauncher implements RtLauncher {
         @Override
         public void unbind(String port) throws IOException {
             unbind(port, CALL_TIMEOUT_MS);
+        }
+
+        @Override
+        public CompletableFuture<Void> rebind(String port, String segment, long waitMs) {
+            Mailbox.Cmd c = segment != null ? Mailbox.Cmd.BIND : Mailbox.Cmd.UNBIND;
+            String what = c + " " + inst + "." + port + (segment != null ? " to " + segment : "");
+            int s;
+            try {
+                s = segment != null ? mb.sendBind(port, segment, CALL_TIMEOUT_MS) : mb.sendUnbind(port, CALL_TIMEOUT_MS);
+            } catch (IOException | RuntimeException e) {
+                return CompletableFuture.failedFuture(e);
+            }
+            CompletableFuture<Void> done = new CompletableFuture<>();
+            long t0 = System.nanoTime();
+            Runnable rest = () -> {
+                try {
+                    long left = CALL_TIMEOUT_MS - (System.nanoTime() - t0) / 1_000_000L;
+                    Optional<Mailbox.Reply> r = mb.await(c, s, Math.max(0, left));
+                    if (r.isEmpty()) {
+                        done.completeExceptionally(new IOException(what + ": no reply within " + CALL_TIMEOUT_MS + " ms"));
+                    } else if (r.get().status() != 0) {
+                        done.completeExceptionally(new IOException(what + " refused: status " + r.get().status()));
+                    } else {
+                        done.complete(null);
+                    }
+                } catch (IOException | RuntimeException e) {
+                    done.completeExceptionally(e);
+                } finally {
+                    mb.forget(s);
+                }
+            };
+            try {
+                Optional<Mailbox.Reply> r = mb.await(c, s, waitMs);
+                if (r.isPresent()) {
+                    mb.forget(s);
+                    if (r.get().status() != 0) {
+                        done.completeExceptionally(new IOException(what + " refused: status " + r.get().status()));
+                    } else {
+                        done.complete(null);
+                    }
+                    return done;
+                }
+            } catch (IOException | RuntimeException e) {
+                mb.forget(s);
+                return CompletableFuture.failedFuture(e);
+            }
+            CONFIRMER.execute(rest); // the rest of the wait, off the caller's thread
+            return done;
         }
 
         @Override

@@ -24,6 +24,26 @@ public interface RtHalf {
     void unbind(String port) throws IOException;
 
     /**
+     * BIND ({@code segment} not null) or UNBIND of input {@code port} of a running half, waiting
+     * at most {@code waitMs} for its answer (D39: the actor does not wait on a process). The
+     * stage completes when the half has answered; exceptionally when it refused, did not answer
+     * within the call timeout, or exited. This default answers at once (a half that answers in
+     * the caller's thread).
+     */
+    default CompletableFuture<Void> rebind(String port, String segment, long waitMs) {
+        try {
+            if (segment != null) {
+                bind(port, segment);
+            } else {
+                unbind(port);
+            }
+            return CompletableFuture.completedFuture(null);
+        } catch (IOException | RuntimeException e) {
+            return CompletableFuture.failedFuture(e);
+        }
+    }
+
+    /**
      * UNBIND input {@code port}, answered within {@code timeoutMs} (a stop's short deadline: a
      * half that does not answer is not waited for longer).
      */

@@ -72,6 +72,19 @@ final class FakeLauncher implements RtLauncher {
             events.add(inst + " UNBIND " + port);
         }
 
+        /** When set, a running rebind is answered by what this returns (a test holds it open). */
+        java.util.function.Function<String, CompletableFuture<Void>> rebinds;
+
+        @Override
+        public CompletableFuture<Void> rebind(String port, String segment, long waitMs) {
+            if (rebinds == null) {
+                return RtHalf.super.rebind(port, segment, waitMs);
+            }
+            String what = (segment != null ? "BIND " : "UNBIND ") + port;
+            events.add(inst + " " + what + " (unanswered)");
+            return rebinds.apply(what);
+        }
+
         @Override
         public long cycles() {
             return started ? 0 : -1;
