@@ -87,7 +87,7 @@ public final class Cell {
         this.monitor = new HeartbeatMonitor((half, why) -> actor.submit(() -> hung(half, why)));
         this.stops = new Stops(actor, stopper, monitor, cfg.shutdownMs(), log, this::stopped);
         this.segments = new Segments(cfg.runtimeId(), cfg.types(), launcher, stops,
-                new EvaluationSegments(cfg.evaluation(), launcher));
+                new EvaluationSegments(cfg.evaluation(), launcher), this::objectId);
         this.failures = new Failures(this, this::execute, log);
         this.starter = new Starter(cfg, actor, launcher, monitor, segments, stops, failures, log, launches,
                 planner, this::changed, this::resume);
@@ -185,6 +185,15 @@ public final class Cell {
     /** The instance of that name, or null (actor thread). */
     Instance find(String name) {
         return instances.get(name);
+    }
+
+    /**
+     * The object id the current RT half of component {@code name} runs under: its name, or the
+     * generation id an update in a change set gave it (D38); the name itself when unknown.
+     */
+    String objectId(String name) {
+        Instance i = instances.get(name);
+        return i == null ? name : i.objectId;
     }
 
     /** Names of the instances. */
