@@ -8,7 +8,8 @@ import java.util.Objects;
 /**
  * Several actions on the cell planned, admitted and applied together (docs/DECISIONS.md D35):
  * installs of components that are known to the cell but not running (their bundle is installed,
- * not started), uninstalls of running ones, and parameter writes. Rewiring follows from the plan.
+ * not started), uninstalls of running ones, updates of running ones to a new version (D38), and
+ * parameter writes. Rewiring follows from the plan.
  * Immutable; build one with {@link #builder()}.
  */
 public final class ChangeSet {
@@ -32,6 +33,32 @@ public final class ChangeSet {
         @Override
         public String text() {
             return "install " + component;
+        }
+    }
+
+    /**
+     * Replaces the running RT half of {@code component} by a new version (D38): the contract
+     * {@code contract} (same name) with the executable {@code exe}, both from {@code from}, already
+     * through the code gate. The new half is prepared beside the old one under a generation's
+     * object id, switched in the set's actor turn, and the old one is kept warm for
+     * {@code window} cycles of the new one (0: stopped at once); a crash or an overrun of the new
+     * one within the window rolls the component back to the old half.
+     */
+    public record Update(String component, org.arflex.contract.Contract contract, Path exe, String from, long window)
+            implements Step {
+        public Update {
+            Objects.requireNonNull(component, "component");
+            Objects.requireNonNull(contract, "contract");
+            Objects.requireNonNull(exe, "exe");
+            Objects.requireNonNull(from, "from");
+            if (window < 0) {
+                throw new IllegalArgumentException("window " + window + " < 0");
+            }
+        }
+
+        @Override
+        public String text() {
+            return "update " + component + " " + from;
         }
     }
 
@@ -97,6 +124,11 @@ public final class ChangeSet {
 
         public Builder install(String name, Path exe) {
             steps.add(new Install(name, exe));
+            return this;
+        }
+
+        public Builder update(String name, org.arflex.contract.Contract contract, Path exe, String from, long window) {
+            steps.add(new Update(name, contract, exe, from, window));
             return this;
         }
 
