@@ -22,10 +22,24 @@ class ChangeSetsParseTest {
     }
 
     @Test
+    void anUpdateTakesItsJarThenAnOptionalPinAndWindow() {
+        String sha = "ab".repeat(32);
+        assertEquals(List.of("update tcp-correction file:/x.jar  ", "uninstall b"),
+                flat(List.of("update", "tcp-correction", "file:/x.jar", "uninstall", "b")));
+        assertEquals(List.of("update tcp-correction file:/x.jar " + sha + " 2000", "set a gain 2"),
+                flat(List.of("update tcp-correction file:/x.jar " + sha + " window 2000; set a gain 2")));
+        assertEquals(List.of("update c https://h/c.jar  50"), flat(List.of("update", "c", "https://h/c.jar", "window", "50")));
+    }
+
+    @Test
     void anUnknownOrIncompleteActionIsRefusedNamingIt() {
-        assertEquals("unknown action 'update' (actions: install <component>, uninstall <component>, set <component> "
-                + "<parameter> <value>)", assertThrows(IllegalArgumentException.class,
-                        () -> ChangeSets.parse(List.of("update", "vision"))).getMessage());
+        assertEquals("unknown action 'upgrade' (actions: install <component>, uninstall <component>, set <component> "
+                + "<parameter> <value>, update <component> <jar URL> [<sha256>] [window <cycles>])",
+                assertThrows(IllegalArgumentException.class, () -> ChangeSets.parse(List.of("upgrade", "vision"))).getMessage());
+        assertEquals("'update vision' is incomplete (update <component> <jar URL> [<sha256>] [window <cycles>])",
+                assertThrows(IllegalArgumentException.class, () -> ChangeSets.parse(List.of("update", "vision"))).getMessage());
+        assertEquals("update vision: window needs a number of cycles", assertThrows(IllegalArgumentException.class,
+                () -> ChangeSets.parse(List.of("update vision file:/v.jar window soon"))).getMessage());
         assertEquals("'set teach mass' is incomplete (set <component> <parameter> <value>)",
                 assertThrows(IllegalArgumentException.class,
                         () -> ChangeSets.parse(List.of("install", "teach", "set", "teach", "mass"))).getMessage());
