@@ -619,7 +619,7 @@ final class ChangeSetExecutor {
         if (w == null || w.next != inst || w.nextHalf != half) {
             return false;
         }
-        w.rollback("the new version (pid " + half.pid() + ") exited: " + ex.description());
+        w.rollback("the new version (pid " + half.pid() + ") exited: " + ex.description(), ex.seenNanos());
         return true;
     }
 
@@ -674,11 +674,6 @@ final class ChangeSetExecutor {
                 end("committed at the switch (no rollback window)", 0);
                 return;
             }
-            org.arflex.drcr.impl.abi.ControlBlock.Stats n = stats(nextHalf, next);
-            org.arflex.drcr.impl.abi.ControlBlock.Stats o = stats(oldHalf, old);
-            cycles0 = n == null ? 0 : n.cycles();
-            newBad0 = bad(n);
-            oldBad0 = bad(o);
             long period = Math.max(1, next.contract.timing().periodNs());
             // a half that does not cycle (sporadic, starved) ends its window by time
             tEndNs = cell.config().monotonicNs().getAsLong() + 4 * update.window() * period + 1_000_000_000L;
@@ -693,6 +688,19 @@ final class ChangeSetExecutor {
             log.accept("arflex: " + next.name + ": update switched to pid " + nextHalf.pid() + " (" + next.objectId
                     + "); the old version (pid " + oldHalf.pid() + ", " + old.objectId + ") is kept warm for "
                     + update.window() + " cycles");
+            // the counters' baseline right after the switch turn, which it would only lengthen
+            cell.actor().submit(this::baseline);
+        }
+
+        private void baseline() {
+            if (done) {
+                return;
+            }
+            org.arflex.drcr.impl.abi.ControlBlock.Stats n = stats(nextHalf, next);
+            org.arflex.drcr.impl.abi.ControlBlock.Stats o = stats(oldHalf, old);
+            cycles0 = n == null ? 0 : n.cycles();
+            newBad0 = bad(n);
+            oldBad0 = bad(o);
             timer = cell.actor().schedule(this::watch, WATCH_MS);
         }
 
@@ -717,7 +725,8 @@ final class ChangeSetExecutor {
             long oldBad = bad(o) - oldBad0;
             if (newBad > oldBad + OVERRUN_ALLOWANCE) {
                 rollback(String.format(java.util.Locale.ROOT, "the new version overran or missed its deadline in %d "
-                        + "of its first %d cycles (the old one, on the same inputs: %d)", newBad, cycles, oldBad));
+                        + "of its first %d cycles (the old one, on the same inputs: %d)", newBad, cycles, oldBad),
+                        System.nanoTime());
                 return;
             }
             if (cycles >= update.window() || cell.config().monotonicNs().getAsLong() - tEndNs >= 0) {
@@ -753,8 +762,12 @@ final class ChangeSetExecutor {
             verdict.complete(v);
         }
 
-        /** The old half is the component's again; the new one stops (actor thread). */
-        void rollback(String why) {
+        /**
+         * The old half is the component's again; the new one stops (actor thread).
+         *
+         * @param seenNanos when the cause was seen ({@link System#nanoTime()}): an exit's waiter thread, or now
+         */
+        void rollback(String why, long seenNanos) {
             done = true;
             warm.remove(next.name, this);
             if (timer != null) {
@@ -762,19 +775,27 @@ final class ChangeSetExecutor {
                 timer = null;
             }
             long cycles = cyclesNow();
-            try {
-                cell.planner().apply(Change.replace(old.contract));
-            } catch (RuntimeException e) {
-                log.accept("arflex: " + next.name + ": the planner refused the old contract back: " + e.getMessage());
-            }
+            long boundBackNanos = 0;
             next.half = null;
             cell.monitor().unwatch(nextHalf);
             cell.swap(next, old);
             old.half = oldHalf;
-            Plan now = cell.planner().current();
-            for (Instance inst : cell.instances()) {
-                if (inst.half != null && inst != old) {
-                    rebind(inst, now, "the rollback of " + next.name);
+            // the consumers first (they read a dead or failing half until their BIND is taken),
+            // then the planner, then once more should the old contract's wiring differ
+            for (int pass = 0; pass < 2; pass++) {
+                Plan now = cell.planner().current();
+                for (Instance inst : cell.instances()) {
+                    if (inst.half != null && inst != old) {
+                        rebind(inst, now, "the rollback of " + next.name);
+                    }
+                }
+                if (pass == 0) {
+                    boundBackNanos = System.nanoTime() - seenNanos;
+                    try {
+                        cell.planner().apply(Change.replace(old.contract));
+                    } catch (RuntimeException e) {
+                        log.accept("arflex: " + next.name + ": the planner refused the old contract back: " + e.getMessage());
+                    }
                 }
             }
             next.life.target(State.DESTROYED);
@@ -791,8 +812,8 @@ final class ChangeSetExecutor {
                 next.bound.clear();
             }
             String v = String.format(java.util.Locale.ROOT, "update %s: rolled back after %d cycles of the new version "
-                    + "(%s): %s; pid %d (%s) runs it again", next.name, cycles, update.from(), why, oldHalf.pid(),
-                    old.objectId);
+                    + "(%s): %s; pid %d (%s) runs it again (its consumers bound back %.1f ms after the cause was seen)",
+                    next.name, cycles, update.from(), why, oldHalf.pid(), old.objectId, boundBackNanos / 1e6);
             old.life.reason(null);
             cell.problem("change set " + set.describe() + ": " + v);
             verdict.complete(v);

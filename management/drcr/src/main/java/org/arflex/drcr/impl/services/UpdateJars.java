@@ -58,6 +58,8 @@ public final class UpdateJars implements ChangeSets.Versions {
             }
             how = v.describe();
         }
+        // one pass over the jar: the names, and the bytes of everything but native code (an
+        // executable of tens of MB is streamed from the jar only when it is extracted)
         Map<String, byte[]> entries = new HashMap<>();
         String header;
         try (JarInputStream in = new JarInputStream(new ByteArrayInputStream(jar))) {
@@ -65,7 +67,7 @@ public final class UpdateJars implements ChangeSets.Versions {
             header = m == null ? null : m.getMainAttributes().getValue(ContractReader.HEADER);
             for (JarEntry e = in.getNextJarEntry(); e != null; e = in.getNextJarEntry()) {
                 if (!e.isDirectory()) {
-                    entries.put(e.getName(), in.readAllBytes());
+                    entries.put(e.getName(), e.getName().startsWith("native/") ? NATIVE : in.readAllBytes());
                 }
             }
         }
@@ -82,10 +84,24 @@ public final class UpdateJars implements ChangeSets.Versions {
         Contract c = r.contracts().stream().filter(x -> x.name().equals(component)).findFirst()
                 .orElseThrow(() -> new IOException(location + " carries no contract of '" + component + "' (it has "
                         + r.contracts().stream().map(Contract::name).toList() + ")"));
-        byte[] exe = entries.get(ContractReader.NATIVE_DIR + c.executable());
+        String exe = ContractReader.NATIVE_DIR + c.executable();
         String digest = Services.sha256(jar);
         Path into = dir.resolve(component + "-" + digest.substring(0, 16).toLowerCase(java.util.Locale.ROOT));
-        return new ChangeSets.Version(c, location, how,
-                () -> executables.extract(into, c.executable(), () -> new ByteArrayInputStream(exe)));
+        return new ChangeSets.Version(c, location, how, () -> executables.extract(into, c.executable(), () -> open(jar, exe)));
+    }
+
+    /** Stands for an entry under native/ whose bytes are not kept. */
+    private static final byte[] NATIVE = new byte[0];
+
+    /** The jar's entry {@code name} as a stream (the jar verified above, held in memory). */
+    private static java.io.InputStream open(byte[] jar, String name) throws IOException {
+        JarInputStream in = new JarInputStream(new ByteArrayInputStream(jar));
+        for (JarEntry e = in.getNextJarEntry(); e != null; e = in.getNextJarEntry()) {
+            if (e.getName().equals(name)) {
+                return in;
+            }
+        }
+        in.close();
+        throw new IOException(name + " is not in the jar");
     }
 }
