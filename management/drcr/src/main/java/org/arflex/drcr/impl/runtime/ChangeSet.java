@@ -44,9 +44,15 @@ public final class ChangeSet {
      * {@code window} cycles of the new one (0: stopped at once); a crash or an overrun of the new
      * one within the window rolls the component back to the old half.
      */
-    public record Update(String component, org.arflex.contract.Contract contract, Path exe, String from, long window)
-            implements Step {
+    public record Update(String component, org.arflex.contract.Contract contract, Path exe, String from, long window,
+                         List<Envelope> envelopes) implements Step {
+
+        public Update(String component, org.arflex.contract.Contract contract, Path exe, String from, long window) {
+            this(component, contract, exe, from, window, List.of());
+        }
+
         public Update {
+            envelopes = List.copyOf(envelopes);
             Objects.requireNonNull(component, "component");
             Objects.requireNonNull(contract, "contract");
             Objects.requireNonNull(exe, "exe");
@@ -59,6 +65,26 @@ public final class ChangeSet {
         @Override
         public String text() {
             return "update " + component + " " + from;
+        }
+    }
+
+    /**
+     * A range every element of numeric field {@code field} of output {@code port} of an update's
+     * new version must stay in during its rollback window (D38); else it is rolled back.
+     */
+    public record Envelope(String port, String field, double min, double max) {
+        public Envelope {
+            Objects.requireNonNull(port, "port");
+            Objects.requireNonNull(field, "field");
+            if (!(min <= max)) {
+                throw new IllegalArgumentException("envelope " + port + "." + field + ": min " + min + " > max " + max);
+            }
+        }
+
+        /** As written: {@code port.field [min, max]}. */
+        @Override
+        public String toString() {
+            return port + "." + field + " [" + min + ", " + max + "]";
         }
     }
 
@@ -128,7 +154,12 @@ public final class ChangeSet {
         }
 
         public Builder update(String name, org.arflex.contract.Contract contract, Path exe, String from, long window) {
-            steps.add(new Update(name, contract, exe, from, window));
+            return update(name, contract, exe, from, window, List.of());
+        }
+
+        public Builder update(String name, org.arflex.contract.Contract contract, Path exe, String from, long window,
+                              List<Envelope> envelopes) {
+            steps.add(new Update(name, contract, exe, from, window, envelopes));
             return this;
         }
 

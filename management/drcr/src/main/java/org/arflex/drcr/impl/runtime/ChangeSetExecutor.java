@@ -242,6 +242,17 @@ final class ChangeSetExecutor {
             return "'" + n + "' moves hardware: its new half would drive it beside the old one; update it outside a "
                     + "change set";
         }
+        for (ChangeSet.Envelope e : u.envelopes()) {
+            org.arflex.contract.PortSpec out = u.contract().outputs().stream().filter(o -> o.name().equals(e.port()))
+                    .findFirst().orElse(null);
+            if (out == null) {
+                return "envelope " + e + ": the new version has no output '" + e.port() + "'";
+            }
+            var f = cell.config().types().find(out.type()).flatMap(t -> t.field(e.field())).orElse(null);
+            if (f == null || f.padding()) {
+                return "envelope " + e + ": port type " + out.type() + " has no field '" + e.field() + "'";
+            }
+        }
         String id = Instance.generationId(n, inst.generation + 1);
         if (id.length() > 40) {
             return "the new half's object id '" + id + "' is longer than 40 characters (rt-core ABI)";
@@ -723,6 +734,11 @@ final class ChangeSetExecutor {
             long cycles = cyclesNow();
             long newBad = bad(n) - newBad0;
             long oldBad = bad(o) - oldBad0;
+            String outside = outside();
+            if (outside != null) {
+                rollback(outside, System.nanoTime());
+                return;
+            }
             if (newBad > oldBad + OVERRUN_ALLOWANCE) {
                 rollback(String.format(java.util.Locale.ROOT, "the new version overran or missed its deadline in %d "
                         + "of its first %d cycles (the old one, on the same inputs: %d)", newBad, cycles, oldBad),
@@ -735,6 +751,43 @@ final class ChangeSetExecutor {
                 return;
             }
             timer = cell.actor().schedule(this::watch, WATCH_MS);
+        }
+
+        /** Which value of the new half's outputs lies outside its declared envelope, or null. */
+        private String outside() {
+            for (ChangeSet.Envelope e : update.envelopes()) {
+                org.arflex.drcr.impl.supervisor.RtLauncher.Output o = next.outputs.get(e.port());
+                org.arflex.contract.PortSpec spec = next.contract.outputs().stream()
+                        .filter(p -> p.name().equals(e.port())).findFirst().orElse(null);
+                org.arflex.contract.PortType t = spec == null ? null : cell.config().types().find(spec.type()).orElse(null);
+                if (o == null || t == null) {
+                    continue;
+                }
+                byte[] v;
+                try {
+                    v = o.newest(t.name(), (int) t.size());
+                } catch (java.io.IOException | RuntimeException ex) {
+                    continue; // not readable now: the next look
+                }
+                if (v == null) {
+                    continue;
+                }
+                for (org.arflex.drcr.dto.PortFieldDTO f : PortValues.decode(t,
+                        java.nio.ByteBuffer.wrap(v).order(java.nio.ByteOrder.LITTLE_ENDIAN))) {
+                    if (!f.name.equals(e.field())) {
+                        continue;
+                    }
+                    for (int i = 0; i < f.values.length; i++) {
+                        double x = f.values[i];
+                        if (!(x >= e.min() && x <= e.max())) {
+                            return String.format(java.util.Locale.ROOT, "output %s.%s%s = %s left the envelope [%s, %s] "
+                                    + "declared for the update", e.port(), e.field(), f.count > 1 ? "[" + i + "]" : "",
+                                    x, e.min(), e.max());
+                        }
+                    }
+                }
+            }
+            return null;
         }
 
         /** The window is over without a rollback: the old half stops, its segments go after it. */

@@ -45,7 +45,7 @@ public final class ChangeSets implements ChangeSetService {
     static final long WINDOW = 1000;
     /** The usage of the actions. */
     static final String ACTIONS = "actions: install <component>, uninstall <component>, set <component> <parameter> "
-            + "<value>, update <component> <jar URL> [<sha256>] [window <cycles>]";
+            + "<value>, update <component> <jar URL> [<sha256>] [window <cycles>] [envelope <port>.<field> <min> <max>]...";
 
     /** A new version of a component, from a jar that passed the code gate (D38). */
     public record Version(Contract contract, String from, String how, Extract extract) {
@@ -120,7 +120,8 @@ public final class ChangeSets implements ChangeSetService {
                 throw new IllegalArgumentException("'" + String.join(" ", tokens.subList(i, tokens.size()))
                         + "' is incomplete (" + verb + switch (verb) {
                             case "set" -> " <component> <parameter> <value>";
-                            case "update" -> " <component> <jar URL> [<sha256>] [window <cycles>]";
+                            case "update" -> " <component> <jar URL> [<sha256>] [window <cycles>] [envelope <port>.<field> "
+                                    + "<min> <max>]...";
                             default -> " <component>";
                         } + ")");
             }
@@ -129,19 +130,34 @@ public final class ChangeSets implements ChangeSetService {
                 i += n;
                 continue;
             }
-            String[] u = {verb, tokens.get(i + 1), tokens.get(i + 2), "", ""};
+            List<String> u = new ArrayList<>(List.of(verb, tokens.get(i + 1), tokens.get(i + 2), "", ""));
             i += 3;
             if (i < tokens.size() && tokens.get(i).matches("[0-9a-fA-F]{64}")) {
-                u[3] = tokens.get(i++);
+                u.set(3, tokens.get(i++));
             }
-            if (i < tokens.size() && tokens.get(i).equals("window")) {
-                if (i + 1 >= tokens.size() || !tokens.get(i + 1).matches("[0-9]{1,9}")) {
-                    throw new IllegalArgumentException("update " + u[1] + ": window needs a number of cycles");
+            while (i < tokens.size() && (tokens.get(i).equals("window") || tokens.get(i).equals("envelope"))) {
+                if (tokens.get(i).equals("window")) {
+                    if (i + 1 >= tokens.size() || !tokens.get(i + 1).matches("[0-9]{1,9}")) {
+                        throw new IllegalArgumentException("update " + u.get(1) + ": window needs a number of cycles");
+                    }
+                    u.set(4, tokens.get(i + 1));
+                    i += 2;
+                } else {
+                    if (i + 3 >= tokens.size() || !tokens.get(i + 1).matches("[a-z][a-z0-9_]*\\.[a-z][a-z0-9_]*")) {
+                        throw new IllegalArgumentException("update " + u.get(1) + ": envelope needs <port>.<field> <min> <max>");
+                    }
+                    try {
+                        new ChangeSet.Envelope("p", "f", Double.parseDouble(tokens.get(i + 2)),
+                                Double.parseDouble(tokens.get(i + 3)));
+                    } catch (IllegalArgumentException e) {
+                        throw new IllegalArgumentException("update " + u.get(1) + ": envelope " + tokens.get(i + 1)
+                                + ": " + tokens.get(i + 2) + " " + tokens.get(i + 3) + " is not a range (<min> <max>)");
+                    }
+                    u.add(tokens.get(i + 1) + " " + tokens.get(i + 2) + " " + tokens.get(i + 3));
+                    i += 4;
                 }
-                u[4] = tokens.get(i + 1);
-                i += 2;
             }
-            out.add(u);
+            out.add(u.toArray(String[]::new));
         }
         return out;
     }
@@ -262,7 +278,14 @@ public final class ChangeSets implements ChangeSetService {
                     } catch (IOException e) {
                         throw new IllegalStateException("update " + a[1] + ": cannot extract its executable: " + e.getMessage());
                     }
-                    b.update(a[1], v.contract(), exe, a[2], a[4].isEmpty() ? WINDOW : Long.parseLong(a[4]));
+                    List<ChangeSet.Envelope> envelopes = new ArrayList<>();
+                    for (int k = 5; k < a.length; k++) {
+                        String[] e = a[k].split(" ");
+                        int dot = e[0].indexOf('.');
+                        envelopes.add(new ChangeSet.Envelope(e[0].substring(0, dot), e[0].substring(dot + 1),
+                                Double.parseDouble(e[1]), Double.parseDouble(e[2])));
+                    }
+                    b.update(a[1], v.contract(), exe, a[2], a[4].isEmpty() ? WINDOW : Long.parseLong(a[4]), envelopes);
                 }
                 case "uninstall" -> b.uninstall(a[1]);
                 default -> b.set(a[1], a[2], a[3]);

@@ -214,7 +214,8 @@ public final class Commands {
     public String change(String... args) {
         return guard(() -> {
             String usage = "usage: change plan|apply <action>... (actions: install <component>, uninstall <component>,"
-                    + " set <component> <parameter> <value>, update <component> <jar URL> [<sha256>] [window <cycles>])";
+                    + " set <component> <parameter> <value>, update <component> <jar URL> [<sha256>] [window <cycles>]"
+                    + " [envelope <port>.<field> <min> <max>]...)";
             if (changeSets == null || args.length < 2 || !(args[0].equals("plan") || args[0].equals("apply"))) {
                 return usage;
             }

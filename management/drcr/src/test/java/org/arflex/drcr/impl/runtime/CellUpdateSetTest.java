@@ -214,6 +214,52 @@ class CellUpdateSetTest {
                 "the consumer is back on the old half before the new one stops: " + fake.events);
     }
 
+    /** An arflex.Sample payload: seq, t_ns, value. */
+    private static byte[] sample(double value) {
+        return java.nio.ByteBuffer.allocate(24).order(java.nio.ByteOrder.LITTLE_ENDIAN).putLong(7).putLong(1000)
+                .putDouble(value).array();
+    }
+
+    @Test
+    void aNewVersionWhoseOutputLeavesItsEnvelopeIsRolledBack() throws Exception {
+        runningCell();
+        FakeLauncher.FakeHalf oldHalf = fake.running.get("stage");
+        ChangeSet set = ChangeSet.builder().update("stage", parse("stage", "stage", IN_SRC + OUT, "1.1.0"),
+                Path.of("/nonexistent/stage-1.1"), "file:/x/stage-1.1.jar", 1000,
+                java.util.List.of(new ChangeSet.Envelope("y", "value", -1, 1))).build();
+        ChangeSetResult r = apply(set);
+        assertTrue(r.applied(), r.text());
+        FakeLauncher.FakeHalf newHalf = fake.running.get("1-stage");
+        newHalf.stats = cycles(20, 0);
+        fake.values.put("/arflex.t.1-stage.out.y", sample(0.5));
+        watch();
+        assertFalse(r.verdict().isDone(), "inside its envelope: " + rig.log);
+        newHalf.stats = cycles(30, 0);
+        fake.values.put("/arflex.t.1-stage.out.y", sample(5.0));
+        watch();
+        rig.stepUntil("the verdict", () -> r.verdict().isDone());
+        assertTrue(r.verdict().join().contains("rolled back after 30 cycles of the new version (file:/x/stage-1.1.jar): "
+                + "output y.value = 5.0 left the envelope [-1.0, 1.0] declared for the update;"), r.verdict().join());
+        assertEquals(oldHalf.pid, cell.instance("stage").orElseThrow().half.pid());
+        rig.stepUntil("the new half stopped", () -> !fake.running.containsKey("1-stage")
+                && !fake.openOutputs.containsKey("/arflex.t.1-stage.out.y"));
+        assertTrue(index("user BIND x /arflex.t.stage.out.y") < index("1-stage SHUTDOWN"), fake.events::toString);
+    }
+
+    @Test
+    void anEnvelopeOnAnUnknownOutputOrFieldIsRefused() throws Exception {
+        runningCell();
+        Contract next = parse("stage", "stage", IN_SRC + OUT, "1.1.0");
+        ChangeSetResult port = actor.call(() -> cell.planChangeSet(ChangeSet.builder().update("stage", next, Path.of("/x"),
+                "file:/x.jar", 10, java.util.List.of(new ChangeSet.Envelope("z", "value", 0, 1))).build()), 0);
+        assertTrue(port.refusal().startsWith("update stage file:/x.jar: envelope z.value [0.0, 1.0]: the new version has no "
+                + "output 'z'"), port.text());
+        ChangeSetResult field = actor.call(() -> cell.planChangeSet(ChangeSet.builder().update("stage", next, Path.of("/x"),
+                "file:/x.jar", 10, java.util.List.of(new ChangeSet.Envelope("y", "q", 0, 1))).build()), 0);
+        assertTrue(field.refusal().startsWith("update stage file:/x.jar: envelope y.q [0.0, 1.0]: port type arflex.Sample "
+                + "has no field 'q'"), field.text());
+    }
+
     @Test
     void anUninstallInTheWindowStopsBothHalves() throws Exception {
         runningCell();
