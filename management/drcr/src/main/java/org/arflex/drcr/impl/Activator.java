@@ -178,6 +178,10 @@ public final class Activator implements BundleActivator {
         regs.add(ctx.registerService(ResourceManager.class, rm[0], null));
         org.arflex.drcr.impl.services.ChangeSets changeSets = new org.arflex.drcr.impl.services.ChangeSets(cell, ctx, log);
         regs.add(ctx.registerService(org.arflex.drcr.ChangeSetService.class, changeSets, null));
+        // updates in change sets (D38): the new version's jar through the same gate as a deploy
+        changeSets.versions(new org.arflex.drcr.impl.services.UpdateJars(installer, gate, reader, executables,
+                java.util.Objects.requireNonNull(ctx.getDataFile("updates"), "the framework has no data area for bundles")
+                        .toPath()));
         Hashtable<String, Object> shell = new Hashtable<>();
         shell.put("osgi.command.scope", Commands.SCOPE);
         shell.put("osgi.command.function", Commands.FUNCTIONS);

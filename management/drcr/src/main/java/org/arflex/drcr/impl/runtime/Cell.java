@@ -87,8 +87,8 @@ public final class Cell {
         this.monitor = new HeartbeatMonitor((half, why) -> actor.submit(() -> hung(half, why)));
         this.stops = new Stops(actor, stopper, monitor, cfg.shutdownMs(), log, this::stopped);
         this.segments = new Segments(cfg.runtimeId(), cfg.types(), launcher, stops,
-                new EvaluationSegments(cfg.evaluation(), launcher));
-        this.failures = new Failures(this, this::execute, log);
+                new EvaluationSegments(cfg.evaluation(), launcher), this::objectId);
+        this.failures = new Failures(this, this::execute, log, this::exitedInWindow);
         this.starter = new Starter(cfg, actor, launcher, monitor, segments, stops, failures, log, launches,
                 planner, this::changed, this::resume);
         this.plans = new PlanExecutor(this, stops, segments, starter, log);
@@ -101,6 +101,10 @@ public final class Cell {
 
     private void execute(Plan plan) {
         plans.execute(plan);
+    }
+
+    private boolean exitedInWindow(Instance inst, RtHalf half, RtHalf.Exit ex) {
+        return changeSets.exited(inst, half, ex);
     }
 
     private void hung(RtHalf half, String why) {
@@ -185,6 +189,15 @@ public final class Cell {
     /** The instance of that name, or null (actor thread). */
     Instance find(String name) {
         return instances.get(name);
+    }
+
+    /**
+     * The object id the current RT half of component {@code name} runs under: its name, or the
+     * generation id an update in a change set gave it (D38); the name itself when unknown.
+     */
+    String objectId(String name) {
+        Instance i = instances.get(name);
+        return i == null ? name : i.objectId;
     }
 
     /** Names of the instances. */
@@ -344,6 +357,7 @@ public final class Cell {
             if (inst != null) {
                 inst.life.target(State.DESTROYED);
                 failures.cancelRestart(inst);
+                changeSets.uninstalled(name, why); // an update's old half kept warm goes too (D38)
                 going.add(inst);
             }
         }
@@ -438,6 +452,13 @@ public final class Cell {
         CompletableFuture<ChangeSetResult> f = new CompletableFuture<>();
         changeSets.apply(set, o -> f.complete(ChangeSetResult.of(set, o)));
         return f;
+    }
+
+    /** {@code to} takes {@code from}'s place in the registry (actor thread): an update's switch or rollback (D38). */
+    void swap(Instance from, Instance to) {
+        if (!instances.replace(from.name, from, to)) {
+            throw new IllegalStateException(from.name + ": not the registered instance");
+        }
     }
 
     /** Removes an instance from the registry (actor thread); a change set uninstalled it. */

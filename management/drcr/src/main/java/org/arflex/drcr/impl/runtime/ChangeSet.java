@@ -8,7 +8,8 @@ import java.util.Objects;
 /**
  * Several actions on the cell planned, admitted and applied together (docs/DECISIONS.md D35):
  * installs of components that are known to the cell but not running (their bundle is installed,
- * not started), uninstalls of running ones, and parameter writes. Rewiring follows from the plan.
+ * not started), uninstalls of running ones, updates of running ones to a new version (D38), and
+ * parameter writes. Rewiring follows from the plan.
  * Immutable; build one with {@link #builder()}.
  */
 public final class ChangeSet {
@@ -32,6 +33,58 @@ public final class ChangeSet {
         @Override
         public String text() {
             return "install " + component;
+        }
+    }
+
+    /**
+     * Replaces the running RT half of {@code component} by a new version (D38): the contract
+     * {@code contract} (same name) with the executable {@code exe}, both from {@code from}, already
+     * through the code gate. The new half is prepared beside the old one under a generation's
+     * object id, switched in the set's actor turn, and the old one is kept warm for
+     * {@code window} cycles of the new one (0: stopped at once); a crash or an overrun of the new
+     * one within the window rolls the component back to the old half.
+     */
+    public record Update(String component, org.arflex.contract.Contract contract, Path exe, String from, long window,
+                         List<Envelope> envelopes) implements Step {
+
+        public Update(String component, org.arflex.contract.Contract contract, Path exe, String from, long window) {
+            this(component, contract, exe, from, window, List.of());
+        }
+
+        public Update {
+            envelopes = List.copyOf(envelopes);
+            Objects.requireNonNull(component, "component");
+            Objects.requireNonNull(contract, "contract");
+            Objects.requireNonNull(exe, "exe");
+            Objects.requireNonNull(from, "from");
+            if (window < 0) {
+                throw new IllegalArgumentException("window " + window + " < 0");
+            }
+        }
+
+        @Override
+        public String text() {
+            return "update " + component + " " + from;
+        }
+    }
+
+    /**
+     * A range every element of numeric field {@code field} of output {@code port} of an update's
+     * new version must stay in during its rollback window (D38); else it is rolled back.
+     */
+    public record Envelope(String port, String field, double min, double max) {
+        public Envelope {
+            Objects.requireNonNull(port, "port");
+            Objects.requireNonNull(field, "field");
+            if (!(min <= max)) {
+                throw new IllegalArgumentException("envelope " + port + "." + field + ": min " + min + " > max " + max);
+            }
+        }
+
+        /** As written: {@code port.field [min, max]}. */
+        @Override
+        public String toString() {
+            return port + "." + field + " [" + min + ", " + max + "]";
         }
     }
 
@@ -97,6 +150,16 @@ public final class ChangeSet {
 
         public Builder install(String name, Path exe) {
             steps.add(new Install(name, exe));
+            return this;
+        }
+
+        public Builder update(String name, org.arflex.contract.Contract contract, Path exe, String from, long window) {
+            return update(name, contract, exe, from, window, List.of());
+        }
+
+        public Builder update(String name, org.arflex.contract.Contract contract, Path exe, String from, long window,
+                              List<Envelope> envelopes) {
+            steps.add(new Update(name, contract, exe, from, window, envelopes));
             return this;
         }
 

@@ -42,7 +42,12 @@ final class ChangeSetExecutor {
      * @param prepareNs from the start of preparation to the switch
      * @param switchNs  the switch's actor turn
      */
-    record Outcome(boolean applied, String refusal, Plan plan, long prepareNs, long switchNs) {
+    record Outcome(boolean applied, String refusal, Plan plan, long prepareNs, long switchNs,
+                   java.util.concurrent.CompletableFuture<String> verdict) {
+
+        Outcome(boolean applied, String refusal, Plan plan, long prepareNs, long switchNs) {
+            this(applied, refusal, plan, prepareNs, switchNs, null);
+        }
 
         /** The text the shell prints: the refusal or the result, then the plan. */
         String text(ChangeSet set) {
@@ -76,6 +81,16 @@ final class ChangeSetExecutor {
     private final Consumer<String> log;
     /** The set being prepared, if any: one at a time (actor thread). */
     private Run current;
+    /** Updates in their rollback window, by component name (actor thread; D38). */
+    private final Map<String, Warm> warm = new LinkedHashMap<>();
+    /** How often a rollback window looks at the new half's counters. */
+    static final long WATCH_MS = 10;
+    /**
+     * Cycles with an overrun or a missed deadline the new version may have beyond what the old
+     * one, still running on the same inputs, had in the same window: the noise of a machine
+     * that is not PREEMPT_RT, where either may miss one under load.
+     */
+    static final long OVERRUN_ALLOWANCE = 2;
 
     ChangeSetExecutor(Cell cell, Stops stops, Segments segments, Starter starter, PlanExecutor plans,
                       Failures failures, Consumer<String> log) {
@@ -101,7 +116,12 @@ final class ChangeSetExecutor {
         if (current != null) {
             return new Checked(Change.none(), null, "another change set is being applied (" + current.set.describe() + ")");
         }
+        if (!warm.isEmpty()) {
+            return new Checked(Change.none(), null, "the update of " + warm.keySet() + " is in its rollback window: "
+                    + "a set is applied once it is committed or rolled back");
+        }
         List<String> problems = new ArrayList<>();
+        java.util.Set<String> updates = new HashSet<>();
         java.util.Set<String> installs = new HashSet<>();
         java.util.Set<String> uninstalls = new HashSet<>();
         java.util.Set<String> named = new HashSet<>();
@@ -125,6 +145,14 @@ final class ChangeSetExecutor {
                     installs.add(n);
                     b.install(inst.contract);
                 }
+            } else if (s instanceof ChangeSet.Update u) {
+                String why = updateProblem(inst, u);
+                if (why != null) {
+                    problems.add(s.text() + ": " + why);
+                } else {
+                    updates.add(n);
+                    b.replace(u.contract());
+                }
             } else if (s instanceof ChangeSet.Uninstall) {
                 if (inst == null || !inst.planned) {
                     problems.add(s.text() + ": '" + n + "' is not installed"
@@ -144,7 +172,8 @@ final class ChangeSetExecutor {
                     problems.add(s.text() + ": '" + p.component() + "' is uninstalled by this set");
                 } else {
                     try {
-                        Parameters.check(inst, p.param(), p.value(), !installs.contains(p.component()));
+                        Parameters.check(inst, p.param(), p.value(), !installs.contains(p.component())
+                                && !updates.contains(p.component()));
                     } catch (IllegalArgumentException e) {
                         problems.add(s.text() + ": " + e.getMessage());
                     }
@@ -163,7 +192,8 @@ final class ChangeSetExecutor {
         }
         List<String> refused = new ArrayList<>();
         for (ChangeSet.Step s : set.steps()) {
-            if (s instanceof ChangeSet.Install && !plan.activeAfter().contains(s.component())) {
+            if ((s instanceof ChangeSet.Install || s instanceof ChangeSet.Update)
+                    && !plan.activeAfter().contains(s.component())) {
                 refused.add(s.text() + ": not admitted: " + plan.inactiveAfter().getOrDefault(s.component(), "not active"));
             }
         }
@@ -175,8 +205,12 @@ final class ChangeSetExecutor {
                         refused.add("the set would stop '" + n + "' (" + a.reason() + "): name it in the set");
                     }
                 }
-                case RESTART -> refused.add("the set would restart '" + n + "' (" + a.reason()
-                        + "): a change set switches without restarts");
+                case RESTART -> {
+                    if (!updates.contains(n)) { // an update's new half is prepared beside the old one
+                        refused.add("the set would restart '" + n + "' (" + a.reason()
+                                + "): a change set switches without restarts");
+                    }
+                }
                 case HOLD -> refused.add("the set would hold '" + n + "' in a protective stop (" + a.reason() + ")");
                 case START -> {
                     Instance inst = cell.find(n);
@@ -189,6 +223,41 @@ final class ChangeSetExecutor {
             }
         }
         return new Checked(change, plan, refused.isEmpty() ? null : String.join("; ", refused));
+    }
+
+    /** Why {@code inst} cannot be updated to {@code u} in a change set, or null. */
+    private String updateProblem(Instance inst, ChangeSet.Update u) {
+        String n = u.component();
+        if (inst == null || !inst.planned) {
+            return "'" + n + "' is not installed" + (inst == null ? "" : " (" + inst.life.state() + ")");
+        }
+        if (!u.contract().name().equals(n)) {
+            return "the new version's contract is of '" + u.contract().name() + "'";
+        }
+        if (inst.half == null || inst.launching || stops.pending(n) || starter.launching(n)) {
+            return "'" + n + "' has no running RT half to update (" + inst.life.state() + "); install or update it "
+                    + "outside a change set";
+        }
+        if (inst.contract.movesHardware() || u.contract().movesHardware()) {
+            return "'" + n + "' moves hardware: its new half would drive it beside the old one; update it outside a "
+                    + "change set";
+        }
+        for (ChangeSet.Envelope e : u.envelopes()) {
+            org.arflex.contract.PortSpec out = u.contract().outputs().stream().filter(o -> o.name().equals(e.port()))
+                    .findFirst().orElse(null);
+            if (out == null) {
+                return "envelope " + e + ": the new version has no output '" + e.port() + "'";
+            }
+            var f = cell.config().types().find(out.type()).flatMap(t -> t.field(e.field())).orElse(null);
+            if (f == null || f.padding()) {
+                return "envelope " + e + ": port type " + out.type() + " has no field '" + e.field() + "'";
+            }
+        }
+        String id = Instance.generationId(n, inst.generation + 1);
+        if (id.length() > 40) {
+            return "the new half's object id '" + id + "' is longer than 40 characters (rt-core ABI)";
+        }
+        return null;
     }
 
     /**
@@ -225,6 +294,10 @@ final class ChangeSetExecutor {
         final Map<Instance, long[]> paramsBefore = new LinkedHashMap<>();
         /** Executables of the installed instances before the set. */
         final Map<Instance, java.nio.file.Path> exeBefore = new LinkedHashMap<>();
+        /** Updated components: the new version's instance (not in the registry before the switch). */
+        final Map<String, Instance> nexts = new LinkedHashMap<>();
+        /** Updated components: the running half when the set was prepared (the switch needs the same). */
+        final Map<String, RtHalf> oldHalves = new LinkedHashMap<>();
         int outstanding;
         boolean over;
 
@@ -246,15 +319,42 @@ final class ChangeSetExecutor {
                 }
             }
             for (ChangeSet.Step s : set.steps()) {
-                if (s instanceof ChangeSet.Set p && paramsBefore.containsKey(cell.find(p.component()))) {
-                    // the value the new half starts with (its spawn request carries it)
-                    Parameters.set(cell.find(p.component()), p.param(), p.value());
+                if (s instanceof ChangeSet.Update u) {
+                    Instance old = cell.find(u.component());
+                    Instance next = new Instance(u.contract(), old.bundleId, u.exe(), cell.actor(), log, old.generation + 1);
+                    next.params = Instance.carried(old.contract, old.params, u.contract());
+                    next.life.reason("change set: new version being prepared beside the running one");
+                    nexts.put(old.name, next);
+                    oldHalves.put(old.name, old.half);
+                }
+            }
+            for (ChangeSet.Step s : set.steps()) {
+                if (s instanceof ChangeSet.Set p) {
+                    Instance target = nexts.get(p.component());
+                    try {
+                        if (target != null) {
+                            Parameters.set(target, p.param(), p.value()); // the new version starts with it
+                        } else if (paramsBefore.containsKey(cell.find(p.component()))) {
+                            // the value the new half starts with (its spawn request carries it)
+                            Parameters.set(cell.find(p.component()), p.param(), p.value());
+                        }
+                    } catch (RuntimeException e) {
+                        tearDown(s.text() + ": " + e.getMessage());
+                        return;
+                    }
                 }
             }
             for (String name : plan.startOrder()) {
-                Instance inst = cell.find(name);
+                Instance inst = nexts.containsKey(name) ? nexts.get(name) : cell.find(name);
                 starting.add(inst);
-                inst.life.reason("change set: being prepared while the cell runs");
+                if (!nexts.containsKey(name)) {
+                    inst.life.reason("change set: being prepared while the cell runs");
+                }
+            }
+            for (Instance next : nexts.values()) {
+                if (!starting.contains(next)) { // a new version the planner sees no reason to restart
+                    starting.add(next);
+                }
             }
             // every output segment first, so the members of a cycle can bind to each other
             for (Instance inst : starting) {
@@ -341,7 +441,8 @@ final class ChangeSetExecutor {
 
         private void closeUnused(List<Instance> mine) {
             for (Instance inst : mine) {
-                if (inst.half == null && !inst.launching && !stops.stopping(inst) && !cell.planner().active().contains(inst.name)) {
+                if (inst.half == null && !inst.launching && !stops.stopping(inst)
+                        && (cell.find(inst.name) != inst || !cell.planner().active().contains(inst.name))) {
                     segments.close(inst);
                 }
             }
@@ -352,7 +453,13 @@ final class ChangeSetExecutor {
             long ts = cell.config().monotonicNs().getAsLong();
             Plan shown = checked.plan();
             for (Instance inst : starting) {
-                if (cell.find(inst.name) != inst) {
+                if (nexts.get(inst.name) == inst) {
+                    Instance old = cell.find(inst.name);
+                    if (old == null || old.half == null || old.half != oldHalves.get(inst.name)) {
+                        tearDown("the running half of '" + inst.name + "' changed while its new version was prepared");
+                        return;
+                    }
+                } else if (cell.find(inst.name) != inst) {
                     tearDown("'" + inst.name + "' was uninstalled while the set was prepared");
                     return;
                 }
@@ -378,6 +485,15 @@ final class ChangeSetExecutor {
                     uninstalled.add(s.component());
                 }
             }
+            // 0. an updated component's registry entry is its new version from now on: the old
+            //    half keeps running, bound to its inputs, read by nobody once its consumers follow
+            Map<String, Instance> olds = new LinkedHashMap<>();
+            for (Instance next : nexts.values()) {
+                Instance old = cell.find(next.name);
+                olds.put(next.name, old);
+                old.half = null; // its exit is the rollback window's now, not Failures'
+                cell.swap(old, next);
+            }
             // 1. the new halves: bound to their providers (running, or prepared here) and started
             for (Instance inst : starting) {
                 RtHalf half = prepared.get(inst);
@@ -392,33 +508,22 @@ final class ChangeSetExecutor {
             // 2. the running consumers follow: one BIND per input whose provider changes (taken at
             //    its next cycle boundary, the old value read until then), an UNBIND only for an
             //    input that loses its provider
+            Map<String, String> why = new LinkedHashMap<>();
             for (Plan.Action a : plan.rewires()) {
-                Instance inst = cell.find(a.component());
-                if (inst == null || inst.half == null) {
-                    continue;
-                }
-                Map<String, String> target = new java.util.TreeMap<>();
-                for (Wire w : plan.wiringOf(inst.name)) {
-                    target.put(w.inPort(), segments.name(w.provider(), w.outPort()));
-                }
-                try {
-                    for (var e : target.entrySet()) {
-                        if (!e.getValue().equals(inst.bound.get(e.getKey()))) {
-                            inst.half.bind(e.getKey(), e.getValue());
-                            inst.bound.put(e.getKey(), e.getValue());
-                        }
+                why.put(a.component(), a.reason());
+            }
+            if (!nexts.isEmpty()) {
+                // the consumers of an updated component: same provider, the new half's segments
+                for (Instance inst : cell.instances()) {
+                    if (inst.half != null && !starting.contains(inst)) {
+                        why.putIfAbsent(inst.name, "its provider was updated");
                     }
-                    for (String port : List.copyOf(inst.bound.keySet())) {
-                        if (!target.containsKey(port)) {
-                            inst.half.unbind(port);
-                            inst.bound.remove(port);
-                        }
-                    }
-                    log.accept("arflex: " + inst.name + " rewired by the change set (" + a.reason() + "); inputs "
-                            + inst.bound);
-                } catch (java.io.IOException | RuntimeException e) {
-                    log.accept("arflex: " + inst.name + ": rewiring failed: " + e.getMessage() + "; restarting it");
-                    inst.half.kill();
+                }
+            }
+            for (var e : why.entrySet()) {
+                Instance inst = cell.find(e.getKey());
+                if (inst != null && inst.half != null && !starting.contains(inst)) {
+                    rebind(inst, plan, "the change set (" + e.getValue() + ")");
                 }
             }
             // 3. the parameter writes to running components
@@ -436,8 +541,8 @@ final class ChangeSetExecutor {
             List<Instance> gone = new ArrayList<>();
             for (String name : plan.stopOrder()) {
                 Instance inst = cell.find(name);
-                if (inst == null) {
-                    continue;
+                if (inst == null || nexts.containsKey(name)) {
+                    continue; // an updated component's old half is the window's (5.)
                 }
                 failures.cancelRestart(inst);
                 if (uninstalled.contains(name)) {
@@ -459,12 +564,325 @@ final class ChangeSetExecutor {
                     inst.life.to(State.DESTROYED, inst.destroyReason);
                 }
             }
+            // 5. the old halves of updated components: kept warm for their window, or stopped now
+            List<java.util.concurrent.CompletableFuture<String>> verdicts = new ArrayList<>();
+            for (ChangeSet.Step s : set.steps()) {
+                if (s instanceof ChangeSet.Update u) {
+                    Instance next = nexts.get(u.component());
+                    Warm w = new Warm(set, u, olds.get(u.component()), oldHalves.get(u.component()), next);
+                    verdicts.add(w.verdict);
+                    w.begin();
+                }
+            }
             long switchNs = cell.config().monotonicNs().getAsLong() - ts;
             log.accept(String.format("arflex: change set %s: switched (prepared in %.1f ms, switch turn %.3f ms)",
                     set.describe(), (ts - t0) / 1e6, switchNs / 1e6));
             cell.changed();
-            done.accept(new Outcome(true, null, plan, ts - t0, switchNs));
+            java.util.concurrent.CompletableFuture<String> verdict = verdicts.isEmpty() ? null
+                    : java.util.concurrent.CompletableFuture.allOf(verdicts.toArray(java.util.concurrent.CompletableFuture[]::new))
+                    .thenApply(v -> String.join("\n", verdicts.stream().map(java.util.concurrent.CompletableFuture::join).toList()));
+            done.accept(new Outcome(true, null, plan, ts - t0, switchNs, verdict));
         }
+    }
+
+    /**
+     * Binds the running {@code inst} to the providers {@code plan} gives it, under their current
+     * object ids: one BIND per input whose segment changes (taken at its next cycle boundary,
+     * the old value read until then), an UNBIND only for an input that loses its provider. A
+     * refused command kills the half (its restart binds it afresh).
+     */
+    private void rebind(Instance inst, Plan plan, String why) {
+        Map<String, String> target = new java.util.TreeMap<>();
+        for (Wire w : plan.wiringOf(inst.name)) {
+            target.put(w.inPort(), segments.name(w.provider(), w.outPort()));
+        }
+        if (target.equals(inst.bound)) {
+            return;
+        }
+        try {
+            for (var e : target.entrySet()) {
+                if (!e.getValue().equals(inst.bound.get(e.getKey()))) {
+                    inst.half.bind(e.getKey(), e.getValue());
+                    inst.bound.put(e.getKey(), e.getValue());
+                }
+            }
+            for (String port : List.copyOf(inst.bound.keySet())) {
+                if (!target.containsKey(port)) {
+                    inst.half.unbind(port);
+                    inst.bound.remove(port);
+                }
+            }
+            log.accept("arflex: " + inst.name + " rewired by " + why + "; inputs " + inst.bound);
+        } catch (java.io.IOException | RuntimeException e) {
+            log.accept("arflex: " + inst.name + ": rewiring failed: " + e.getMessage() + "; restarting it");
+            inst.half.kill();
+        }
+    }
+
+    /**
+     * A half's exit that {@link Failures} would handle (actor thread): the new version of an
+     * update in its rollback window is rolled back instead of restarted.
+     *
+     * @return true when handled here
+     */
+    boolean exited(Instance inst, RtHalf half, RtHalf.Exit ex) {
+        Warm w = warm.get(inst.name);
+        if (w == null || w.next != inst || w.nextHalf != half) {
+            return false;
+        }
+        w.rollback("the new version (pid " + half.pid() + ") exited: " + ex.description(), ex.seenNanos());
+        return true;
+    }
+
+    /** Component {@code name} is uninstalled (actor thread): its window ends, its old half stops. */
+    void uninstalled(String name, String why) {
+        Warm w = warm.get(name);
+        if (w != null) {
+            w.end("its old version stopped: " + why, w.cyclesNow());
+        }
+    }
+
+    /**
+     * An update after its switch (D38): the old half keeps running on its inputs, unread, for
+     * {@code window} cycles of the new one; a crash of the new half, or more overruns and
+     * deadline misses than the old had in the same cycles (plus {@link #OVERRUN_ALLOWANCE}),
+     * rolls the component back: the old half is the component's again and its consumers are
+     * bound back to its segments (each at its next cycle boundary), the new half stops. Else the
+     * old half stops when the window is over. Actor thread.
+     */
+    private final class Warm {
+        final ChangeSet set;
+        final ChangeSet.Update update;
+        final Instance old;
+        final RtHalf oldHalf;
+        final Instance next;
+        final RtHalf nextHalf;
+        final java.util.concurrent.CompletableFuture<String> verdict = new java.util.concurrent.CompletableFuture<>();
+        long cycles0;
+        long lastCycles;
+        long newBad0;
+        long oldBad0;
+        long tEndNs;
+        org.arflex.drcr.impl.lifecycle.Actor.Cancellable timer;
+        boolean done;
+
+        Warm(ChangeSet set, ChangeSet.Update update, Instance old, RtHalf oldHalf, Instance next) {
+            this.set = set;
+            this.update = update;
+            this.old = old;
+            this.oldHalf = oldHalf;
+            this.next = next;
+            this.nextHalf = next.half;
+        }
+
+        void begin() {
+            if (nextHalf == null) { // its START was refused: Failures restarts the new version
+                done = true;
+                end("the new version did not start", 0);
+                return;
+            }
+            if (update.window() == 0) {
+                end("committed at the switch (no rollback window)", 0);
+                return;
+            }
+            long period = Math.max(1, next.contract.timing().periodNs());
+            // a half that does not cycle (sporadic, starved) ends its window by time
+            tEndNs = cell.config().monotonicNs().getAsLong() + 4 * update.window() * period + 1_000_000_000L;
+            warm.put(next.name, this);
+            oldHalf.exit().thenAccept(ex -> cell.actor().submit(() -> {
+                if (!done) {
+                    oldHalf.cleanup();
+                    end("the old version (pid " + oldHalf.pid() + ") exited while kept warm (" + ex.description()
+                            + "): no rollback possible any more", cyclesNow());
+                }
+            }));
+            log.accept("arflex: " + next.name + ": update switched to pid " + nextHalf.pid() + " (" + next.objectId
+                    + "); the old version (pid " + oldHalf.pid() + ", " + old.objectId + ") is kept warm for "
+                    + update.window() + " cycles");
+            // the counters' baseline right after the switch turn, which it would only lengthen
+            cell.actor().submit(this::baseline);
+        }
+
+        private void baseline() {
+            if (done) {
+                return;
+            }
+            org.arflex.drcr.impl.abi.ControlBlock.Stats n = stats(nextHalf, next);
+            org.arflex.drcr.impl.abi.ControlBlock.Stats o = stats(oldHalf, old);
+            cycles0 = n == null ? 0 : n.cycles();
+            newBad0 = bad(n);
+            oldBad0 = bad(o);
+            timer = cell.actor().schedule(this::watch, WATCH_MS);
+        }
+
+        /** The new half's cycles since the switch; the last seen once it is gone. */
+        long cyclesNow() {
+            org.arflex.drcr.impl.abi.ControlBlock.Stats n = stats(nextHalf, next);
+            if (n != null) {
+                lastCycles = n.cycles() - cycles0;
+            }
+            return lastCycles;
+        }
+
+        private void watch() {
+            timer = null;
+            if (done) {
+                return;
+            }
+            org.arflex.drcr.impl.abi.ControlBlock.Stats n = stats(nextHalf, next);
+            org.arflex.drcr.impl.abi.ControlBlock.Stats o = stats(oldHalf, old);
+            long cycles = cyclesNow();
+            long newBad = bad(n) - newBad0;
+            long oldBad = bad(o) - oldBad0;
+            String outside = outside();
+            if (outside != null) {
+                rollback(outside, System.nanoTime());
+                return;
+            }
+            if (newBad > oldBad + OVERRUN_ALLOWANCE) {
+                rollback(String.format(java.util.Locale.ROOT, "the new version overran or missed its deadline in %d "
+                        + "of its first %d cycles (the old one, on the same inputs: %d)", newBad, cycles, oldBad),
+                        System.nanoTime());
+                return;
+            }
+            if (cycles >= update.window() || cell.config().monotonicNs().getAsLong() - tEndNs >= 0) {
+                end(String.format(java.util.Locale.ROOT, "committed: the new version ran %d cycles (%d overruns or "
+                        + "deadline misses, the old one %d)", cycles, newBad, oldBad), cycles);
+                return;
+            }
+            timer = cell.actor().schedule(this::watch, WATCH_MS);
+        }
+
+        /** Which value of the new half's outputs lies outside its declared envelope, or null. */
+        private String outside() {
+            for (ChangeSet.Envelope e : update.envelopes()) {
+                org.arflex.drcr.impl.supervisor.RtLauncher.Output o = next.outputs.get(e.port());
+                org.arflex.contract.PortSpec spec = next.contract.outputs().stream()
+                        .filter(p -> p.name().equals(e.port())).findFirst().orElse(null);
+                org.arflex.contract.PortType t = spec == null ? null : cell.config().types().find(spec.type()).orElse(null);
+                if (o == null || t == null) {
+                    continue;
+                }
+                byte[] v;
+                try {
+                    v = o.newest(t.name(), (int) t.size());
+                } catch (java.io.IOException | RuntimeException ex) {
+                    continue; // not readable now: the next look
+                }
+                if (v == null) {
+                    continue;
+                }
+                for (org.arflex.drcr.dto.PortFieldDTO f : PortValues.decode(t,
+                        java.nio.ByteBuffer.wrap(v).order(java.nio.ByteOrder.LITTLE_ENDIAN))) {
+                    if (!f.name.equals(e.field())) {
+                        continue;
+                    }
+                    for (int i = 0; i < f.values.length; i++) {
+                        double x = f.values[i];
+                        if (!(x >= e.min() && x <= e.max())) {
+                            return String.format(java.util.Locale.ROOT, "output %s.%s%s = %s left the envelope [%s, %s] "
+                                    + "declared for the update", e.port(), e.field(), f.count > 1 ? "[" + i + "]" : "",
+                                    x, e.min(), e.max());
+                        }
+                    }
+                }
+            }
+            return null;
+        }
+
+        /** The window is over without a rollback: the old half stops, its segments go after it. */
+        void end(String why, long cycles) {
+            done = true;
+            warm.remove(next.name, this);
+            if (timer != null) {
+                timer.cancel();
+                timer = null;
+            }
+            old.life.target(State.DESTROYED);
+            old.destroyReason = "replaced by its new version (" + set.describe() + ")";
+            if (!oldHalf.exit().isDone()) {
+                long settle = Math.max(100, 3 * old.contract.timing().periodNs() / 1_000_000L);
+                stops.submit(List.of(new Stops.Going(old, oldHalf, List.copyOf(old.bound.keySet()), settle,
+                        old.destroyReason)));
+            } else {
+                segments.close(old);
+                old.life.to(State.DESTROYED, old.destroyReason);
+            }
+            old.bound.clear();
+            String v = "update " + next.name + ": " + why;
+            log.accept("arflex: " + v);
+            cell.changed();
+            verdict.complete(v);
+        }
+
+        /**
+         * The old half is the component's again; the new one stops (actor thread).
+         *
+         * @param seenNanos when the cause was seen ({@link System#nanoTime()}): an exit's waiter thread, or now
+         */
+        void rollback(String why, long seenNanos) {
+            done = true;
+            warm.remove(next.name, this);
+            if (timer != null) {
+                timer.cancel();
+                timer = null;
+            }
+            long cycles = cyclesNow();
+            long boundBackNanos = 0;
+            next.half = null;
+            cell.monitor().unwatch(nextHalf);
+            cell.swap(next, old);
+            old.half = oldHalf;
+            // the consumers first (they read a dead or failing half until their BIND is taken),
+            // then the planner, then once more should the old contract's wiring differ
+            for (int pass = 0; pass < 2; pass++) {
+                Plan now = cell.planner().current();
+                for (Instance inst : cell.instances()) {
+                    if (inst.half != null && inst != old) {
+                        rebind(inst, now, "the rollback of " + next.name);
+                    }
+                }
+                if (pass == 0) {
+                    boundBackNanos = System.nanoTime() - seenNanos;
+                    try {
+                        cell.planner().apply(Change.replace(old.contract));
+                    } catch (RuntimeException e) {
+                        log.accept("arflex: " + next.name + ": the planner refused the old contract back: " + e.getMessage());
+                    }
+                }
+            }
+            next.life.target(State.DESTROYED);
+            next.destroyReason = "rolled back: " + why;
+            if (nextHalf.exit().isDone()) {
+                nextHalf.cleanup();
+                next.bound.clear();
+                segments.close(next);
+                next.life.to(State.DESTROYED, next.destroyReason);
+            } else {
+                long settle = Math.max(100, 3 * next.contract.timing().periodNs() / 1_000_000L);
+                stops.submit(List.of(new Stops.Going(next, nextHalf, List.copyOf(next.bound.keySet()), settle,
+                        next.destroyReason)));
+                next.bound.clear();
+            }
+            String v = String.format(java.util.Locale.ROOT, "update %s: rolled back after %d cycles of the new version "
+                    + "(%s): %s; pid %d (%s) runs it again (its consumers bound back %.1f ms after the cause was seen)",
+                    next.name, cycles, update.from(), why, oldHalf.pid(), old.objectId, boundBackNanos / 1e6);
+            old.life.reason(null);
+            cell.problem("change set " + set.describe() + ": " + v);
+            verdict.complete(v);
+        }
+    }
+
+    private static org.arflex.drcr.impl.abi.ControlBlock.Stats stats(RtHalf half, Instance inst) {
+        try {
+            return half.exit().isDone() ? null : half.stats(inst.contract.timing().wcetNs());
+        } catch (RuntimeException e) {
+            return null;
+        }
+    }
+
+    private static long bad(org.arflex.drcr.impl.abi.ControlBlock.Stats s) {
+        return s == null ? 0 : s.overruns() + s.deadlineMisses();
     }
 
     /** Null when {@code now} does what {@code shown} said, else what differs. */
@@ -485,7 +903,8 @@ final class ChangeSetExecutor {
     private void stopQuietly(Instance inst, RtHalf half, String why) {
         Stops.Batch b = stops.submit(List.of(new Stops.Going(inst, half, List.of(), 0, why)));
         b.done.thenRun(() -> cell.actor().submit(() -> {
-            if (inst.half == null && !inst.launching && !stops.stopping(inst) && !cell.planner().active().contains(inst.name)) {
+            if (inst.half == null && !inst.launching && !stops.stopping(inst)
+                    && (cell.find(inst.name) != inst || !cell.planner().active().contains(inst.name))) {
                 segments.close(inst);
             }
         }));

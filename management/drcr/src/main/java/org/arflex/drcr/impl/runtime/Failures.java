@@ -22,7 +22,19 @@ final class Failures {
     private final Consumer<String> log;
 
     /** @param execute executes a plan of the planner ({@link PlanExecutor#execute}) */
+    /** Sees an exit first: true when it handled it (an update's rollback window, D38). */
+    interface Intercept {
+        boolean exited(Instance inst, RtHalf half, RtHalf.Exit exit);
+    }
+
+    private final Intercept intercept;
+
     Failures(Cell cell, Consumer<Plan> execute, Consumer<String> log) {
+        this(cell, execute, log, (i, h, e) -> false);
+    }
+
+    Failures(Cell cell, Consumer<Plan> execute, Consumer<String> log, Intercept intercept) {
+        this.intercept = intercept;
         this.cell = cell;
         this.execute = execute;
         this.log = log;
@@ -44,6 +56,9 @@ final class Failures {
         cell.actor().checkThread();
         if (inst.half != half) {
             return; // an orderly stop, already handled
+        }
+        if (intercept.exited(inst, half, exit)) {
+            return; // rolled back to the version it ran before (D38)
         }
         inst.half = null;
         cell.monitor().unwatch(half);

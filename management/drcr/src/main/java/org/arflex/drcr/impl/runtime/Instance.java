@@ -24,6 +24,14 @@ public final class Instance {
     }
 
     final String name;
+    /**
+     * The id its RT half runs under, in the names of its control block, queues and output
+     * segments ({@code /arflex.<rid>.<id>.*}): the name, unless a change set's update gave it
+     * a generation id ({@link #generationId}) so the new version runs beside the old (D38).
+     */
+    final String objectId;
+    /** The generation of this instance: 0 for the first, n for the n-th update in a change set. */
+    final int generation;
     volatile Contract contract;
     public volatile long bundleId;
     volatile Path executable;
@@ -70,13 +78,29 @@ public final class Instance {
     String destroyReason;
 
     Instance(Contract c, long bundleId, Path exe, Actor actor, java.util.function.Consumer<String> log) {
+        this(c, bundleId, exe, actor, log, 0);
+    }
+
+    /** Generation {@code generation} of component {@code c}: a change set's update (D38). */
+    Instance(Contract c, long bundleId, Path exe, Actor actor, java.util.function.Consumer<String> log, int generation) {
         this.name = c.name();
+        this.generation = generation;
+        this.objectId = generationId(c.name(), generation);
         this.contract = c;
         this.bundleId = bundleId;
         this.executable = exe;
         this.life = new Lifecycle(c.name(), actor, log);
         this.policy = new RestartPolicy(c.fault(), actor.clock());
         this.params = defaults(c);
+    }
+
+    /**
+     * The object id of generation {@code g} of component {@code name}: the name for 0, else
+     * {@code <g>-<name>}. A component name starts with a letter (contract 3.1), so an id that
+     * starts with a digit is never another component's; rt-core takes ids of [a-z0-9-]{1,40}.
+     */
+    static String generationId(String name, int g) {
+        return g == 0 ? name : g + "-" + name;
     }
 
     static long[] defaults(Contract c) {

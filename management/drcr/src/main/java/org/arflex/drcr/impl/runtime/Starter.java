@@ -72,7 +72,7 @@ final class Starter {
         RtLauncher.Spec spec;
         try {
             segments.ensure(inst);
-            spec = new RtLauncher.Spec(cfg.runtimeId(), inst.name, inst.executable,
+            spec = new RtLauncher.Spec(cfg.runtimeId(), inst.objectId, inst.executable,
                     ControlSetup.config(c, cpu, cfg.noMlock()), ControlSetup.params(c, params), resetRequired,
                     cfg.readyTimeoutMs());
         } catch (IOException | RuntimeException e) {
@@ -166,7 +166,7 @@ final class Starter {
         RtLauncher.Spec spec;
         try {
             segments.ensure(inst);
-            spec = new RtLauncher.Spec(cfg.runtimeId(), inst.name, inst.executable,
+            spec = new RtLauncher.Spec(cfg.runtimeId(), inst.objectId, inst.executable,
                     ControlSetup.config(c, cpu, cfg.noMlock()), ControlSetup.params(c, inst.params.clone()), false,
                     cfg.readyTimeoutMs());
         } catch (IOException | RuntimeException e) {

@@ -41,8 +41,37 @@ public final class ChangeSets implements ChangeSetService {
         Path executable(Bundle bundle, Contract c) throws IOException;
     }
 
+    /** Default rollback window of an update, in cycles of the new version (D38). */
+    static final long WINDOW = 1000;
+    /** The usage of the actions. */
+    static final String ACTIONS = "actions: install <component>, uninstall <component>, set <component> <parameter> "
+            + "<value>, update <component> <jar URL> [<sha256>] [window <cycles>] [envelope <port>.<field> <min> <max>]...";
+
+    /** A new version of a component, from a jar that passed the code gate (D38). */
+    public record Version(Contract contract, String from, String how, Extract extract) {
+    }
+
+    /** Extracts a verified version's executable (apply only, never in a dry run). */
+    @FunctionalInterface
+    public interface Extract {
+        Path executable() throws IOException;
+    }
+
+    /** Reads a new version of a component: fetched, pinned or signed, its contract read. */
+    @FunctionalInterface
+    public interface Versions {
+        /**
+         * @param sha256 the pinned SHA-256, or null: then the jar must be signed by a trusted key
+         * @throws IOException saying why the jar is refused or unreadable
+         */
+        Version read(String component, String location, String sha256) throws IOException;
+    }
+
     private final Cell cell;
     private final BundleContext context;
+    private volatile Versions versions = (n, l, s) -> {
+        throw new IOException("the DRCR is not started yet");
+    };
     private volatile Executables executables = (b, c) -> {
         throw new IOException("the DRCR is not started yet");
     };
@@ -54,12 +83,21 @@ public final class ChangeSets implements ChangeSetService {
         this.log = log;
     }
 
+    /** Where the new versions of updates come from. */
+    public void versions(Versions v) {
+        versions = v;
+    }
+
     /** Where the executables of installs come from (the extender, built after this service). */
     public void executables(Executables e) {
         executables = e;
     }
 
-    /** The actions, parsed: {@code install n}, {@code uninstall n}, {@code set n p v}, also as one token list. */
+    /**
+     * The actions, parsed: {@code install n}, {@code uninstall n}, {@code set n p v},
+     * {@code update n <url> [<sha256>] [window <cycles>]} (as {@code update n url sha|"" cycles|""}),
+     * also as one token list.
+     */
     static List<String[]> parse(List<String> actions) {
         List<String> tokens = new ArrayList<>();
         for (String a : actions) {
@@ -75,15 +113,51 @@ public final class ChangeSets implements ChangeSetService {
             int n = switch (verb) {
                 case "install", "uninstall" -> 2;
                 case "set" -> 4;
-                default -> throw new IllegalArgumentException("unknown action '" + verb
-                        + "' (actions: install <component>, uninstall <component>, set <component> <parameter> <value>)");
+                case "update" -> 3;
+                default -> throw new IllegalArgumentException("unknown action '" + verb + "' (" + ACTIONS + ")");
             };
             if (i + n > tokens.size()) {
                 throw new IllegalArgumentException("'" + String.join(" ", tokens.subList(i, tokens.size()))
-                        + "' is incomplete (" + verb + (n == 2 ? " <component>" : " <component> <parameter> <value>") + ")");
+                        + "' is incomplete (" + verb + switch (verb) {
+                            case "set" -> " <component> <parameter> <value>";
+                            case "update" -> " <component> <jar URL> [<sha256>] [window <cycles>] [envelope <port>.<field> "
+                                    + "<min> <max>]...";
+                            default -> " <component>";
+                        } + ")");
             }
-            out.add(tokens.subList(i, i + n).toArray(String[]::new));
-            i += n;
+            if (!verb.equals("update")) {
+                out.add(tokens.subList(i, i + n).toArray(String[]::new));
+                i += n;
+                continue;
+            }
+            List<String> u = new ArrayList<>(List.of(verb, tokens.get(i + 1), tokens.get(i + 2), "", ""));
+            i += 3;
+            if (i < tokens.size() && tokens.get(i).matches("[0-9a-fA-F]{64}")) {
+                u.set(3, tokens.get(i++));
+            }
+            while (i < tokens.size() && (tokens.get(i).equals("window") || tokens.get(i).equals("envelope"))) {
+                if (tokens.get(i).equals("window")) {
+                    if (i + 1 >= tokens.size() || !tokens.get(i + 1).matches("[0-9]{1,9}")) {
+                        throw new IllegalArgumentException("update " + u.get(1) + ": window needs a number of cycles");
+                    }
+                    u.set(4, tokens.get(i + 1));
+                    i += 2;
+                } else {
+                    if (i + 3 >= tokens.size() || !tokens.get(i + 1).matches("[a-z][a-z0-9_]*\\.[a-z][a-z0-9_]*")) {
+                        throw new IllegalArgumentException("update " + u.get(1) + ": envelope needs <port>.<field> <min> <max>");
+                    }
+                    try {
+                        new ChangeSet.Envelope("p", "f", Double.parseDouble(tokens.get(i + 2)),
+                                Double.parseDouble(tokens.get(i + 3)));
+                    } catch (IllegalArgumentException e) {
+                        throw new IllegalArgumentException("update " + u.get(1) + ": envelope " + tokens.get(i + 1)
+                                + ": " + tokens.get(i + 2) + " " + tokens.get(i + 3) + " is not a range (<min> <max>)");
+                    }
+                    u.add(tokens.get(i + 1) + " " + tokens.get(i + 2) + " " + tokens.get(i + 3));
+                    i += 4;
+                }
+            }
+            out.add(u.toArray(String[]::new));
         }
         return out;
     }
@@ -96,7 +170,12 @@ public final class ChangeSets implements ChangeSetService {
         } catch (IllegalArgumentException e) {
             return refused(actions, e.getMessage());
         }
-        ChangeSet set = build(parsed, false);
+        ChangeSet set;
+        try {
+            set = build(parsed, false);
+        } catch (IllegalStateException e) {
+            return refused(actions, e.getMessage());
+        }
         ChangeSetResult r = cell.actor().call(() -> cell.planChangeSet(set), Services.CALL_MS);
         String bundles = r.admitted() ? bundleProblems(parsed) : null;
         return bundles != null ? refused(actions, bundles) : dto(actions, r);
@@ -122,14 +201,21 @@ public final class ChangeSets implements ChangeSetService {
                 bundleIds.put(a[1], i.bundleId);
             }
         }
-        // refused sets are refused before anything is extracted from a bundle
-        ChangeSetResult dry = cell.actor().call(() -> cell.planChangeSet(build(parsed, false)), Services.CALL_MS);
+        // refused sets are refused before anything is extracted from a bundle or a jar
+        java.util.Map<String, Version> read = new java.util.HashMap<>();
+        ChangeSet dryRun;
+        try {
+            dryRun = build(parsed, false, read);
+        } catch (IllegalStateException e) {
+            return refused(actions, e.getMessage());
+        }
+        ChangeSetResult dry = cell.actor().call(() -> cell.planChangeSet(dryRun), Services.CALL_MS);
         if (!dry.admitted()) {
             return dto(actions, dry);
         }
         ChangeSet set;
         try {
-            set = build(parsed, true);
+            set = build(parsed, true, read);
         } catch (IllegalStateException e) {
             return refused(actions, e.getMessage());
         }
@@ -147,15 +233,60 @@ public final class ChangeSets implements ChangeSetService {
         if (r.applied()) {
             d.text += followBundles(parsed, bundleIds);
         }
+        if (r.applied() && r.verdict() != null) {
+            // an update's rollback window: the command says how it ended (committed or rolled back, why)
+            try {
+                d.text += r.verdict().get(APPLY_MS, TimeUnit.MILLISECONDS) + "\n";
+            } catch (ExecutionException | TimeoutException e) {
+                d.text += "warning: no verdict of the rollback window yet: " + e + "\n";
+            } catch (InterruptedException e) {
+                Thread.currentThread().interrupt();
+            }
+        }
         return d;
     }
 
-    /** The cell's change set; {@code extract}: the executables of installs are checked and extracted. */
     private ChangeSet build(List<String[]> parsed, boolean extract) {
+        return build(parsed, extract, new java.util.HashMap<>());
+    }
+
+    /**
+     * The cell's change set; {@code extract}: the executables of installs and updates are checked
+     * and extracted. {@code read}: the new versions of updates read so far (each jar is fetched
+     * and checked once per apply).
+     */
+    private ChangeSet build(List<String[]> parsed, boolean extract, java.util.Map<String, Version> read) {
         ChangeSet.Builder b = ChangeSet.builder();
         for (String[] a : parsed) {
             switch (a[0]) {
                 case "install" -> b.install(a[1], extract ? executable(a[1]) : Path.of("(not extracted in a dry run)"));
+                case "update" -> {
+                    Version v = read.get(a[1]);
+                    if (v == null) {
+                        try {
+                            v = versions.read(a[1], a[2], a[3].isEmpty() ? null : a[3]);
+                        } catch (IOException | RuntimeException e) {
+                            throw new IllegalStateException("update " + a[1] + ": " + e.getMessage());
+                        }
+                        read.put(a[1], v);
+                        log.accept("arflex: change set: update " + a[1] + ": " + v.from() + " (" + v.how() + "), version "
+                                + v.contract().version());
+                    }
+                    Path exe;
+                    try {
+                        exe = extract ? v.extract().executable() : Path.of("(not extracted in a dry run)");
+                    } catch (IOException e) {
+                        throw new IllegalStateException("update " + a[1] + ": cannot extract its executable: " + e.getMessage());
+                    }
+                    List<ChangeSet.Envelope> envelopes = new ArrayList<>();
+                    for (int k = 5; k < a.length; k++) {
+                        String[] e = a[k].split(" ");
+                        int dot = e[0].indexOf('.');
+                        envelopes.add(new ChangeSet.Envelope(e[0].substring(0, dot), e[0].substring(dot + 1),
+                                Double.parseDouble(e[1]), Double.parseDouble(e[2])));
+                    }
+                    b.update(a[1], v.contract(), exe, a[2], a[4].isEmpty() ? WINDOW : Long.parseLong(a[4]), envelopes);
+                }
                 case "uninstall" -> b.uninstall(a[1]);
                 default -> b.set(a[1], a[2], a[3]);
             }
@@ -192,8 +323,8 @@ public final class ChangeSets implements ChangeSetService {
         }
         List<String> problems = new ArrayList<>();
         for (String[] a : parsed) {
-            if (a[0].equals("set")) {
-                continue;
+            if (a[0].equals("set") || a[0].equals("update")) {
+                continue; // an update does not start or stop a bundle (D38)
             }
             Instance inst = find(a[1]);
             if (inst == null) {
@@ -225,7 +356,7 @@ public final class ChangeSets implements ChangeSetService {
         }
         StringBuilder sb = new StringBuilder();
         for (String[] a : parsed) {
-            if (a[0].equals("set")) {
+            if (a[0].equals("set") || a[0].equals("update")) {
                 continue;
             }
             long id = bundleIds.getOrDefault(a[1], -1L);

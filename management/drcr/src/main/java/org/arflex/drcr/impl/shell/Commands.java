@@ -206,14 +206,16 @@ public final class Commands {
     /**
      * Change sets (D35): {@code change plan <actions>} is the dry run of the whole set,
      * {@code change apply <actions>} applies it all or nothing; actions are
-     * {@code install <component>} (its bundle installed, not started), {@code uninstall <component>}
-     * and {@code set <component> <parameter> <value>}, in any number, e.g.
+     * {@code install <component>} (its bundle installed, not started), {@code uninstall <component>},
+     * {@code set <component> <parameter> <value>} and {@code update <component> <jar URL> [<sha256>]
+     * [window <cycles>]} (D38), in any number, e.g.
      * {@code change apply install teach uninstall trajectory}.
      */
     public String change(String... args) {
         return guard(() -> {
             String usage = "usage: change plan|apply <action>... (actions: install <component>, uninstall <component>,"
-                    + " set <component> <parameter> <value>)";
+                    + " set <component> <parameter> <value>, update <component> <jar URL> [<sha256>] [window <cycles>]"
+                    + " [envelope <port>.<field> <min> <max>]...)";
             if (changeSets == null || args.length < 2 || !(args[0].equals("plan") || args[0].equals("apply"))) {
                 return usage;
             }

@@ -33,6 +33,18 @@ public interface RtLauncher {
         /** Elements published by the producer. */
         long published();
 
+        /**
+         * The newest value's payload ({@code bytes} bytes of port type {@code typeName}), or
+         * null when none was written yet; any thread.
+         *
+         * @throws IOException when the segment cannot be read
+         */
+        default byte[] newest(String typeName, int bytes) throws IOException {
+            org.arflex.drcr.impl.abi.PortReader.Value v = org.arflex.drcr.impl.abi.PortReader.readNewest(name(), typeName,
+                    bytes);
+            return v.index() < 0 ? null : v.payload();
+        }
+
         /** Why the segment is damaged (truncated, header overwritten), or null when intact. */
         default String damage() {
             return null;

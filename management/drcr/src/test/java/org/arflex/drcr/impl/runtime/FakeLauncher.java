@@ -21,6 +21,8 @@ final class FakeLauncher implements RtLauncher {
     final Map<String, Integer> openOutputs = new HashMap<>();
     /** Segment name -> what damage() of its output reports (tests set it). */
     final Map<String, String> damaged = new HashMap<>();
+    /** Segment name -> the newest value's payload its output reports (tests set it; none: never written). */
+    final Map<String, byte[]> values = new java.util.concurrent.ConcurrentHashMap<>();
     /** Instances whose next launches fail. */
     final Map<String, Integer> failLaunches = new java.util.concurrent.ConcurrentHashMap<>();
     private final java.util.concurrent.atomic.AtomicLong nextPid = new java.util.concurrent.atomic.AtomicLong(1000);
@@ -220,6 +222,11 @@ final class FakeLauncher implements RtLauncher {
             @Override
             public String damage() {
                 return closed ? null : damaged.get(segmentName);
+            }
+
+            @Override
+            public byte[] newest(String typeName, int bytes) {
+                return values.get(segmentName);
             }
 
             @Override

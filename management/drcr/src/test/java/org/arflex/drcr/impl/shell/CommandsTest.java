@@ -330,7 +330,8 @@ class CommandsTest {
     @Test
     void changeWithoutActionsPrintsItsUsage() {
         String usage = "usage: change plan|apply <action>... (actions: install <component>, uninstall <component>,"
-                + " set <component> <parameter> <value>)";
+                + " set <component> <parameter> <value>, update <component> <jar URL> [<sha256>] [window <cycles>]"
+                + " [envelope <port>.<field> <min> <max>]...)";
         assertEquals(usage, cmd.change());
         assertEquals(usage, cmd.change("apply"));
         assertEquals(usage, cmd.change("do", "install", "x"));
