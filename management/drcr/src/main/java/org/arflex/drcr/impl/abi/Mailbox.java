@@ -140,36 +140,32 @@ public final class Mailbox implements AutoCloseable {
 
     /** BIND of input {@code port} to the provider segment {@code shmName}. */
     public Reply bind(String port, String shmName, long timeoutMs) throws IOException {
-        return call(Cmd.BIND, b -> {
+        return call(Cmd.BIND, bindPayload(port, shmName), timeoutMs);
+    }
+
+    private static java.util.function.Consumer<ByteBuffer> bindPayload(String port, String shmName) {
+        return b -> {
             putName(b, BIND_PORT, ControlBlock.NAME_SIZE, port);
-            putName(b, BIND_SHM_NAME, OBJ_NAME_SIZE, shmName);
+            if (shmName != null) {
+                putName(b, BIND_SHM_NAME, OBJ_NAME_SIZE, shmName);
+            }
             b.putInt(OFF_PAYLOAD_LEN, BIND_SIZE);
-        }, timeoutMs);
+        };
     }
 
     /** UNBIND of input {@code port}. */
     public Reply unbind(String port, long timeoutMs) throws IOException {
-        return call(Cmd.UNBIND, b -> {
-            putName(b, BIND_PORT, ControlBlock.NAME_SIZE, port);
-            b.putInt(OFF_PAYLOAD_LEN, BIND_SIZE);
-        }, timeoutMs);
+        return call(Cmd.UNBIND, bindPayload(port, null), timeoutMs);
     }
 
     /** Sends BIND of {@code port} to {@code shmName}; returns its seq for {@link #await}. */
     public int sendBind(String port, String shmName, long timeoutMs) throws IOException {
-        return send(Cmd.BIND, b -> {
-            putName(b, BIND_PORT, ControlBlock.NAME_SIZE, port);
-            putName(b, BIND_SHM_NAME, OBJ_NAME_SIZE, shmName);
-            b.putInt(OFF_PAYLOAD_LEN, BIND_SIZE);
-        }, timeoutMs);
+        return send(Cmd.BIND, bindPayload(port, shmName), timeoutMs);
     }
 
     /** Sends UNBIND of {@code port}; returns its seq for {@link #await}. */
     public int sendUnbind(String port, long timeoutMs) throws IOException {
-        return send(Cmd.UNBIND, b -> {
-            putName(b, BIND_PORT, ControlBlock.NAME_SIZE, port);
-            b.putInt(OFF_PAYLOAD_LEN, BIND_SIZE);
-        }, timeoutMs);
+        return send(Cmd.UNBIND, bindPayload(port, null), timeoutMs);
     }
 
     /** SET_PARAM of slot {@code index}; the reply carries the applied value. */
