@@ -82,7 +82,7 @@ final class ChangeSetExecutor {
     /** The set being prepared, if any: one at a time (actor thread). */
     private Run current;
     /** Updates in their rollback window, by component name (actor thread; D38). */
-    private final Map<String, Warm> warm = new LinkedHashMap<>();
+    private final Map<String, UpdateWindow> warm = new LinkedHashMap<>();
     /** How often a rollback window looks at the new half's counters. */
     static final long WATCH_MS = 10;
     /**
@@ -569,7 +569,7 @@ final class ChangeSetExecutor {
             for (ChangeSet.Step s : set.steps()) {
                 if (s instanceof ChangeSet.Update u) {
                     Instance next = nexts.get(u.component());
-                    Warm w = new Warm(set, u, olds.get(u.component()), oldHalves.get(u.component()), next);
+                    UpdateWindow w = new UpdateWindow(ChangeSetExecutor.this, cell, stops, segments, log, warm, set, u, olds.get(u.component()), oldHalves.get(u.component()), next);
                     verdicts.add(w.verdict);
                     w.begin();
                 }
@@ -591,7 +591,7 @@ final class ChangeSetExecutor {
      * the old value read until then), an UNBIND only for an input that loses its provider. A
      * refused command kills the half (its restart binds it afresh).
      */
-    private void rebind(Instance inst, Plan plan, String why) {
+    void rebind(Instance inst, Plan plan, String why) {
         Map<String, String> target = new java.util.TreeMap<>();
         for (Wire w : plan.wiringOf(inst.name)) {
             target.put(w.inPort(), segments.name(w.provider(), w.outPort()));
@@ -626,7 +626,7 @@ final class ChangeSetExecutor {
      * @return true when handled here
      */
     boolean exited(Instance inst, RtHalf half, RtHalf.Exit ex) {
-        Warm w = warm.get(inst.name);
+        UpdateWindow w = warm.get(inst.name);
         if (w == null || w.next != inst || w.nextHalf != half) {
             return false;
         }
@@ -636,244 +636,13 @@ final class ChangeSetExecutor {
 
     /** Component {@code name} is uninstalled (actor thread): its window ends, its old half stops. */
     void uninstalled(String name, String why) {
-        Warm w = warm.get(name);
+        UpdateWindow w = warm.get(name);
         if (w != null) {
             w.end("its old version stopped: " + why, w.cyclesNow());
         }
     }
 
-    /**
-     * An update after its switch (D38): the old half keeps running on its inputs, unread, for
-     * {@code window} cycles of the new one; a crash of the new half, or more overruns and
-     * deadline misses than the old had in the same cycles (plus {@link #OVERRUN_ALLOWANCE}),
-     * rolls the component back: the old half is the component's again and its consumers are
-     * bound back to its segments (each at its next cycle boundary), the new half stops. Else the
-     * old half stops when the window is over. Actor thread.
-     */
-    private final class Warm {
-        final ChangeSet set;
-        final ChangeSet.Update update;
-        final Instance old;
-        final RtHalf oldHalf;
-        final Instance next;
-        final RtHalf nextHalf;
-        final java.util.concurrent.CompletableFuture<String> verdict = new java.util.concurrent.CompletableFuture<>();
-        long cycles0;
-        long lastCycles;
-        long newBad0;
-        long oldBad0;
-        long tEndNs;
-        org.arflex.drcr.impl.lifecycle.Actor.Cancellable timer;
-        boolean done;
-
-        Warm(ChangeSet set, ChangeSet.Update update, Instance old, RtHalf oldHalf, Instance next) {
-            this.set = set;
-            this.update = update;
-            this.old = old;
-            this.oldHalf = oldHalf;
-            this.next = next;
-            this.nextHalf = next.half;
-        }
-
-        void begin() {
-            if (nextHalf == null) { // its START was refused: Failures restarts the new version
-                done = true;
-                end("the new version did not start", 0);
-                return;
-            }
-            if (update.window() == 0) {
-                end("committed at the switch (no rollback window)", 0);
-                return;
-            }
-            long period = Math.max(1, next.contract.timing().periodNs());
-            // a half that does not cycle (sporadic, starved) ends its window by time
-            tEndNs = cell.config().monotonicNs().getAsLong() + 4 * update.window() * period + 1_000_000_000L;
-            warm.put(next.name, this);
-            oldHalf.exit().thenAccept(ex -> cell.actor().submit(() -> {
-                if (!done) {
-                    oldHalf.cleanup();
-                    end("the old version (pid " + oldHalf.pid() + ") exited while kept warm (" + ex.description()
-                            + "): no rollback possible any more", cyclesNow());
-                }
-            }));
-            log.accept("arflex: " + next.name + ": update switched to pid " + nextHalf.pid() + " (" + next.objectId
-                    + "); the old version (pid " + oldHalf.pid() + ", " + old.objectId + ") is kept warm for "
-                    + update.window() + " cycles");
-            // the counters' baseline right after the switch turn, which it would only lengthen
-            cell.actor().submit(this::baseline);
-        }
-
-        private void baseline() {
-            if (done) {
-                return;
-            }
-            org.arflex.drcr.impl.abi.ControlBlock.Stats n = stats(nextHalf, next);
-            org.arflex.drcr.impl.abi.ControlBlock.Stats o = stats(oldHalf, old);
-            cycles0 = n == null ? 0 : n.cycles();
-            newBad0 = bad(n);
-            oldBad0 = bad(o);
-            timer = cell.actor().schedule(this::watch, WATCH_MS);
-        }
-
-        /** The new half's cycles since the switch; the last seen once it is gone. */
-        long cyclesNow() {
-            org.arflex.drcr.impl.abi.ControlBlock.Stats n = stats(nextHalf, next);
-            if (n != null) {
-                lastCycles = n.cycles() - cycles0;
-            }
-            return lastCycles;
-        }
-
-        private void watch() {
-            timer = null;
-            if (done) {
-                return;
-            }
-            org.arflex.drcr.impl.abi.ControlBlock.Stats n = stats(nextHalf, next);
-            org.arflex.drcr.impl.abi.ControlBlock.Stats o = stats(oldHalf, old);
-            long cycles = cyclesNow();
-            long newBad = bad(n) - newBad0;
-            long oldBad = bad(o) - oldBad0;
-            String outside = outside();
-            if (outside != null) {
-                rollback(outside, System.nanoTime());
-                return;
-            }
-            if (newBad > oldBad + OVERRUN_ALLOWANCE) {
-                rollback(String.format(java.util.Locale.ROOT, "the new version overran or missed its deadline in %d "
-                        + "of its first %d cycles (the old one, on the same inputs: %d)", newBad, cycles, oldBad),
-                        System.nanoTime());
-                return;
-            }
-            if (cycles >= update.window() || cell.config().monotonicNs().getAsLong() - tEndNs >= 0) {
-                end(String.format(java.util.Locale.ROOT, "committed: the new version ran %d cycles (%d overruns or "
-                        + "deadline misses, the old one %d)", cycles, newBad, oldBad), cycles);
-                return;
-            }
-            timer = cell.actor().schedule(this::watch, WATCH_MS);
-        }
-
-        /** Which value of the new half's outputs lies outside its declared envelope, or null. */
-        private String outside() {
-            for (ChangeSet.Envelope e : update.envelopes()) {
-                org.arflex.drcr.impl.supervisor.RtLauncher.Output o = next.outputs.get(e.port());
-                org.arflex.contract.PortSpec spec = next.contract.outputs().stream()
-                        .filter(p -> p.name().equals(e.port())).findFirst().orElse(null);
-                org.arflex.contract.PortType t = spec == null ? null : cell.config().types().find(spec.type()).orElse(null);
-                if (o == null || t == null) {
-                    continue;
-                }
-                byte[] v;
-                try {
-                    v = o.newest(t.name(), (int) t.size());
-                } catch (java.io.IOException | RuntimeException ex) {
-                    continue; // not readable now: the next look
-                }
-                if (v == null) {
-                    continue;
-                }
-                for (org.arflex.drcr.dto.PortFieldDTO f : PortValues.decode(t,
-                        java.nio.ByteBuffer.wrap(v).order(java.nio.ByteOrder.LITTLE_ENDIAN))) {
-                    if (!f.name.equals(e.field())) {
-                        continue;
-                    }
-                    for (int i = 0; i < f.values.length; i++) {
-                        double x = f.values[i];
-                        if (!(x >= e.min() && x <= e.max())) {
-                            return String.format(java.util.Locale.ROOT, "output %s.%s%s = %s left the envelope [%s, %s] "
-                                    + "declared for the update", e.port(), e.field(), f.count > 1 ? "[" + i + "]" : "",
-                                    x, e.min(), e.max());
-                        }
-                    }
-                }
-            }
-            return null;
-        }
-
-        /** The window is over without a rollback: the old half stops, its segments go after it. */
-        void end(String why, long cycles) {
-            done = true;
-            warm.remove(next.name, this);
-            if (timer != null) {
-                timer.cancel();
-                timer = null;
-            }
-            old.life.target(State.DESTROYED);
-            old.destroyReason = "replaced by its new version (" + set.describe() + ")";
-            if (!oldHalf.exit().isDone()) {
-                long settle = Math.max(100, 3 * old.contract.timing().periodNs() / 1_000_000L);
-                stops.submit(List.of(new Stops.Going(old, oldHalf, List.copyOf(old.bound.keySet()), settle,
-                        old.destroyReason)));
-            } else {
-                segments.close(old);
-                old.life.to(State.DESTROYED, old.destroyReason);
-            }
-            old.bound.clear();
-            String v = "update " + next.name + ": " + why;
-            log.accept("arflex: " + v);
-            cell.changed();
-            verdict.complete(v);
-        }
-
-        /**
-         * The old half is the component's again; the new one stops (actor thread).
-         *
-         * @param seenNanos when the cause was seen ({@link System#nanoTime()}): an exit's waiter thread, or now
-         */
-        void rollback(String why, long seenNanos) {
-            done = true;
-            warm.remove(next.name, this);
-            if (timer != null) {
-                timer.cancel();
-                timer = null;
-            }
-            long cycles = cyclesNow();
-            long boundBackNanos = 0;
-            next.half = null;
-            cell.monitor().unwatch(nextHalf);
-            cell.swap(next, old);
-            old.half = oldHalf;
-            // the consumers first (they read a dead or failing half until their BIND is taken),
-            // then the planner, then once more should the old contract's wiring differ
-            for (int pass = 0; pass < 2; pass++) {
-                Plan now = cell.planner().current();
-                for (Instance inst : cell.instances()) {
-                    if (inst.half != null && inst != old) {
-                        rebind(inst, now, "the rollback of " + next.name);
-                    }
-                }
-                if (pass == 0) {
-                    boundBackNanos = System.nanoTime() - seenNanos;
-                    try {
-                        cell.planner().apply(Change.replace(old.contract));
-                    } catch (RuntimeException e) {
-                        log.accept("arflex: " + next.name + ": the planner refused the old contract back: " + e.getMessage());
-                    }
-                }
-            }
-            next.life.target(State.DESTROYED);
-            next.destroyReason = "rolled back: " + why;
-            if (nextHalf.exit().isDone()) {
-                nextHalf.cleanup();
-                next.bound.clear();
-                segments.close(next);
-                next.life.to(State.DESTROYED, next.destroyReason);
-            } else {
-                long settle = Math.max(100, 3 * next.contract.timing().periodNs() / 1_000_000L);
-                stops.submit(List.of(new Stops.Going(next, nextHalf, List.copyOf(next.bound.keySet()), settle,
-                        next.destroyReason)));
-                next.bound.clear();
-            }
-            String v = String.format(java.util.Locale.ROOT, "update %s: rolled back after %d cycles of the new version "
-                    + "(%s): %s; pid %d (%s) runs it again (its consumers bound back %.1f ms after the cause was seen)",
-                    next.name, cycles, update.from(), why, oldHalf.pid(), old.objectId, boundBackNanos / 1e6);
-            old.life.reason(null);
-            cell.problem("change set " + set.describe() + ": " + v);
-            verdict.complete(v);
-        }
-    }
-
-    private static org.arflex.drcr.impl.abi.ControlBlock.Stats stats(RtHalf half, Instance inst) {
+    static org.arflex.drcr.impl.abi.ControlBlock.Stats stats(RtHalf half, Instance inst) {
         try {
             return half.exit().isDone() ? null : half.stats(inst.contract.timing().wcetNs());
         } catch (RuntimeException e) {
@@ -881,7 +650,7 @@ final class ChangeSetExecutor {
         }
     }
 
-    private static long bad(org.arflex.drcr.impl.abi.ControlBlock.Stats s) {
+    static long bad(org.arflex.drcr.impl.abi.ControlBlock.Stats s) {
         return s == null ? 0 : s.overruns() + s.deadlineMisses();
     }
 
