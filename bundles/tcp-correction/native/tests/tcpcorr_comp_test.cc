@@ -244,6 +244,23 @@ struct Rig {
     arflex_state_write(arflex_host_output(&feeder, "tcp_pose"), &p, sizeof(p));
   }
 
+  // Reads until `n` new outputs in a row equal the one before them: the correction has come
+  // to rest (it slews at max_rate towards its target). False when it has not within 20 s.
+  bool Settle(int n) {
+    const uint64_t deadline = arflex_sys_now_ns() + 20 * kSec;
+    Read();
+    arflex_joint_ref prev = last;
+    int same = 0;
+    while (same < n && arflex_sys_now_ns() < deadline) {
+      if (!Read() || last.seq == prev.seq) continue;
+      bool equal = true;
+      for (int i = 0; i < 6; ++i) equal = equal && last.q[i] == prev.q[i];
+      same = equal ? same + 1 : 0;
+      prev = last;
+    }
+    return same >= n;
+  }
+
   uint64_t Errors() {
     arflex_stats st;
     return arflex_ctl_stats_read(corr.ctl, &st) == 0 ? st.update_errors : 0;
@@ -377,6 +394,8 @@ int RunCase(const std::string& name, const char* exe) {
     //    state at the output lets them in again and the output moves.
     {
       rig.Watch(200 * kMs, false, true, Eigen::Vector3d::Zero());
+      // the correction may still be slewing towards what case 2 measured: at rest first
+      CHECK(rig.Settle(50), "the output did not come to rest");
       const arflex_joint_ref held = rig.last;
       arflex_joint_state js;
       std::memset(&js, 0, sizeof(js));
