@@ -438,6 +438,12 @@ class WebConsoleIT {
         open("arflex-component?name=sample-counter");
         new WebDriverWait(browser, WAIT).until(d -> d.findElement(By.id("arflex-summary")).getText().contains("INSTALLED"));
         await(By.id("arflex-cmd-start")).click();
+        // the console's own answer first: "start: done", or why not (a failure names it here)
+        String answered = new WebDriverWait(browser, WAIT).until(d -> {
+            String t = d.findElement(By.id("arflex-component-status")).getText();
+            return t.contains("start:") ? t : null;
+        });
+        assertTrue(answered.contains("start: done"), "the console answered the start with: " + answered);
         RuntimeUnderTest.awaitCondition("both Active", WAIT,
                 () -> "ACTIVE".equals(instanceState("sample-counter")) && "ACTIVE".equals(instanceState("sample-scaler")));
     }
