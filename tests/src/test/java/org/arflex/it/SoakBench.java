@@ -176,6 +176,7 @@ class SoakBench {
             if (samples.isEmpty() || samples.get(samples.size() - 1)[0] != cycles.get()) {
                 sampleQuietly(); // the last churn window ends here
             }
+            readKills(rt);
             for (String l : rt.logSince(0)) {
                 if (l.contains("rewiring failed") || l.contains("did not answer")) {
                     System.out.println("soak: log " + l); // a half that did not take a command in time
@@ -263,16 +264,39 @@ class SoakBench {
         if (!Signals.tryToSend(pid, "9")) {
             return false; // it went away by itself (an uninstall) in between
         }
-        String who = name + " (pid " + pid + ") ";
-        double d = FaultBench.detection(rt, mark, at, who);
-        if (d >= 0) {
-            detections.add(d);
-        }
-        double h = handled(rt, mark, who);
-        if (h >= 0) {
-            handlings.add(h);
-        }
+        // read from the log at the end: waiting here for the DRCR's lines held the probe loop
+        // (and, behind a sample waiting for the lock, every worker) for seconds per kill
+        kills.add(new Kill(mark, at, name + " (pid " + pid + ") "));
         return true;
+    }
+
+    /** One kill -9: the log mark and wall time just before it, and how the DRCR names the half. */
+    private record Kill(int mark, java.time.LocalTime at, String who) {
+    }
+
+    private final List<Kill> kills = new ArrayList<>();
+
+    /** Detection and handling of every kill, from the runtime's log (the last one waited for). */
+    private void readKills(Runtime rt) {
+        if (!kills.isEmpty()) {
+            Kill last = kills.get(kills.size() - 1);
+            FaultBench.detection(rt, last.mark(), last.at(), last.who()); // its lines may still be on their way
+            handled(rt, last.mark(), last.who());
+        }
+        Pattern p = Pattern.compile("\\(handled ([0-9.]+) ms after the exit was seen\\)");
+        for (Kill k : kills) {
+            List<String> after = rt.logSince(k.mark());
+            after.stream().filter(l -> l.contains(k.who())).findFirst().ifPresent(l -> {
+                try {
+                    detections.add(java.time.Duration.between(k.at(),
+                            java.time.LocalTime.parse(l.replace("err| ", "").split(" ", 2)[0])).toNanos() / 1e6);
+                } catch (java.time.format.DateTimeParseException e) {
+                    // not a line of the DRCR's log
+                }
+            });
+            after.stream().filter(l -> l.contains(k.who())).map(p::matcher).filter(Matcher::find).findFirst()
+                    .ifPresent(m -> handlings.add(Double.parseDouble(m.group(1))));
+        }
     }
 
     /** The actor's "(handled X ms after the exit was seen)" for @who, or -1 (not within 10 s). */
