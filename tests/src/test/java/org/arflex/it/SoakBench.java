@@ -177,8 +177,10 @@ class SoakBench {
                 sampleQuietly(); // the last churn window ends here
             }
             readKills(rt);
-            for (String l : rt.logSince(0)) {
-                if (l.contains("rewiring failed") || l.contains("did not answer")) {
+            List<String> all = rt.logSince(0);
+            for (int li = 0; li < all.size(); li++) {
+                String l = all.get(li);
+                if (l.contains("rewiring failed") || l.contains("did not answer") || l.contains("an actor task has run")) {
                     System.out.println("soak: log " + l); // a half that did not take a command in time
                 }
                 for (Pattern p : new Pattern[] {SILENT, ACTOR}) {
@@ -191,10 +193,16 @@ class SoakBench {
                         } else {
                             maxStallMs = Math.max(maxStallMs, ms);
                             System.out.println("soak: log " + l); // which stall, and when
+                            if (ms >= 50) {
+                                // what the runtime said just before: whoever held the actor or the JVM
+                                all.subList(Math.max(0, li - 40), li).stream().filter(c -> c.startsWith("err| ")).skip(0)
+                                        .forEach(c -> System.out.println("soak:   before: " + c.substring(0, Math.min(c.length(), 220))));
+                            }
                         }
                     }
                 }
             }
+            jvmPauses(rt.dir.resolve("jvm-pauses.log"));
             if (Boolean.getBoolean("arflex.bench.histogram")) {
                 // what the heap holds after the churn: the classes with the most bytes
                 Jcmd.run(sjvm, "GC.class_histogram").lines().limit(25)
@@ -268,6 +276,28 @@ class SoakBench {
         // (and, behind a sample waiting for the lock, every worker) for seconds per kill
         kills.add(new Kill(mark, at, name + " (pid " + pid + ") "));
         return true;
+    }
+
+    /** The runtime JVM's safepoint pauses (its -Xlog:safepoint) over 20 ms, the bench's own full GCs among them. */
+    private static void jvmPauses(Path log) throws Exception {
+        if (!Files.isRegularFile(log)) {
+            return;
+        }
+        Pattern total = Pattern.compile("Safepoint \"([^\"]+)\".*Total: (\\d+) ns");
+        int over = 0;
+        long max = 0;
+        for (String l : Files.readAllLines(log)) {
+            Matcher m = total.matcher(l);
+            if (m.find()) {
+                long ms = Long.parseLong(m.group(2)) / 1_000_000L;
+                if (ms >= 20) {
+                    over++;
+                    max = Math.max(max, ms);
+                    System.out.println("soak: JVM pause " + ms + " ms: " + m.group(1) + " " + l.split(" ", 2)[0]);
+                }
+            }
+        }
+        System.out.printf(Locale.ROOT, "soak: JVM safepoint pauses over 20 ms: %d, longest %d ms (jvm-pauses.log)%n", over, max);
     }
 
     /** One kill -9: the log mark and wall time just before it, and how the DRCR names the half. */

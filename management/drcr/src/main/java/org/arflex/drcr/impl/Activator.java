@@ -63,6 +63,8 @@ public final class Activator implements BundleActivator {
     private static final Pattern RID = Pattern.compile("[a-z0-9-]{1,40}");
     private static final SecureRandom RANDOM = new SecureRandom();
     private static final long HEARTBEAT_MS = org.arflex.drcr.impl.supervisor.HeartbeatMonitor.PERIOD_MS;
+    /** An actor task running longer than this is reported with its stack (issue 17: stalls under 50 ms). */
+    private static final long ACTOR_WATCH_MS = 50;
     private static final long SAMPLE_MS = 1_000;
 
     private ThreadActor actor;
@@ -231,6 +233,7 @@ public final class Activator implements BundleActivator {
             try {
                 bridge.round();
                 cell.monitor().check(Posix.monotonicNs());
+                actor.watch(ACTOR_WATCH_MS); // a task that holds supervision: where it is
             } catch (RuntimeException e) {
                 log.accept("arflex: heartbeat round failed: " + e);
             }

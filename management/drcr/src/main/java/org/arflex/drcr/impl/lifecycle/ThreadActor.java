@@ -24,6 +24,10 @@ public final class ThreadActor implements Actor {
     /** A wait for the actor longer than this is logged when it is the longest yet. */
     static final long LAG_LOG_MS = 20;
     private long longestWaitNs = LAG_LOG_MS * 1_000_000L; // actor thread only
+    /** When the running task began (System.nanoTime), 0 when the actor is idle. */
+    private volatile long taskStartNs;
+    /** The running task was reported by {@link #watch} already. */
+    private volatile boolean taskReported;
 
     public ThreadActor(Consumer<String> log) {
         this.log = log;
@@ -32,7 +36,18 @@ public final class ThreadActor implements Actor {
             t.setDaemon(true);
             thread = t;
             return t;
-        });
+        }) {
+            @Override
+            protected void beforeExecute(Thread t, Runnable r) {
+                taskReported = false;
+                taskStartNs = System.nanoTime();
+            }
+
+            @Override
+            protected void afterExecute(Runnable r, Throwable t) {
+                taskStartNs = 0;
+            }
+        };
         executor.setRemoveOnCancelPolicy(true);
         executor.setExecuteExistingDelayedTasksAfterShutdownPolicy(false);
     }
@@ -64,6 +79,40 @@ public final class ThreadActor implements Actor {
             longestWaitNs = w;
             log.accept("arflex: the actor answered after " + w / 1_000_000L + " ms (longest yet)");
         }
+    }
+
+    /**
+     * From another thread (the DRCR's ticker): when the actor's current task has run longer than
+     * {@code thresholdMs}, logs once where it is ("an actor task has run N ms, at ..."), the
+     * DRCR's frames of the actor thread's stack. What a supervision stall's line alone cannot say.
+     *
+     * @return the frames logged, or null when nothing was reported
+     */
+    public String watch(long thresholdMs) {
+        long s = taskStartNs;
+        Thread t = thread;
+        if (s == 0 || t == null || taskReported) {
+            return null;
+        }
+        long ran = System.nanoTime() - s;
+        if (ran < thresholdMs * 1_000_000L) {
+            return null;
+        }
+        StringBuilder at = new StringBuilder();
+        int n = 0;
+        for (StackTraceElement e : t.getStackTrace()) {
+            if (n < 6 && (e.getClassName().startsWith("org.arflex.") || n == 0)) {
+                at.append(n++ == 0 ? "" : " < ").append(e.getClassName().replaceFirst("^org\\.arflex\\.drcr\\.impl\\.", ""))
+                        .append('.').append(e.getMethodName()).append(':').append(e.getLineNumber());
+            }
+        }
+        if (taskStartNs != s) {
+            return null; // that task ended meanwhile: its stack is another's
+        }
+        taskReported = true;
+        String frames = at.toString();
+        log.accept("arflex: an actor task has run " + ran / 1_000_000L + " ms, at " + frames);
+        return frames;
     }
 
     @Override

@@ -77,4 +77,38 @@ class ThreadActorTest {
         actor.call(() -> null, 5_000);
         assertEquals(lags.size(), lags().size());
     }
+
+    /** A task that holds the actor, as a stop that waits on a process would. */
+    private static void holdTheActor(CountDownLatch release) {
+        try {
+            release.await(10, TimeUnit.SECONDS);
+        } catch (InterruptedException e) {
+            Thread.currentThread().interrupt();
+        }
+    }
+
+    @Test
+    void aTaskThatHoldsTheActorIsReportedOnceWithWhereItIs() throws Exception {
+        assertEquals(null, actor.watch(50), "an idle actor: nothing to report");
+        CountDownLatch running = new CountDownLatch(1);
+        CountDownLatch release = new CountDownLatch(1);
+        actor.submit(() -> {
+            running.countDown();
+            holdTheActor(release);
+        });
+        assertTrue(running.await(10, TimeUnit.SECONDS));
+        long started = System.nanoTime();
+        assertEquals(null, actor.watch(60_000), "not over the threshold");
+        String frames = null;
+        while (frames == null && System.nanoTime() - started < 10_000_000_000L) {
+            frames = actor.watch(50);
+            LockSupport.parkNanos(1_000_000);
+        }
+        assertTrue(frames != null && frames.contains("ThreadActorTest.holdTheActor"), String.valueOf(frames));
+        assertEquals(null, actor.watch(50), "reported once per task");
+        String line = log.stream().filter(l -> l.contains("an actor task has run")).findFirst().orElse("");
+        assertTrue(line.contains("ThreadActorTest.holdTheActor") && Long.parseLong(line.replaceAll(".*has run (\\d+) ms.*", "$1")) >= 50,
+                line);
+        release.countDown();
+    }
 }
