@@ -45,10 +45,11 @@ final class PlanExecutor {
         // Live rewiring: inputs whose provider changes or goes are unbound before any stop, so
         // no consumer reads a provider while it goes away; new bindings come after the starts,
         // when every provider's segment exists.
-        List<java.util.concurrent.CompletableFuture<Void>> unbinding = new ArrayList<>();
+        List<Sent> unbinds = new ArrayList<>();
         for (Plan.Action a : plan.rewires()) {
-            unbinding.addAll(rebind(cell.find(a.component()), plan.wiringOf(a.component()), false, a.reason()));
+            rebind(cell.find(a.component()), plan.wiringOf(a.component()), false, a.reason(), unbinds);
         }
+        List<java.util.concurrent.CompletableFuture<Void>> unbinding = settle(unbinds);
         // The plan's stops in three sweeps, so that their waits overlap: every half to stop is
         // detached and its inputs unbound, then each is given its cycles to run its safe
         // behaviour (counted from the unbind, so the waits run side by side), then each is
@@ -100,10 +101,12 @@ final class PlanExecutor {
                 starter.start(inst, plan.cpuAssignment().getOrDefault(name, -1));
             }
         }
+        List<Sent> binds = new ArrayList<>();
         for (Plan.Action a : plan.rewires()) {
             rebind(cell.find(a.component()), plan.wiringOf(a.component()).stream()
-                    .filter(w -> !waiting.contains(w.provider())).toList(), true, a.reason());
+                    .filter(w -> !waiting.contains(w.provider())).toList(), true, a.reason(), binds);
         }
+        settle(binds);
         // Everything the plan leaves inactive shows the planner's reason (a start that waited is
         // off when the planner no longer wants it).
         Set<String> activeNow = cell.planner().active();
@@ -119,21 +122,20 @@ final class PlanExecutor {
         }
     }
 
+    /** A BIND or UNBIND sent to a running half, its answer not yet looked at. */
+    private record Sent(Instance inst, RtHalf h, String port, String segment,
+                        java.util.concurrent.CompletableFuture<Void> answer) {
+    }
+
     /**
-     * One phase of a REBIND: unbind (bindPhase false) the inputs whose segment changes or goes,
-     * or bind (bindPhase true) the inputs to their new segments. The RT half picks a binding up
-     * at a cycle boundary and keeps running. The actor waits at most {@link #ANSWER_MS} for each
-     * answer (D39): a half that is slower (a long period) or frozen answers later, on a confirmer
-     * thread, and the plan goes on meanwhile. A refusal, or no answer within the call timeout,
-     * means the half cannot follow the new wiring: it is restarted through the normal failure
-     * path, as a crash would be. UNBINDs still unanswered are returned: the plan's stops wait for
-     * them before any provider is stopped.
+     * One phase of a REBIND: sends the UNBINDs (bindPhase false) of the inputs whose segment
+     * changes or goes, or the BINDs (bindPhase true) of the inputs to their new segments, to
+     * {@code inst}'s running half without waiting for its answers; {@link #settle} looks at them.
+     * The RT half picks a binding up at a cycle boundary and keeps running.
      */
-    private List<java.util.concurrent.CompletableFuture<Void>> rebind(Instance inst, List<Wire> wires, boolean bindPhase,
-                                                                     String why) {
-        List<java.util.concurrent.CompletableFuture<Void>> open = new ArrayList<>();
+    private void rebind(Instance inst, List<Wire> wires, boolean bindPhase, String why, List<Sent> into) {
         if (inst == null || inst.half == null) {
-            return open;
+            return;
         }
         Map<String, String> target = new TreeMap<>();
         for (Wire w : wires) {
@@ -156,31 +158,60 @@ final class PlanExecutor {
         }
         for (var e : changes.entrySet()) {
             String port = e.getKey();
-            java.util.concurrent.CompletableFuture<Void> f = h.rebind(port, e.getValue(), ANSWER_MS);
+            java.util.concurrent.CompletableFuture<Void> f = h.rebind(port, e.getValue(), 0);
             if (f.isCompletedExceptionally()) {
                 rewiringFailed(inst, h, f);
-                return open;
+                return;
             }
             if (e.getValue() == null) {
                 inst.bound.remove(port);
             } else {
                 inst.bound.put(port, e.getValue());
             }
-            if (!f.isDone()) {
-                log.accept("arflex: " + inst.name + " has not answered " + (e.getValue() == null ? "UNBIND " : "BIND ")
-                        + port + " within " + ANSWER_MS + " ms; the plan goes on, its answer is awaited apart");
-                f.whenComplete((v, ex) -> {
-                    if (ex != null) {
-                        cell.actor().submit(() -> rewiringFailed(inst, h, f));
-                    }
-                });
-                if (e.getValue() == null) {
-                    open.add(f);
-                }
-            }
+            into.add(new Sent(inst, h, port, e.getValue(), f));
         }
         if (bindPhase) {
             log.accept("arflex: " + inst.name + " rewired while running (" + why + "); inputs " + inst.bound);
+        }
+    }
+
+    /**
+     * Looks at the answers of a phase's BINDs or UNBINDs, all sent first: the actor waits at most
+     * {@link #ANSWER_MS} for all of them together (D39; the consumers' cycles run side by side,
+     * so n consumers cost the actor one wait, not n). A half that is slower (a long period) or
+     * frozen answers later, on a confirmer thread, and the plan goes on meanwhile. A refusal, or
+     * no answer within the call timeout, means the half cannot follow the new wiring: it is
+     * restarted through the normal failure path, as a crash would be. UNBINDs still unanswered
+     * are returned: the plan's stops wait for them before any provider is stopped.
+     */
+    private List<java.util.concurrent.CompletableFuture<Void>> settle(List<Sent> sent) {
+        List<java.util.concurrent.CompletableFuture<Void>> open = new ArrayList<>();
+        long deadline = System.nanoTime() + ANSWER_MS * 1_000_000L;
+        for (Sent s : sent) {
+            try {
+                s.answer().get(Math.max(0, deadline - System.nanoTime()), java.util.concurrent.TimeUnit.NANOSECONDS);
+            } catch (java.util.concurrent.TimeoutException | java.util.concurrent.ExecutionException e) {
+                // looked at below
+            } catch (InterruptedException e) {
+                Thread.currentThread().interrupt();
+            }
+        }
+        for (Sent s : sent) {
+            java.util.concurrent.CompletableFuture<Void> f = s.answer();
+            if (f.isCompletedExceptionally()) {
+                rewiringFailed(s.inst(), s.h(), f);
+            } else if (!f.isDone()) {
+                log.accept("arflex: " + s.inst().name + " has not answered " + (s.segment() == null ? "UNBIND " : "BIND ")
+                        + s.port() + " within " + ANSWER_MS + " ms; the plan goes on, its answer is awaited apart");
+                f.whenComplete((v, ex) -> {
+                    if (ex != null) {
+                        cell.actor().submit(() -> rewiringFailed(s.inst(), s.h(), f));
+                    }
+                });
+                if (s.segment() == null) {
+                    open.add(f);
+                }
+            }
         }
         return open;
     }
@@ -308,14 +339,16 @@ final class PlanExecutor {
                 starter.start(inst, now.cpuAssignment().getOrDefault(name, -1));
             }
         }
+        List<Sent> binds = new ArrayList<>();
         for (Instance inst : cell.instances()) {
             if (inst.half == null) {
                 continue;
             }
             List<Wire> wires = now.wiringOf(inst.name).stream().filter(w -> !waiting.contains(w.provider())).toList();
             if (wires.stream().anyMatch(w -> !segments.name(w.provider(), w.outPort()).equals(inst.bound.get(w.inPort())))) {
-                rebind(inst, wires, true, "its provider started after its previous RT half exited");
+                rebind(inst, wires, true, "its provider started after its previous RT half exited", binds);
             }
         }
+        settle(binds);
     }
 }
