@@ -271,6 +271,17 @@ final class Starter {
             changed.run();
             return false;
         }
+        adopt(inst, half, cpu, t0, tLaunched);
+        return true;
+    }
+
+    /**
+     * Makes a half that is bound and started already the instance's running half (actor thread):
+     * ACTIVE, watched, its exit to {@link Failures}. {@link #activate} ends here; an update's
+     * shadow run (D42, {@link ShadowRun}) bound and started its half itself and comes here at
+     * the switch, with no second BIND or START.
+     */
+    void adopt(Instance inst, RtHalf half, int cpu, long t0, long tLaunched) {
         Contract c = inst.contract;
         inst.half = half;
         inst.cpu = cpu;
@@ -291,7 +302,6 @@ final class Starter {
         log.accept("arflex: " + inst.name + " ACTIVE (pid " + half.pid() + ", cpu " + cpu + ", inputs " + inst.bound
                 + "; spawn to READY " + (tLaunched - t0) / 1000 + " us, bind+start " + (t1 - tLaunched) / 1000 + " us)");
         changed.run();
-        return true;
     }
 
     private void fail(Instance inst, Exception e) {
