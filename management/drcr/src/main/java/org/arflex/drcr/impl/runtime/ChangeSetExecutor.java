@@ -564,7 +564,7 @@ final class ChangeSetExecutor {
                 }
                 if (shadows.containsKey(inst)) { // bound and started by its shadow run (D42)
                     starter.adopt(inst, Objects.requireNonNull(half), plan.cpuAssignment().getOrDefault(inst.name, -1),
-                            t0, ts);
+                            "bound and started by its shadow run");
                 } else {
                     starter.activate(inst, Objects.requireNonNull(half), plan.cpuAssignment().getOrDefault(inst.name, -1),
                             inst.params.clone(), plan.wiringOf(inst.name), t0, ts);

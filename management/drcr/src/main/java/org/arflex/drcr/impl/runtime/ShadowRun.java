@@ -209,8 +209,9 @@ final class ShadowRun {
                     oldBad, compared));
             for (int i = 0; i < largest.length; i++) {
                 ChangeSet.Tolerance t = update.tolerances().get(i);
-                sb.append(String.format(Locale.ROOT, ", %s.%s at most %.3g from the running version's (tolerance %s)",
-                        t.port(), t.field(), largest[i], t.abs()));
+                sb.append(String.format(Locale.ROOT, ", %s.%s at most %s from the running version's (tolerance %s)",
+                        t.port(), t.field(), largest[i] == 0 ? "0" : String.format(Locale.ROOT, "%.3g", largest[i]),
+                        t.abs()));
             }
             sb.append(')');
             cell.monitor().unwatch(nextHalf); // watched again as the component's half at the switch
