@@ -30,7 +30,7 @@ import org.junit.jupiter.api.Test;
  * from the built bundles and pinned, as in UpdateSetIT:
  * <ul>
  * <li>tcp-correction 1.0.2-faulty (a script that runs the real executable and sends it SIGSEGV
- * 100 ms after its spawn, some 30-85 cycles after its START): rejected in shadow (200 cycles);
+ * 150 ms after its spawn, some 30-125 cycles after its START: spawn to READY took 10-51 ms, the BINDs and START 15-71 ms): rejected in shadow (200 cycles);
  * sim-robot never rebound, no safe cycle, the guard NORMAL, no reset, every pid unchanged;</li>
  * <li>sample-scaler 1.0.1-gain (its contract's gain 2.5 where the running version's is 2.0, in
  * the same runtime beside the moving arm): its output differs from the running version's by
@@ -160,8 +160,8 @@ class ShadowRunIT {
             Files.write(real, UpdateSetIT.entry(CellRig.TCP_CORRECTION, UpdateSetIT.EXE));
             Files.setPosixFilePermissions(real, PosixFilePermissions.fromString("r-x------"));
             String script = "#!/bin/sh\n"
-                    + "# ShadowRunIT's deliberately faulty tcp-correction: the real one, killed by SIGSEGV 100 ms after its spawn\n"
-                    + "( sleep 0.1; kill -SEGV $$ ) </dev/null >/dev/null 2>&1 &\n"
+                    + "# ShadowRunIT's deliberately faulty tcp-correction: the real one, killed by SIGSEGV 150 ms after its spawn\n"
+                    + "( sleep 0.15; kill -SEGV $$ ) </dev/null >/dev/null 2>&1 &\n"
                     + "exec " + real + " \"$@\"\n";
             Path jar = version(dir, CellRig.TCP_CORRECTION, "tcp-correction-1.0.2-faulty", UpdateSetIT.CONTRACT,
                     versioned("tcp-correction", "1.0.2-faulty"), UpdateSetIT.EXE, script.getBytes(StandardCharsets.UTF_8));
