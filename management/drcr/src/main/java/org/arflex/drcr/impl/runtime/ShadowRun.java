@@ -68,9 +68,10 @@ final class ShadowRun {
     private long lastCycles;
     private long newBad0;
     private long oldBad0;
-    private long tEndNs;
+    /** On the actor's clock ({@link org.arflex.drcr.impl.lifecycle.Clock#millis()}), which its looks follow. */
+    private long tEndMs;
     private long limitMs;
-    private long lastProgressNs;
+    private long lastProgressMs;
     /** Values of the same source cycle compared so far, and the largest difference of each tolerance. */
     private long compared;
     private final double[] largest;
@@ -110,8 +111,8 @@ final class ShadowRun {
         cell.monitor().watch(next.name, nextHalf, next.contract.fault().heartbeatTimeoutMs(), now);
         long period = Math.max(1, next.contract.timing().periodNs());
         limitMs = (4 * update.shadow() * period + 1_000_000_000L) / 1_000_000L;
-        tEndNs = now + limitMs * 1_000_000L;
-        lastProgressNs = now;
+        lastProgressMs = cell.actor().clock().millis();
+        tEndMs = lastProgressMs + limitMs;
         log.accept("arflex: " + next.name + ": the new version (pid " + nextHalf.pid() + ", " + next.objectId
                 + ") runs in shadow for " + update.shadow() + " cycles on inputs " + next.bound
                 + ", its outputs read by nobody; compared with pid " + oldHalf.pid() + " by "
@@ -162,7 +163,7 @@ final class ShadowRun {
         if (done) {
             return;
         }
-        long now = cell.config().monotonicNs().getAsLong();
+        long now = cell.actor().clock().millis();
         ControlBlock.Stats n = ChangeSetExecutor.stats(nextHalf, next);
         if (n == null) { // gone or unreadable: its exit comes to exited()
             timer = cell.actor().schedule(this::look, ChangeSetExecutor.WATCH_MS);
@@ -171,7 +172,7 @@ final class ShadowRun {
         long before = lastCycles;
         long cycles = cycles();
         if (cycles != before) {
-            lastProgressNs = now;
+            lastProgressMs = now;
         }
         long newBad = ChangeSetExecutor.bad(n) - newBad0;
         long oldBad = ChangeSetExecutor.bad(ChangeSetExecutor.stats(oldHalf, old)) - oldBad0;
@@ -191,7 +192,7 @@ final class ShadowRun {
             reject(differs);
             return;
         }
-        long silentMs = (now - lastProgressNs) / 1_000_000L;
+        long silentMs = now - lastProgressMs;
         if (cycles < update.shadow() && silentMs >= next.contract.fault().heartbeatTimeoutMs()) {
             reject("it ran no cycle for " + silentMs + " ms (heartbeat timeout "
                     + next.contract.fault().heartbeatTimeoutMs() + " ms)");
@@ -218,7 +219,7 @@ final class ShadowRun {
             outcome.passed(this, sb.toString());
             return;
         }
-        if (now - tEndNs >= 0) {
+        if (now - tEndMs >= 0) {
             reject(String.format(Locale.ROOT, "it ran only %d of its %d shadow cycles in %d ms", cycles,
                     update.shadow(), limitMs));
             return;

@@ -267,4 +267,57 @@ class CellShadowRunTest {
         assertEquals(before, fake.events.size(), fake.events::toString);
         assertNotNull(cell.instance("stage").orElseThrow().half);
     }
+
+    @Test
+    void aVersionThatStopsCyclingInShadowIsRejectedAfterItsHeartbeatTimeout() throws Exception {
+        runningCell();
+        CompletableFuture<ChangeSetResult> f = applyIntoShadow(update(200, 1000, List.of()));
+        FakeLauncher.FakeHalf newHalf = fake.running.get("1-stage");
+        newHalf.stats = cycles(10, 0);
+        look();
+        for (int i = 0; i < 9; i++) { // 90 ms without a cycle: the contracts' heartbeat timeout is 100 ms
+            look();
+        }
+        assertFalse(f.isDone(), "rejected before its heartbeat timeout: " + rig.log);
+        look();
+        rig.stepUntil("the outcome", f::isDone);
+        assertTrue(f.join().refusal().startsWith("update stage: rejected in shadow after 10 cycles: it ran no cycle for "
+                + "100 ms (heartbeat timeout 100 ms); nothing changed"), f.join().text());
+        rig.stepUntil("the new half stopped", () -> !fake.running.containsKey("1-stage"));
+        assertFalse(fake.events.contains("user BIND x " + NEW_Y), fake.events::toString);
+    }
+
+    @Test
+    void aVersionTooSlowForItsShadowCyclesIsRejectedAfterFourTimesTheirPeriodsAndASecond() throws Exception {
+        runningCell();
+        CompletableFuture<ChangeSetResult> f = applyIntoShadow(update(200, 1000, List.of()));
+        FakeLauncher.FakeHalf newHalf = fake.running.get("1-stage");
+        // one cycle per look (10 ms): 200 cycles of 1 ms would take 2 s; the limit is 4 x 200 ms + 1 s
+        for (int i = 1; i < 180; i++) {
+            newHalf.stats = cycles(i, 0);
+            look();
+        }
+        assertFalse(f.isDone(), "rejected before its time: " + rig.log);
+        newHalf.stats = cycles(180, 0);
+        look();
+        rig.stepUntil("the outcome", f::isDone);
+        assertTrue(f.join().refusal().startsWith("update stage: rejected in shadow after 180 cycles: it ran only 180 of "
+                + "its 200 shadow cycles in 1800 ms; nothing changed"), f.join().text());
+    }
+
+    @Test
+    void toleranceWithoutAnyValueOfTheSameSourceCycleFailsClosed() throws Exception {
+        runningCell();
+        CompletableFuture<ChangeSetResult> f = applyIntoShadow(update(100, 1000,
+                List.of(new ChangeSet.Tolerance("y", "value", 0.01))));
+        FakeLauncher.FakeHalf newHalf = fake.running.get("1-stage");
+        fake.values.put(OLD_Y, sample(500, 7_000, 1.0));
+        fake.values.put(NEW_Y, sample(3, 9_000, 1.0)); // always another source cycle
+        newHalf.stats = cycles(100, 0);
+        look();
+        rig.stepUntil("the outcome", f::isDone);
+        assertEquals("update stage: rejected in shadow after 100 cycles: no value of the same source cycle of both "
+                + "versions could be compared in 100 cycles (tolerances [y.value +-0.01]); nothing changed (pid "
+                + fake.running.get("stage").pid + " runs stage on)", f.join().refusal());
+    }
 }
