@@ -86,16 +86,25 @@ final class Runtime implements AutoCloseable {
     /** @param umask the file mode creation mask to start the JVM with (octal), null: this JVM's */
     Runtime(String name, String fixedRid, boolean waitForDrcr, String trusted, String umask)
             throws IOException, InterruptedException {
-        this(name, fixedRid, waitForDrcr, trusted, umask, List.of());
+        this(name, fixedRid, waitForDrcr, trusted, umask, List.of(), null);
     }
 
     /** A runtime whose framework gets these properties too ("key=value", e.g. a heartbeat grace). */
     static Runtime withProperties(String name, String... properties) throws IOException, InterruptedException {
-        return new Runtime(name, null, true, trustedFolders(), null, List.of(properties));
+        return new Runtime(name, null, true, trustedFolders(), null, List.of(properties), null);
     }
 
-    private Runtime(String name, String fixedRid, boolean waitForDrcr, String trusted, String umask, List<String> properties)
-            throws IOException, InterruptedException {
+    /**
+     * A runtime whose JVM runs on @jvmCpus only ({@code taskset -c}, e.g. "0"), with it the
+     * non-real-time threads of every RT half it spawns (an RT thread sets its own affinity to
+     * the CPU admission gave it): the setup of docs/latency.md for a CPU kept apart.
+     */
+    static Runtime pinned(String name, String jvmCpus, String... properties) throws IOException, InterruptedException {
+        return new Runtime(name, null, true, trustedFolders(), null, List.of(properties), jvmCpus);
+    }
+
+    private Runtime(String name, String fixedRid, boolean waitForDrcr, String trusted, String umask, List<String> properties,
+            String jvmCpus) throws IOException, InterruptedException {
         Path assembly = Path.of(System.getProperty("arflex.it.runtime"));
         if (!Files.isRegularFile(assembly.resolve("bin/felix.jar"))) {
             fail("runtime assembly not found at " + assembly + " (build management/runtime first)");
@@ -118,6 +127,9 @@ final class Runtime implements AutoCloseable {
         List<String> command = new ArrayList<>();
         if (umask != null) {
             command.addAll(List.of("sh", "-c", "umask " + umask + " && exec \"$@\"", "sh"));
+        }
+        if (jvmCpus != null) {
+            command.addAll(List.of("taskset", "-c", jvmCpus));
         }
         command.addAll(List.of(Path.of(System.getProperty("java.home"), "bin", "java").toString(),
                 "-XX:+UseG1GC", "-XX:MaxGCPauseMillis=20",
@@ -280,6 +292,7 @@ final class Runtime implements AutoCloseable {
     void waitUntil(String what, long timeoutMs, Cond c) {
         long deadline = System.nanoTime() + timeoutMs * 1_000_000L;
         Exception last = null;
+        long pollMs = 2;
         while (System.nanoTime() - deadline < 0) {
             try {
                 if (c.test()) {
@@ -289,7 +302,10 @@ final class Runtime implements AutoCloseable {
                 last = e;
             }
             try {
-                Thread.sleep(50); // poll interval of a condition with a deadline
+                // poll interval of a condition with a deadline: 2 ms at first, then doubled up to
+                // 50 ms, so what is quick is seen quickly and a long wait costs the shell little
+                Thread.sleep(pollMs);
+                pollMs = Math.min(50, pollMs * 2);
             } catch (InterruptedException e) {
                 Thread.currentThread().interrupt();
                 return;

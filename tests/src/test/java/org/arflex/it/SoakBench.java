@@ -13,6 +13,7 @@ import java.util.concurrent.ExecutorService;
 import java.util.concurrent.Executors;
 import java.util.concurrent.Future;
 import java.util.concurrent.atomic.AtomicInteger;
+import java.util.concurrent.locks.ReentrantReadWriteLock;
 import java.util.regex.Matcher;
 import java.util.regex.Pattern;
 import org.junit.jupiter.api.Test;
@@ -25,8 +26,10 @@ import org.junit.jupiter.api.Test;
  * each, at most two), and {@code arflex.bench.kills} kill -9 of a random running RT half of the
  * churned components are spread over the run (the unrelated component is never killed: its
  * latency is what is measured).
- * Every {@code arflex.bench.every} cycles it samples the runtime JVM (heap after a full GC,
- * threads, fds) and the cell's objects (shm, mq, RT processes). Prints a table, writes
+ * Every {@code arflex.bench.every} cycles every worker and the kill loop pause between two steps:
+ * the counter is measured over a quiet window ({@code arflex.bench.quietms}, 3 s), then the
+ * runtime JVM is sampled (heap after a full GC, threads, fds) with the cell's objects (shm, mq,
+ * RT processes). Quiet and churn windows alternate over the whole run. Prints a table, writes
  * target/bench/soak.json, and ends with
  * {@code soak: C cycles, K kills, heap slope S KB/1000 cycles, leaks L, max supervision stall X ms}.
  *
@@ -49,6 +52,10 @@ class SoakBench {
     private final List<Double> handlings = Collections.synchronizedList(new ArrayList<>());
     private final List<long[]> samples = Collections.synchronizedList(new ArrayList<>()); // cycles, heapKB, threads, fds, shm, mq, procs
     private final AtomicInteger cycles = new AtomicInteger();
+    /** Each step of a cycle, from the Felix command to the state it leads to, as the shell sees it (ms). */
+    private final List<Double> installs = Collections.synchronizedList(new ArrayList<>());
+    private final List<Double> updates = Collections.synchronizedList(new ArrayList<>());
+    private final List<Double> uninstalls = Collections.synchronizedList(new ArrayList<>());
     private volatile long maxShellMs;
     private long maxStallMs;
     private int frozenEvery;
@@ -57,10 +64,34 @@ class SoakBench {
     private final List<java.time.LocalTime[]> forcedGcs = Collections.synchronizedList(new ArrayList<>());
     private long maxForcedGcStallMs;
 
+    /** Workers and the kill loop hold it shared for one step; a sample holds it alone. */
+    private final ReentrantReadWriteLock quiesce = new ReentrantReadWriteLock(true);
+    /** The 1 kHz counter in the quiet windows, and between them (the churn). */
+    private final CellChurnBench.Tally quiet = new CellChurnBench.Tally();
+    private final CellChurnBench.Tally busy = new CellChurnBench.Tally();
+    private CellChurnBench.Snap churnFrom; // under the write lock
+    private final long quietMs = Long.getLong("arflex.bench.quietms", 3000);
+    private Runtime srt;
+    private long sjvm;
+    private String srid;
+    private static final long PERIOD_NS = 1_000_000L;
+
     /** The 1 kHz unrelated component. */
-    private static Path counter1kHz() throws Exception {
+    private static Path counter1kHz(boolean apart) throws Exception {
         return Jars.withContract(CellIT.COUNTER, Files.createTempDirectory("arflex-soak").resolve("counter-1khz.jar"),
-                xml -> xml.replace("period=\"10ms\" deadline=\"10ms\"", "period=\"1ms\" deadline=\"1ms\""));
+                xml -> xml.replace("period=\"10ms\" deadline=\"10ms\"",
+                        "period=\"1ms\" deadline=\"1ms\"" + (apart ? " cpus=\"1\" exclusive=\"true\"" : "")));
+    }
+
+    /**
+     * The counter's CPU kept apart (default; {@code arflex.bench.sharedcpu} turns it off), as
+     * docs/latency.md does for the probe: the counter holds CPU 1 exclusively, the runtime
+     * reserves it ({@code arflex.cpus.reserved=1}: the churned halves are placed on CPU 0), and
+     * the JVM runs on CPU 0 with the spawns' non-RT threads, so the churn's process creation,
+     * exits and the JVM's own work run beside the counter, not on its CPU.
+     */
+    private static Runtime runtime(boolean apart) throws Exception {
+        return apart ? Runtime.pinned("soak", "0", "arflex.cpus=0,1", "arflex.cpus.reserved=1") : new Runtime("soak");
     }
 
     @Test
@@ -75,37 +106,38 @@ class SoakBench {
         Path[] churn = {CellIT.SCALER, DebugMonitorIT.DEBUGMON};
         String[] names = {"sample-scaler", "debug-monitor"};
         String rid;
-        CellChurnBench.Tally quiet = new CellChurnBench.Tally();
-        CellChurnBench.Tally busy = new CellChurnBench.Tally();
         int killed = 0;
-        try (Runtime rt = new Runtime("soak")) {
+        boolean apart = !Boolean.getBoolean("arflex.bench.sharedcpu") && java.lang.Runtime.getRuntime().availableProcessors() >= 2;
+        System.out.println("soak: the counter's CPU " + (apart ? "kept apart (CPU 1 exclusive and reserved, the JVM on CPU 0)"
+                : "shared with the churn and the JVM"));
+        try (Runtime rt = runtime(apart)) {
             rid = rt.rid;
-            rt.installAndStart(counter1kHz());
+            rt.installAndStart(counter1kHz(apart));
             rt.awaitState("ACTIVE", T, "sample-counter");
-            long periodNs = 1_000_000L;
-            long jvm = rt.jvmPid();
-            sample(rt, jvm, rid);
-            // a quiet window as long as one sampling interval would take, at least 5 s
-            CellChurnBench.Snap q0 = snap(rt);
-            long quietEnd = System.nanoTime() + 5_000_000_000L;
-            rt.waitUntil("the quiet window", T, () -> System.nanoTime() > quietEnd);
-            CellChurnBench.Snap q1 = snap(rt);
-            quiet.add(q0, q1, periodNs, false);
+            srt = rt;
+            sjvm = rt.jvmPid();
+            srid = rid;
+            sampleQuietly(); // the first quiet window and heap sample, before any churn
 
             Random rnd = new Random(Long.getLong("arflex.bench.seed", System.nanoTime()));
             ExecutorService pool = Executors.newFixedThreadPool(threads);
             List<Future<?>> workers = new ArrayList<>();
-            CellChurnBench.Snap b0 = snap(rt);
             for (int w = 0; w < threads; w++) {
                 int k = w;
                 workers.add(pool.submit(() -> {
                     int mine = 0;
                     while (cycles.get() < total) {
                         boolean frozen = frozenEvery > 0 && ++mine % frozenEvery == 0;
-                        cycle(rt, churn[k], names[k], frozen);
-                        int c = cycles.incrementAndGet();
+                        int c;
+                        quiesce.readLock().lock();
+                        try {
+                            cycle(rt, churn[k], names[k], frozen);
+                            c = cycles.incrementAndGet();
+                        } finally {
+                            quiesce.readLock().unlock();
+                        }
                         if (c % every == 0) {
-                            sample(rt, jvm, rid);
+                            sampleQuietly();
                         }
                     }
                     return null;
@@ -114,24 +146,37 @@ class SoakBench {
             // kills spread over the run, from this thread, with the shell answering in between
             int killEvery = kills == 0 ? Integer.MAX_VALUE : Math.max(1, total / kills);
             int nextKill = killEvery;
+            java.util.concurrent.CompletableFuture<Object> anyDone = new java.util.concurrent.CompletableFuture<>();
             while (workers.stream().anyMatch(f -> !f.isDone())) {
-                long t0 = System.nanoTime();
-                rt.cmd("arflex:list");
-                maxShellMs = Math.max(maxShellMs, (System.nanoTime() - t0) / 1_000_000L);
-                if (killed < kills && cycles.get() >= nextKill) {
-                    if (killRandom(rt, rnd)) {
+                quiesce.readLock().lock();
+                try {
+                    long t0 = System.nanoTime();
+                    rt.cmd("arflex:list");
+                    maxShellMs = Math.max(maxShellMs, (System.nanoTime() - t0) / 1_000_000L);
+                    // a kill is due: tried at every probe until a churned half is running
+                    if (killed < kills && cycles.get() >= nextKill && killRandom(rt, rnd)) {
                         killed++;
+                        nextKill += killEvery;
                     }
-                    nextKill += killEvery;
+                } finally {
+                    quiesce.readLock().unlock();
+                }
+                // a probe every 20 ms: back to back, the probes would hold the one shell session
+                // the workers' Felix commands need, and the bench would measure its own queue
+                try {
+                    anyDone.get(20, java.util.concurrent.TimeUnit.MILLISECONDS);
+                } catch (java.util.concurrent.TimeoutException e) {
+                    // the next probe
                 }
             }
             for (Future<?> f : workers) {
                 f.get(); // a worker's failure is the bench's failure
             }
             pool.shutdown();
-            CellChurnBench.Snap b1 = snap(rt);
-            busy.add(b0, b1, periodNs, false);
-            sample(rt, jvm, rid);
+            if (samples.isEmpty() || samples.get(samples.size() - 1)[0] != cycles.get()) {
+                sampleQuietly(); // the last churn window ends here
+            }
+            readKills(rt);
             for (String l : rt.logSince(0)) {
                 if (l.contains("rewiring failed") || l.contains("did not answer")) {
                     System.out.println("soak: log " + l); // a half that did not take a command in time
@@ -152,18 +197,20 @@ class SoakBench {
             }
             if (Boolean.getBoolean("arflex.bench.histogram")) {
                 // what the heap holds after the churn: the classes with the most bytes
-                Jcmd.run(jvm, "GC.class_histogram").lines().limit(25)
+                Jcmd.run(sjvm, "GC.class_histogram").lines().limit(25)
                         .forEach(l -> System.out.println("soak: histogram " + l));
             }
         }
         int leaks = FaultBench.leftovers(rid, "soak");
-        report(total, killed, quiet, busy, leaks);
+        report(total, killed, leaks);
     }
 
     /** One install -> update -> uninstall of one component. */
     private void cycle(Runtime rt, Path jar, String name, boolean frozen) throws Exception {
+        long t0 = System.nanoTime();
         long id = rt.installAndStart(jar);
         rt.awaitState("ACTIVE", T, name);
+        long t1 = step(installs, t0);
         long pid = rt.pid(name);
         if (frozen && Signals.tryToSend(pid, "STOP")) {
             // a frozen half answers nothing: the DRCR kills it after its shutdown deadline
@@ -181,11 +228,20 @@ class SoakBench {
             throw new AssertionError("update " + id + ": " + u);
         }
         rt.waitUntil(name + " back after the update", T, () -> rt.activeWithNewPid(name, pid));
+        long t2 = step(updates, t1);
         String r = rt.cmd("uninstall " + id);
         if (!r.isBlank()) {
             throw new AssertionError("uninstall " + id + ": " + r);
         }
         rt.waitUntil(name + " gone", T, () -> rt.instance(name) == null);
+        step(uninstalls, t2);
+    }
+
+    /** Records the step that began at @t0 (ms, as the bench's shell sees it); returns now. */
+    private static long step(List<Double> into, long t0) {
+        long now = System.nanoTime();
+        into.add((now - t0) / 1e6);
+        return now;
     }
 
     /** kill -9 of a random running RT half; the detection time is from the kill to the DRCR's line. */
@@ -208,16 +264,39 @@ class SoakBench {
         if (!Signals.tryToSend(pid, "9")) {
             return false; // it went away by itself (an uninstall) in between
         }
-        String who = name + " (pid " + pid + ") ";
-        double d = FaultBench.detection(rt, mark, at, who);
-        if (d >= 0) {
-            detections.add(d);
-        }
-        double h = handled(rt, mark, who);
-        if (h >= 0) {
-            handlings.add(h);
-        }
+        // read from the log at the end: waiting here for the DRCR's lines held the probe loop
+        // (and, behind a sample waiting for the lock, every worker) for seconds per kill
+        kills.add(new Kill(mark, at, name + " (pid " + pid + ") "));
         return true;
+    }
+
+    /** One kill -9: the log mark and wall time just before it, and how the DRCR names the half. */
+    private record Kill(int mark, java.time.LocalTime at, String who) {
+    }
+
+    private final List<Kill> kills = new ArrayList<>();
+
+    /** Detection and handling of every kill, from the runtime's log (the last one waited for). */
+    private void readKills(Runtime rt) {
+        if (!kills.isEmpty()) {
+            Kill last = kills.get(kills.size() - 1);
+            FaultBench.detection(rt, last.mark(), last.at(), last.who()); // its lines may still be on their way
+            handled(rt, last.mark(), last.who());
+        }
+        Pattern p = Pattern.compile("\\(handled ([0-9.]+) ms after the exit was seen\\)");
+        for (Kill k : kills) {
+            List<String> after = rt.logSince(k.mark());
+            after.stream().filter(l -> l.contains(k.who())).findFirst().ifPresent(l -> {
+                try {
+                    detections.add(java.time.Duration.between(k.at(),
+                            java.time.LocalTime.parse(l.replace("err| ", "").split(" ", 2)[0])).toNanos() / 1e6);
+                } catch (java.time.format.DateTimeParseException e) {
+                    // not a line of the DRCR's log
+                }
+            });
+            after.stream().filter(l -> l.contains(k.who())).map(p::matcher).filter(Matcher::find).findFirst()
+                    .ifPresent(m -> handlings.add(Double.parseDouble(m.group(1))));
+        }
     }
 
     /** The actor's "(handled X ms after the exit was seen)" for @who, or -1 (not within 10 s). */
@@ -254,6 +333,31 @@ class SoakBench {
 
     private static CellChurnBench.Snap snap(Runtime rt) {
         return CellChurnBench.Snap.of(rt.instance("sample-counter"), System.nanoTime());
+    }
+
+    /**
+     * With every worker and the kill loop between two steps (nothing churns): ends the churn
+     * window, measures the counter over a quiet window, then takes the heap after a full GC and
+     * the counts; the next churn window starts when it returns. Quiet and churn windows thus
+     * alternate over the whole run, so both see the same machine (a short quiet window at the
+     * start only would compare 5 s against an hour), and no worker allocates between the GC and
+     * the reading of the heap (with one running, the "heap after GC" was anything up to 135 MB).
+     */
+    private void sampleQuietly() throws Exception {
+        quiesce.writeLock().lock();
+        try {
+            CellChurnBench.Snap q0 = snap(srt);
+            if (churnFrom != null) {
+                busy.add(churnFrom, q0, PERIOD_NS, false);
+            }
+            long end = System.nanoTime() + quietMs * 1_000_000L;
+            srt.waitUntil("the quiet window", quietMs + T, () -> System.nanoTime() > end);
+            quiet.add(q0, snap(srt), PERIOD_NS, false);
+            sample(srt, sjvm, srid);
+            churnFrom = snap(srt);
+        } finally {
+            quiesce.writeLock().unlock();
+        }
     }
 
     /** Heap after a full GC (KB), threads and fds of the JVM; the cell's shm, mq and RT processes. */
@@ -320,7 +424,7 @@ class SoakBench {
         return n % 2 == 1 ? slopes.get(n / 2) : (slopes.get(n / 2 - 1) + slopes.get(n / 2)) / 2;
     }
 
-    private void report(int total, int killed, CellChurnBench.Tally quiet, CellChurnBench.Tally busy, int leaks)
+    private void report(int total, int killed, int leaks)
             throws Exception {
         List<Double> d = new ArrayList<>(detections);
         Collections.sort(d);
@@ -334,12 +438,20 @@ class SoakBench {
         for (int i = 0; i < label.length; i++) {
             System.out.printf(Locale.ROOT, "soak: %-20s %8d  %8d%n", label[i], first[i + 1], last[i + 1]);
         }
-        System.out.printf(Locale.ROOT, "soak: 1 kHz counter      quiet p99 %s us, overruns %d | churn p99 %s us, overruns %d%n",
-                us(quiet.quantileUs(0.99)), quiet.overruns, us(busy.quantileUs(0.99)), busy.overruns);
+        System.out.printf(Locale.ROOT, "soak: 1 kHz counter      quiet p99 %s us, overruns %d in %d cycles (%s per 100k) | churn p99 %s us, overruns %d in %d cycles (%s per 100k)%n",
+                us(quiet.quantileUs(0.99)), quiet.overruns, quiet.cycles, num(per100k(quiet)),
+                us(busy.quantileUs(0.99)), busy.overruns, busy.cycles, num(per100k(busy)));
         System.out.printf(Locale.ROOT, "soak: exit detection     p50 %s ms, p99 %s ms, max %s ms (%d kills)%n", ms(pct(d, 50)),
                 ms(pct(d, 99)), ms(d.isEmpty() ? Double.NaN : d.get(d.size() - 1)), d.size());
         System.out.printf(Locale.ROOT, "soak: exit handled after p50 %s ms, p99 %s ms, max %s ms (the actor's queue)%n",
                 ms(pct(h, 50)), ms(pct(h, 99)), ms(h.isEmpty() ? Double.NaN : h.get(h.size() - 1)));
+        for (Object[] st : new Object[][] {{"install -> ACTIVE", installs}, {"update -> ACTIVE", updates}, {"uninstall -> gone", uninstalls}}) {
+            @SuppressWarnings("unchecked")
+            List<Double> v = new ArrayList<>((List<Double>) st[1]);
+            Collections.sort(v);
+            System.out.printf(Locale.ROOT, "soak: %-19s p50 %s ms, p99 %s ms (%d, through the shell)%n", st[0], ms(pct(v, 50)),
+                    ms(pct(v, 99)), v.size());
+        }
         System.out.printf(Locale.ROOT, "soak: frozen halves      %d SIGSTOPped and uninstalled (every %d-th cycle of a worker)%n",
                 frozenDone.get(), frozenEvery);
         System.out.printf(Locale.ROOT, "soak: stalls in the bench's own full GCs (jcmd GC.run): max %d ms, not counted%n",
@@ -361,6 +473,10 @@ class SoakBench {
         System.out.println("JSON: " + out.toAbsolutePath());
         System.out.printf(Locale.ROOT, "soak: %d cycles, %d kills, heap slope %.0f KB/1000 cycles, leaks %d, max supervision stall %d ms%n",
                 cycles.get(), killed, slope, leaks, maxStallMs);
+    }
+
+    private static double per100k(CellChurnBench.Tally t) {
+        return t.cycles == 0 ? Double.NaN : Math.round(t.overruns * 1e6 / t.cycles) / 10.0;
     }
 
     private static double pct(List<Double> sorted, double p) {

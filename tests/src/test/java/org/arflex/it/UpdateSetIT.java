@@ -70,6 +70,12 @@ class UpdateSetIT {
                     found = true;
                 } else if (e.getName().equals(EXE) && exe != null) {
                     b = exe;
+                } else if (e.getName().equals("META-INF/MANIFEST.MF")) {
+                    // the bundle's version too, as a release would have it (OSGi: 1.0.2.faulty)
+                    String mf = new String(b, StandardCharsets.UTF_8);
+                    String bumped = mf.replaceFirst("Bundle-Version: [^\r\n]+", "Bundle-Version: " + version.replace('-', '.'));
+                    assertNotEquals(mf, bumped, "the manifest's Bundle-Version");
+                    b = bumped.getBytes(StandardCharsets.UTF_8);
                 }
                 zo.putNextEntry(new ZipEntry(e.getName()));
                 zo.write(b);
@@ -298,6 +304,13 @@ class UpdateSetIT {
             assertNotEquals(r.oldPid(), rt.pid("tcp-correction"), "the new version runs");
             assertEquals(0, ((Number) rt.instance("tcp-correction").get("restarts")).intValue());
             assertTrue(rt.cmd("arflex:info tcp-correction").contains("1.0.1"), rt.cmd("arflex:info tcp-correction"));
+            // D43: the bundle follows the committed version, and the running half is kept
+            java.util.regex.Matcher kept = java.util.regex.Pattern.compile(
+                    "bundle \\d+ updated \\S+ -> 1\\.0\\.1; 'tcp-correction' kept running \\(pid (\\d+)\\)").matcher(r.out());
+            assertTrue(kept.find(), r.out());
+            assertEquals(rt.pid("tcp-correction"), Long.parseLong(kept.group(1)), "the committed half keeps running");
+            String lb = rt.cmd("lb");
+            assertTrue(lb.lines().anyMatch(l -> l.contains("tcp-correction") && l.contains("(1.0.1)")), lb);
             assertTrue(CellRig.armFollows(rt, "trajectory"), rt.cmd("arflex:bindings"));
             rt.waitUntil("the old version's process and segment gone", T, () -> Runtime.rtProcesses(rt.rid).stream()
                     .noneMatch(p -> p.contains("--instance tcp-correction ")) && !Files.exists(

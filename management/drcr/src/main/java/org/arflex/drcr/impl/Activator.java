@@ -251,6 +251,18 @@ public final class Activator implements BundleActivator {
                     }
                 }, gateHook::refusal, log);
         changeSets.executables(extender::executable);
+        changeSets.bundles(new org.arflex.drcr.impl.services.UpdatedBundles(ctx, cell,
+                new org.arflex.drcr.impl.services.UpdatedBundles.Carrier() {
+                    @Override
+                    public void carryOver(long bundleId, java.util.Set<String> names) {
+                        extender.carryOver(bundleId, names);
+                    }
+
+                    @Override
+                    public void carryDone(long bundleId) {
+                        extender.carryDone(bundleId);
+                    }
+                }, log));
         tracker = new BundleTracker<>(ctx, ContractExtender.MASK, extender);
         tracker.open();
         log.accept("arflex: DRCR started, runtime id " + rid + ", cpus " + cpus + ", memory " + memory + ", network "

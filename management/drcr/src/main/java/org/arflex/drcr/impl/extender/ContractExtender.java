@@ -42,6 +42,14 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
         final java.util.Set<Path> extracted = new java.util.HashSet<>();
     }
 
+    /**
+     * Per bundle id, the components that keep running across the bundle's next stop, update and
+     * start: a change set's update was committed and the bundle follows it (D43). The stop
+     * leaves them in the cell, the start finds them running with the same contract and the cell
+     * adopts them.
+     */
+    private final java.util.Map<Long, java.util.Set<String>> carried = new java.util.concurrent.ConcurrentHashMap<>();
+
     private final Cell cell;
     private final ContractReader reader;
     private final BundleContext own;
@@ -184,11 +192,17 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
     }
 
     private void deactivate(Bundle bundle, Tracked t) {
-        List<String> names = t.active;
-        if (names == null) {
+        List<String> all = t.active;
+        if (all == null) {
             return;
         }
         t.active = null;
+        java.util.Set<String> keep = carried.getOrDefault(bundle.getBundleId(), java.util.Set.of());
+        List<String> names = all.stream().filter(n -> !keep.contains(n)).toList();
+        if (names.size() < all.size()) {
+            log.accept("arflex: " + label(bundle) + " stops for its update: "
+                    + all.stream().filter(keep::contains).toList() + " keep running (a committed change-set update)");
+        }
         if (names.isEmpty()) {
             return;
         }
@@ -233,6 +247,20 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
             throw new IOException(refused + "; its RT halves are not started");
         }
         return extract(bundle, c.executable());
+    }
+
+    /**
+     * The components {@code names} of bundle {@code bundleId} keep running across the bundle's
+     * next stop and start (its update to the version they run already, D43), until
+     * {@link #carryDone}.
+     */
+    public void carryOver(long bundleId, java.util.Set<String> names) {
+        carried.put(bundleId, java.util.Set.copyOf(names));
+    }
+
+    /** Ends {@link #carryOver}: a later stop of the bundle stops its components again. */
+    public void carryDone(long bundleId) {
+        carried.remove(bundleId);
     }
 
     /** Copies an executable out of its bundle into a folder; returns where it is. */

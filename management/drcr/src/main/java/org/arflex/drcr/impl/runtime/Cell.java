@@ -290,12 +290,14 @@ public final class Cell {
         if (existing == null && !validName(c, bundleId)) {
             return false;
         }
-        if (existing != null && existing.planned && existing.contract == c && existing.life.target() == State.ACTIVE) {
-            // The bundle of a component a change set installed is started after the switch (D35):
-            // the component runs already with this very contract; only the extracted copy is new.
+        if (existing != null && existing.planned && existing.life.target() == State.ACTIVE
+                && ContractReader.sameButSource(existing.contract, c)) {
+            // The bundle of a component a change set installed is started after the switch (D35),
+            // or a committed update's bundle was updated to that version (D43): the component
+            // runs already with this contract; only the extracted copy is new.
             existing.executable = exe;
-            log.accept("arflex: " + c.name() + ": bundle " + bundleId + " started; the component was installed by a "
-                    + "change set and keeps running");
+            log.accept("arflex: " + c.name() + ": bundle " + bundleId + " started; the component "
+                    + (existing.contract == c ? "was installed by a change set" : "runs this version already") + " and keeps running");
             return true;
         }
         boolean replace = existing != null && existing.planned;

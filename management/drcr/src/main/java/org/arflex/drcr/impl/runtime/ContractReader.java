@@ -79,4 +79,29 @@ public final class ContractReader {
         }
         return new Result(ok, problems);
     }
+
+    /**
+     * The same contract read from two places: every part equal but {@code source} (which says
+     * where it was read: a bundle, a jar URL). A committed update's jar read again from its
+     * updated bundle gives such a pair (D43).
+     */
+    public static boolean sameButSource(Contract a, Contract b) {
+        if (a == b) {
+            return true;
+        }
+        if (a == null || b == null) {
+            return false;
+        }
+        try {
+            for (java.lang.reflect.RecordComponent rc : Contract.class.getRecordComponents()) {
+                if (!rc.getName().equals("source")
+                        && !java.util.Objects.equals(rc.getAccessor().invoke(a), rc.getAccessor().invoke(b))) {
+                    return false;
+                }
+            }
+            return true;
+        } catch (ReflectiveOperationException e) {
+            throw new IllegalStateException(e);
+        }
+    }
 }

@@ -94,6 +94,12 @@ public final class Instance {
         this.params = defaults(c);
     }
 
+    /** The pid of the running RT half, 0 when none runs. */
+    public long pid() {
+        RtHalf h = half;
+        return h == null ? 0 : h.pid();
+    }
+
     /**
      * The object id of generation {@code g} of component {@code name}: the name for 0, else
      * {@code <g>-<name>}. A component name starts with a letter (contract 3.1), so an id that

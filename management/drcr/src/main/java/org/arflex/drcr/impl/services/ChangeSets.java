@@ -48,8 +48,11 @@ public final class ChangeSets implements ChangeSetService {
             + "<value>, update <component> <jar URL> [<sha256>] [window <cycles>] [shadow <cycles>] [envelope <port>.<field> "
             + "<min> <max>]... [tolerance <port>.<field> <max difference>]...";
 
-    /** A new version of a component, from a jar that passed the code gate (D38). */
-    public record Version(Contract contract, String from, String how, Extract extract) {
+    /**
+     * A new version of a component, from a jar that passed the code gate (D38); {@code jar}: its
+     * bytes, as checked, for the component's bundle to follow once the update is committed.
+     */
+    public record Version(Contract contract, String from, String how, Extract extract, byte[] jar) {
     }
 
     /** Extracts a verified version's executable (apply only, never in a dry run). */
@@ -76,6 +79,7 @@ public final class ChangeSets implements ChangeSetService {
     private volatile Executables executables = (b, c) -> {
         throw new IOException("the DRCR is not started yet");
     };
+    private volatile UpdatedBundles bundles;
     private final Consumer<String> log;
 
     public ChangeSets(Cell cell, BundleContext context, Consumer<String> log) {
@@ -87,6 +91,11 @@ public final class ChangeSets implements ChangeSetService {
     /** Where the new versions of updates come from. */
     public void versions(Versions v) {
         versions = v;
+    }
+
+    /** Who updates the bundle of a committed update (built with the extender, after this service). */
+    public void bundles(UpdatedBundles b) {
+        bundles = b;
     }
 
     /** Where the executables of installs come from (the extender, built after this service). */
@@ -251,7 +260,8 @@ public final class ChangeSets implements ChangeSetService {
         if (r.applied() && r.verdict() != null) {
             // an update's rollback window: the command says how it ended (committed or rolled back, why)
             try {
-                d.text += r.verdict().get(APPLY_MS, TimeUnit.MILLISECONDS) + "\n";
+                String verdict = r.verdict().get(APPLY_MS, TimeUnit.MILLISECONDS);
+                d.text += verdict + "\n" + followUpdates(parsed, bundleIds, read, verdict);
             } catch (ExecutionException | TimeoutException e) {
                 d.text += "warning: no verdict of the rollback window yet: " + e + "\n";
             } catch (InterruptedException e) {
@@ -399,6 +409,20 @@ public final class ChangeSets implements ChangeSetService {
                         + (a[0].equals("install") ? "started" : "stopped") + ": " + e.getMessage();
                 log.accept("arflex: " + p);
                 sb.append("warning: ").append(p).append('\n');
+            }
+        }
+        return sb.toString();
+    }
+
+    /** After a committed update: its bundle is updated to the jar that runs (D43). */
+    private String followUpdates(List<String[]> parsed, java.util.Map<String, Long> bundleIds,
+                                 java.util.Map<String, Version> read, String verdict) {
+        UpdatedBundles b = bundles;
+        StringBuilder sb = new StringBuilder();
+        for (String[] a : parsed) {
+            if (b != null && a[0].equals("update") && bundleIds.containsKey(a[1]) && read.containsKey(a[1])
+                    && verdict.contains("update " + a[1] + ": committed")) {
+                sb.append(b.follow(bundleIds.get(a[1]), a[1], read.get(a[1]).jar()));
             }
         }
         return sb.toString();

@@ -18,8 +18,8 @@ import org.arflex.drcr.impl.supervisor.VerifiedExecutables;
  * {@code arflex:deploy}: its SHA-256 matches the pin given, or, without a pin, every entry is
  * signed by a key of the trust store. Its contract is read by the contract reader (the same
  * checks as a bundle's), and its executable is extracted by {@link VerifiedExecutables} (0700
- * folder, 0500 file, hashed again before every spawn). The jar is not installed into Felix: the
- * component's bundle stays the revision it was (see D38).
+ * folder, 0500 file, hashed again before every spawn). The jar is installed into Felix only once
+ * the update is committed ({@link UpdatedBundles}, D43).
  */
 public final class UpdateJars implements ChangeSets.Versions {
 
@@ -87,7 +87,8 @@ public final class UpdateJars implements ChangeSets.Versions {
         String exe = ContractReader.NATIVE_DIR + c.executable();
         String digest = Services.sha256(jar);
         Path into = dir.resolve(component + "-" + digest.substring(0, 16).toLowerCase(java.util.Locale.ROOT));
-        return new ChangeSets.Version(c, location, how, () -> executables.extract(into, c.executable(), () -> open(jar, exe)));
+        return new ChangeSets.Version(c, location, how, () -> executables.extract(into, c.executable(), () -> open(jar, exe)),
+                jar);
     }
 
     /** Stands for an entry under native/ whose bytes are not kept. */
