@@ -24,6 +24,7 @@ import java.util.Optional;
  * @param fault        restart and safe-output policy
  * @param update       where updates come from, if anywhere
  * @param source       where this contract was read from, for error messages
+ * @param rollout      how a new version is shadowed, compared and switched in a change set (SPEC §12.1)
  */
 public record Contract(
         String name,
@@ -40,12 +41,23 @@ public record Contract(
         int criticality,
         FaultPolicy fault,
         Optional<UpdateSpec> update,
-        String source) {
+        String source,
+        Optional<RolloutSpec> rollout) {
 
     public Contract {
         attributes = Map.copyOf(attributes);
+        rollout = rollout == null ? Optional.empty() : rollout;
         ports = List.copyOf(ports);
         properties = List.copyOf(properties);
+    }
+
+    /** A contract without a {@code <rollout>} (SPEC §12.1). */
+    public Contract(String name, String version, String description, String executable, TaskType taskType,
+                    boolean movesHardware, Map<String, String> attributes, List<PortSpec> ports,
+                    List<PropertySpec> properties, Timing timing, Resources resources, int criticality,
+                    FaultPolicy fault, Optional<UpdateSpec> update, String source) {
+        this(name, version, description, executable, taskType, movesHardware, attributes, ports, properties, timing,
+                resources, criticality, fault, update, source, Optional.empty());
     }
 
     /** The inputs, in declaration order. */

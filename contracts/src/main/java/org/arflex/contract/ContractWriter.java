@@ -123,6 +123,41 @@ public final class ContractWriter {
                 w.writeAttribute("url", c.update().get().url().toString());
                 w.writeAttribute("sha256", c.update().get().sha256());
             }
+            if (c.rollout().isPresent()) {
+                RolloutSpec r = c.rollout().get();
+                nl(w, 1);
+                boolean empty = r.tolerances().isEmpty() && r.envelopes().isEmpty();
+                if (empty) {
+                    w.writeEmptyElement("rollout");
+                } else {
+                    w.writeStartElement("rollout");
+                }
+                if (r.shadow().isPresent()) {
+                    w.writeAttribute("shadow", Long.toString(r.shadow().getAsLong()));
+                }
+                if (r.window().isPresent()) {
+                    w.writeAttribute("window", Long.toString(r.window().getAsLong()));
+                }
+                for (RolloutSpec.Tolerance tol : r.tolerances()) {
+                    nl(w, 2);
+                    w.writeEmptyElement("tolerance");
+                    w.writeAttribute("port", tol.port());
+                    w.writeAttribute("field", tol.field());
+                    w.writeAttribute("abs", Double.toString(tol.abs()));
+                }
+                for (RolloutSpec.Envelope e : r.envelopes()) {
+                    nl(w, 2);
+                    w.writeEmptyElement("envelope");
+                    w.writeAttribute("port", e.port());
+                    w.writeAttribute("field", e.field());
+                    w.writeAttribute("min", Double.toString(e.min()));
+                    w.writeAttribute("max", Double.toString(e.max()));
+                }
+                if (!empty) {
+                    nl(w, 1);
+                    w.writeEndElement();
+                }
+            }
             nl(w, 0);
             w.writeEndElement();
             w.writeEndDocument();

@@ -253,4 +253,25 @@ class ContractParserTest {
         assertTrue(e.attributes().isEmpty());
         assertEquals("", e.description());
     }
+
+    @Test
+    void aRolloutDeclaresTheShadowRunTheWindowTolerancesAndEnvelopes() throws Exception {
+        Contract c = PARSER.parse(resource("/good/rollout.xml"), "rollout.xml");
+        RolloutSpec r = c.rollout().orElseThrow();
+        assertEquals(200, r.shadow().getAsLong());
+        assertEquals(1000, r.window().getAsLong());
+        assertEquals(java.util.List.of(new RolloutSpec.Tolerance("y", "value", 0.001)), r.tolerances());
+        assertEquals(java.util.List.of(new RolloutSpec.Envelope("y", "value", -20, 20)), r.envelopes());
+        // none declared: empty, and the shadow run and window default where they are used
+        assertTrue(PARSER.parse(resource("/good/sample-scaler.xml"), "s.xml").rollout().isEmpty());
+        Contract bare = PARSER.parse(resource("/good/sample-scaler.xml").replace("</component>",
+                "<rollout shadow=\"5\"/></component>"), "s.xml");
+        assertEquals(5, bare.rollout().orElseThrow().shadow().getAsLong());
+        assertTrue(bare.rollout().orElseThrow().window().isEmpty());
+        // a second tolerance of the same field is named
+        ContractException e = assertThrows(ContractException.class, () -> PARSER.parse(resource("/good/rollout.xml")
+                .replace("<envelope", "<tolerance port=\"y\" field=\"value\" abs=\"2\"/><envelope"), "r.xml"));
+        assertTrue(e.getMessage().contains("[§12.1] rollout/tolerance[y.value]: a second tolerance for y.value"),
+                e.getMessage());
+    }
 }

@@ -24,6 +24,7 @@ public final class ContractXml extends Located {
     public Text criticality;
     public Fault fault;
     public Update update;
+    public Rollout rollout;
 
     @JsonSetter("description") void description(Text t) { once(description, "description"); description = t; }
     @JsonSetter("implementation") void implementation(Impl v) { once(implementation, "implementation"); implementation = v; }
@@ -35,6 +36,7 @@ public final class ContractXml extends Located {
     @JsonSetter("criticality") void criticality(Text v) { once(criticality, "criticality"); criticality = v; }
     @JsonSetter("fault") void fault(Fault v) { once(fault, "fault"); fault = v; }
     @JsonSetter("update") void update(Update v) { once(update, "update"); update = v; }
+    @JsonSetter("rollout") void rollout(Rollout v) { once(rollout, "rollout"); rollout = v; }
 
     /** {@code <implementation>}. */
     public static final class Impl extends Located {
@@ -137,5 +139,25 @@ public final class ContractXml extends Located {
     public static final class Update extends Located {
         @JacksonXmlProperty(isAttribute = true) public String url;
         @JacksonXmlProperty(isAttribute = true) public String sha256;
+    }
+
+    /** {@code <rollout shadow window>} with its tolerances and envelopes (SPEC §12.1). */
+    public static final class Rollout extends Located {
+        @JacksonXmlProperty(isAttribute = true) public String shadow;
+        @JacksonXmlProperty(isAttribute = true) public String window;
+        public final List<OutputRule> tolerances = new ArrayList<>();
+        public final List<OutputRule> envelopes = new ArrayList<>();
+
+        @JsonSetter("tolerance") void tolerance(OutputRule r) { tolerances.add(r); }
+        @JsonSetter("envelope") void envelope(OutputRule r) { envelopes.add(r); }
+    }
+
+    /** {@code <tolerance port field abs/>} or {@code <envelope port field min max/>}. */
+    public static final class OutputRule extends Located {
+        @JacksonXmlProperty(isAttribute = true) public String port;
+        @JacksonXmlProperty(isAttribute = true) public String field;
+        @JacksonXmlProperty(isAttribute = true) public String abs;
+        @JacksonXmlProperty(isAttribute = true) public String min;
+        @JacksonXmlProperty(isAttribute = true) public String max;
     }
 }

@@ -42,17 +42,28 @@ public final class ChangeSet {
      * through the code gate. The new half is prepared beside the old one under a generation's
      * object id, switched in the set's actor turn, and the old one is kept warm for
      * {@code window} cycles of the new one (0: stopped at once); a crash or an overrun of the new
-     * one within the window rolls the component back to the old half.
+     * one within the window rolls the component back to the old half. With {@code shadow > 0} the
+     * new half first runs {@code shadow} cycles on the same inputs with its outputs not applied,
+     * compared by {@code tolerances} (D42, {@link ShadowRun}); failing, the set is not switched.
      */
     public record Update(String component, org.arflex.contract.Contract contract, Path exe, String from, long window,
-                         List<Envelope> envelopes) implements Step {
+                         List<Envelope> envelopes, long shadow, List<Tolerance> tolerances) implements Step {
 
         public Update(String component, org.arflex.contract.Contract contract, Path exe, String from, long window) {
             this(component, contract, exe, from, window, List.of());
         }
 
+        public Update(String component, org.arflex.contract.Contract contract, Path exe, String from, long window,
+                      List<Envelope> envelopes) {
+            this(component, contract, exe, from, window, envelopes, 0, List.of());
+        }
+
         public Update {
             envelopes = List.copyOf(envelopes);
+            tolerances = List.copyOf(tolerances);
+            if (shadow < 0) {
+                throw new IllegalArgumentException("shadow " + shadow + " < 0");
+            }
             Objects.requireNonNull(component, "component");
             Objects.requireNonNull(contract, "contract");
             Objects.requireNonNull(exe, "exe");
@@ -85,6 +96,28 @@ public final class ChangeSet {
         @Override
         public String toString() {
             return port + "." + field + " [" + min + ", " + max + "]";
+        }
+    }
+
+    /**
+     * How far every element of numeric field {@code field} of output {@code port} of an update's
+     * new version may lie from the running version's value of the same source cycle during its
+     * shadow run (D42); beyond it the update is rejected before the switch.
+     */
+    public record Tolerance(String port, String field, double abs) {
+        public Tolerance {
+            Objects.requireNonNull(port, "port");
+            Objects.requireNonNull(field, "field");
+            if (!(abs >= 0) || Double.isInfinite(abs)) {
+                throw new IllegalArgumentException("tolerance " + port + "." + field + ": " + abs
+                        + " is not a finite number >= 0");
+            }
+        }
+
+        /** As written: {@code port.field +-abs}. */
+        @Override
+        public String toString() {
+            return port + "." + field + " +-" + abs;
         }
     }
 
@@ -121,6 +154,18 @@ public final class ChangeSet {
 
     private ChangeSet(List<Step> steps) {
         this.steps = List.copyOf(steps);
+    }
+
+    /**
+     * An update whose window, shadow run, envelopes and tolerances are those given
+     * ({@code window}, {@code shadow}: null when not given; envelopes and tolerances by
+     * port.field) over the new version's {@code <rollout>} (contract SPEC §12.1) over the
+     * defaults: no shadow run, a window of {@code defaultWindow} cycles (D42).
+     */
+    public static Update rules(String component, org.arflex.contract.Contract contract, Path exe, String from,
+                               Long window, Long shadow, List<Envelope> envelopes, List<Tolerance> tolerances,
+                               long defaultWindow) {
+        return ShadowRules.merged(component, contract, exe, from, window, shadow, envelopes, tolerances, defaultWindow);
     }
 
     public static Builder builder() {
@@ -160,6 +205,19 @@ public final class ChangeSet {
         public Builder update(String name, org.arflex.contract.Contract contract, Path exe, String from, long window,
                               List<Envelope> envelopes) {
             steps.add(new Update(name, contract, exe, from, window, envelopes));
+            return this;
+        }
+
+        /** An update with a shadow run of {@code shadow} cycles compared by {@code tolerances} (D42). */
+        public Builder update(String name, org.arflex.contract.Contract contract, Path exe, String from, long window,
+                              List<Envelope> envelopes, long shadow, List<Tolerance> tolerances) {
+            steps.add(new Update(name, contract, exe, from, window, envelopes, shadow, tolerances));
+            return this;
+        }
+
+        /** Adds a step made elsewhere (e.g. {@link ChangeSet#rules}). */
+        public Builder add(Step step) {
+            steps.add(Objects.requireNonNull(step, "step"));
             return this;
         }
 

@@ -253,6 +253,10 @@ final class ChangeSetExecutor {
                 return "envelope " + e + ": port type " + out.type() + " has no field '" + e.field() + "'";
             }
         }
+        String tolerance = ShadowRules.problem(cell.config().types(), inst.contract, u);
+        if (tolerance != null) {
+            return tolerance;
+        }
         String id = Instance.generationId(n, inst.generation + 1);
         if (id.length() > 40) {
             return "the new half's object id '" + id + "' is longer than 40 characters (rt-core ABI)";
@@ -298,6 +302,10 @@ final class ChangeSetExecutor {
         final Map<String, Instance> nexts = new LinkedHashMap<>();
         /** Updated components: the running half when the set was prepared (the switch needs the same). */
         final Map<String, RtHalf> oldHalves = new LinkedHashMap<>();
+        /** Updates with a shadow run before the switch (D42), by the new version's instance. */
+        final Map<Instance, ShadowRun> shadows = new LinkedHashMap<>();
+        /** What the passed shadow runs said, for the verdict. */
+        final List<String> shadowVerdicts = new ArrayList<>();
         int outstanding;
         boolean over;
 
@@ -367,7 +375,7 @@ final class ChangeSetExecutor {
             }
             outstanding = starting.size();
             if (outstanding == 0) {
-                switchOver();
+                prepared();
                 return;
             }
             for (Instance inst : starting) {
@@ -397,25 +405,78 @@ final class ChangeSetExecutor {
                     + tookNs / 1000 + " us), not started yet");
             half.exit().thenAccept(ex -> cell.actor().submit(() -> exitedEarly(inst, half, ex)));
             if (outstanding == 0) {
-                switchOver();
+                prepared();
             }
         }
+
+        /** Every half is READY: the shadow runs of updates that declare one (D42), else the switch. */
+        private void prepared() {
+            for (ChangeSet.Step s : set.steps()) {
+                if (s instanceof ChangeSet.Update u && u.shadow() > 0) {
+                    Instance next = nexts.get(u.component());
+                    shadows.put(next, new ShadowRun(cell, segments, log, shadowOutcome, u, cell.find(u.component()),
+                            oldHalves.get(u.component()), next, prepared.get(next)));
+                }
+            }
+            if (shadows.isEmpty()) {
+                switchOver();
+                return;
+            }
+            for (ShadowRun r : List.copyOf(shadows.values())) {
+                if (!over) {
+                    r.begin(checked.plan().wiringOf(r.next.name));
+                }
+            }
+        }
+
+        private final ShadowRun.Outcome shadowOutcome = new ShadowRun.Outcome() {
+            @Override
+            public void passed(ShadowRun r, String summary) {
+                if (over) {
+                    return;
+                }
+                shadowVerdicts.add("update " + r.next.name + ": " + summary);
+                log.accept("arflex: " + r.next.name + ": the new version (pid " + r.nextHalf.pid() + ") " + summary);
+                if (shadowVerdicts.size() == shadows.size()) {
+                    switchOver();
+                }
+            }
+
+            @Override
+            public void rejected(ShadowRun r, String why) {
+                if (!over) {
+                    abandon(String.format(java.util.Locale.ROOT, "update %s: rejected in shadow after %d cycles: %s; "
+                            + "nothing changed (pid %d runs %s on)", r.next.name, r.cycles(), why, r.oldHalf.pid(),
+                            r.next.name), "rejected in shadow: " + r.next.name);
+                }
+            }
+        };
 
         private void exitedEarly(Instance inst, RtHalf half, RtHalf.Exit ex) {
             if (!over && prepared.get(inst) == half) {
                 prepared.remove(inst);
                 half.cleanup();
+                ShadowRun shadow = shadows.get(inst);
+                if (shadow != null && shadow.exited(ex)) {
+                    return; // rejected in shadow (D42)
+                }
                 tearDown("'" + inst.name + "' (pid " + half.pid() + ") exited before the switch: " + ex.description());
             }
         }
 
         /** Everything prepared goes; the cell is as it was before the set (actor thread). */
         private void tearDown(String why) {
+            abandon("preparation failed, nothing changed: " + why, "change set torn down");
+        }
+
+        /** Everything prepared goes, with {@code refusal} as the set's outcome (actor thread). */
+        private void abandon(String refusal, String stopReason) {
             over = true;
+            shadows.values().forEach(ShadowRun::cancel);
             current = null;
             List<Stops.Going> going = new ArrayList<>();
             for (var e : prepared.entrySet()) {
-                going.add(new Stops.Going(e.getKey(), e.getValue(), List.of(), 0, "change set torn down"));
+                going.add(new Stops.Going(e.getKey(), e.getValue(), List.of(), 0, stopReason));
             }
             prepared.clear();
             Stops.Batch b = stops.submit(going);
@@ -433,7 +494,6 @@ final class ChangeSetExecutor {
                     inst.life.reason(inst.planned ? "change set torn down" : "bundle " + inst.bundleId + " is not started");
                 }
             }
-            String refusal = "preparation failed, nothing changed: " + why;
             log.accept("arflex: change set " + set.describe() + ": " + refusal);
             cell.changed();
             done.accept(new Outcome(false, refusal, checked.plan(), cell.config().monotonicNs().getAsLong() - t0, 0));
@@ -502,8 +562,13 @@ final class ChangeSetExecutor {
                 if (inst.life.state() == State.INSTALLED) {
                     inst.life.to(State.UNSATISFIED, "change set: switching");
                 }
-                starter.activate(inst, Objects.requireNonNull(half), plan.cpuAssignment().getOrDefault(inst.name, -1),
-                        inst.params.clone(), plan.wiringOf(inst.name), t0, ts);
+                if (shadows.containsKey(inst)) { // bound and started by its shadow run (D42)
+                    starter.adopt(inst, Objects.requireNonNull(half), plan.cpuAssignment().getOrDefault(inst.name, -1),
+                            "bound and started by its shadow run");
+                } else {
+                    starter.activate(inst, Objects.requireNonNull(half), plan.cpuAssignment().getOrDefault(inst.name, -1),
+                            inst.params.clone(), plan.wiringOf(inst.name), t0, ts);
+                }
             }
             // 2. the running consumers follow: one BIND per input whose provider changes (taken at
             //    its next cycle boundary, the old value read until then), an UNBIND only for an
@@ -566,6 +631,9 @@ final class ChangeSetExecutor {
             }
             // 5. the old halves of updated components: kept warm for their window, or stopped now
             List<java.util.concurrent.CompletableFuture<String>> verdicts = new ArrayList<>();
+            for (String v : shadowVerdicts) {
+                verdicts.add(java.util.concurrent.CompletableFuture.completedFuture(v));
+            }
             for (ChangeSet.Step s : set.steps()) {
                 if (s instanceof ChangeSet.Update u) {
                     Instance next = nexts.get(u.component());

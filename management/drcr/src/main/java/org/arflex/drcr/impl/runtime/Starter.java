@@ -271,6 +271,18 @@ final class Starter {
             changed.run();
             return false;
         }
+        adopt(inst, half, cpu, "spawn to READY " + (tLaunched - t0) / 1000 + " us, bind+start "
+                + (cfg.monotonicNs().getAsLong() - tLaunched) / 1000 + " us");
+        return true;
+    }
+
+    /**
+     * Makes a half that is bound and started already the instance's running half (actor thread):
+     * ACTIVE, watched, its exit to {@link Failures}. {@link #activate} ends here; an update's
+     * shadow run (D42, {@link ShadowRun}) bound and started its half itself and comes here at
+     * the switch, with no second BIND or START.
+     */
+    void adopt(Instance inst, RtHalf half, int cpu, String how) {
         Contract c = inst.contract;
         inst.half = half;
         inst.cpu = cpu;
@@ -287,11 +299,9 @@ final class Starter {
         });
         monitor.watch(inst.name, half, c.fault().heartbeatTimeoutMs(), cfg.monotonicNs().getAsLong(),
                 OutputRepair.probe(inst.name, inst.outputs));
-        long t1 = cfg.monotonicNs().getAsLong();
         log.accept("arflex: " + inst.name + " ACTIVE (pid " + half.pid() + ", cpu " + cpu + ", inputs " + inst.bound
-                + "; spawn to READY " + (tLaunched - t0) / 1000 + " us, bind+start " + (t1 - tLaunched) / 1000 + " us)");
+                + "; " + how + ")");
         changed.run();
-        return true;
     }
 
     private void fail(Instance inst, Exception e) {

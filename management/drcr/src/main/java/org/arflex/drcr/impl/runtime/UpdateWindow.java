@@ -116,7 +116,7 @@ final class UpdateWindow {
         long cycles = cyclesNow();
         long newBad = ChangeSetExecutor.bad(n) - newBad0;
         long oldBad = ChangeSetExecutor.bad(o) - oldBad0;
-        String outside = outside();
+        String outside = outside(cell, next, update.envelopes());
         if (outside != null) {
             rollback(outside, System.nanoTime());
             return;
@@ -135,9 +135,9 @@ final class UpdateWindow {
         timer = cell.actor().schedule(this::watch, ChangeSetExecutor.WATCH_MS);
     }
 
-    /** Which value of the new half's outputs lies outside its declared envelope, or null. */
-    private String outside() {
-        for (ChangeSet.Envelope e : update.envelopes()) {
+    /** Which newest value of {@code next}'s outputs lies outside its envelope, or null (also in a shadow run, D42). */
+    static String outside(Cell cell, Instance next, List<ChangeSet.Envelope> envelopes) {
+        for (ChangeSet.Envelope e : envelopes) {
             org.arflex.drcr.impl.supervisor.RtLauncher.Output o = next.outputs.get(e.port());
             org.arflex.contract.PortSpec spec = next.contract.outputs().stream()
                     .filter(p -> p.name().equals(e.port())).findFirst().orElse(null);

@@ -45,7 +45,8 @@ public final class ChangeSets implements ChangeSetService {
     static final long WINDOW = 1000;
     /** The usage of the actions. */
     static final String ACTIONS = "actions: install <component>, uninstall <component>, set <component> <parameter> "
-            + "<value>, update <component> <jar URL> [<sha256>] [window <cycles>] [envelope <port>.<field> <min> <max>]...";
+            + "<value>, update <component> <jar URL> [<sha256>] [window <cycles>] [shadow <cycles>] [envelope <port>.<field> "
+            + "<min> <max>]... [tolerance <port>.<field> <max difference>]...";
 
     /**
      * A new version of a component, from a jar that passed the code gate (D38); {@code jar}: its
@@ -129,8 +130,8 @@ public final class ChangeSets implements ChangeSetService {
                 throw new IllegalArgumentException("'" + String.join(" ", tokens.subList(i, tokens.size()))
                         + "' is incomplete (" + verb + switch (verb) {
                             case "set" -> " <component> <parameter> <value>";
-                            case "update" -> " <component> <jar URL> [<sha256>] [window <cycles>] [envelope <port>.<field> "
-                                    + "<min> <max>]...";
+                            case "update" -> " <component> <jar URL> [<sha256>] [window <cycles>] [shadow <cycles>] "
+                                    + "[envelope <port>.<field> <min> <max>]... [tolerance <port>.<field> <max difference>]...";
                             default -> " <component>";
                         } + ")");
             }
@@ -139,18 +140,32 @@ public final class ChangeSets implements ChangeSetService {
                 i += n;
                 continue;
             }
-            List<String> u = new ArrayList<>(List.of(verb, tokens.get(i + 1), tokens.get(i + 2), "", ""));
+            List<String> u = new ArrayList<>(List.of(verb, tokens.get(i + 1), tokens.get(i + 2), "", "", ""));
             i += 3;
             if (i < tokens.size() && tokens.get(i).matches("[0-9a-fA-F]{64}")) {
                 u.set(3, tokens.get(i++));
             }
-            while (i < tokens.size() && (tokens.get(i).equals("window") || tokens.get(i).equals("envelope"))) {
-                if (tokens.get(i).equals("window")) {
+            while (i < tokens.size() && List.of("window", "shadow", "envelope", "tolerance").contains(tokens.get(i))) {
+                if (tokens.get(i).equals("window") || tokens.get(i).equals("shadow")) {
                     if (i + 1 >= tokens.size() || !tokens.get(i + 1).matches("[0-9]{1,9}")) {
-                        throw new IllegalArgumentException("update " + u.get(1) + ": window needs a number of cycles");
+                        throw new IllegalArgumentException("update " + u.get(1) + ": " + tokens.get(i)
+                                + " needs a number of cycles");
                     }
-                    u.set(4, tokens.get(i + 1));
+                    u.set(tokens.get(i).equals("window") ? 4 : 5, tokens.get(i + 1));
                     i += 2;
+                } else if (tokens.get(i).equals("tolerance")) {
+                    if (i + 2 >= tokens.size() || !tokens.get(i + 1).matches("[a-z][a-z0-9_]*\\.[a-z][a-z0-9_]*")) {
+                        throw new IllegalArgumentException("update " + u.get(1)
+                                + ": tolerance needs <port>.<field> <max difference>");
+                    }
+                    try {
+                        new ChangeSet.Tolerance("p", "f", Double.parseDouble(tokens.get(i + 2)));
+                    } catch (IllegalArgumentException e) {
+                        throw new IllegalArgumentException("update " + u.get(1) + ": tolerance " + tokens.get(i + 1)
+                                + ": " + tokens.get(i + 2) + " is not a tolerance (a finite number >= 0)");
+                    }
+                    u.add("tolerance " + tokens.get(i + 1) + " " + tokens.get(i + 2));
+                    i += 3;
                 } else {
                     if (i + 3 >= tokens.size() || !tokens.get(i + 1).matches("[a-z][a-z0-9_]*\\.[a-z][a-z0-9_]*")) {
                         throw new IllegalArgumentException("update " + u.get(1) + ": envelope needs <port>.<field> <min> <max>");
@@ -162,7 +177,7 @@ public final class ChangeSets implements ChangeSetService {
                         throw new IllegalArgumentException("update " + u.get(1) + ": envelope " + tokens.get(i + 1)
                                 + ": " + tokens.get(i + 2) + " " + tokens.get(i + 3) + " is not a range (<min> <max>)");
                     }
-                    u.add(tokens.get(i + 1) + " " + tokens.get(i + 2) + " " + tokens.get(i + 3));
+                    u.add("envelope " + tokens.get(i + 1) + " " + tokens.get(i + 2) + " " + tokens.get(i + 3));
                     i += 4;
                 }
             }
@@ -289,13 +304,21 @@ public final class ChangeSets implements ChangeSetService {
                         throw new IllegalStateException("update " + a[1] + ": cannot extract its executable: " + e.getMessage());
                     }
                     List<ChangeSet.Envelope> envelopes = new ArrayList<>();
-                    for (int k = 5; k < a.length; k++) {
+                    List<ChangeSet.Tolerance> tolerances = new ArrayList<>();
+                    for (int k = 6; k < a.length; k++) {
                         String[] e = a[k].split(" ");
-                        int dot = e[0].indexOf('.');
-                        envelopes.add(new ChangeSet.Envelope(e[0].substring(0, dot), e[0].substring(dot + 1),
-                                Double.parseDouble(e[1]), Double.parseDouble(e[2])));
+                        int dot = e[1].indexOf('.');
+                        if (e[0].equals("envelope")) {
+                            envelopes.add(new ChangeSet.Envelope(e[1].substring(0, dot), e[1].substring(dot + 1),
+                                    Double.parseDouble(e[2]), Double.parseDouble(e[3])));
+                        } else {
+                            tolerances.add(new ChangeSet.Tolerance(e[1].substring(0, dot), e[1].substring(dot + 1),
+                                    Double.parseDouble(e[2])));
+                        }
                     }
-                    b.update(a[1], v.contract(), exe, a[2], a[4].isEmpty() ? WINDOW : Long.parseLong(a[4]), envelopes);
+                    // the command line over the new version's <rollout> (SPEC 12.1) over the defaults (D42)
+                    b.add(ChangeSet.rules(a[1], v.contract(), exe, a[2], a[4].isEmpty() ? null : Long.parseLong(a[4]),
+                            a[5].isEmpty() ? null : Long.parseLong(a[5]), envelopes, tolerances, WINDOW));
                 }
                 case "uninstall" -> b.uninstall(a[1]);
                 default -> b.set(a[1], a[2], a[3]);

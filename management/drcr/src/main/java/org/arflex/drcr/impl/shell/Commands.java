@@ -208,14 +208,14 @@ public final class Commands {
      * {@code change apply <actions>} applies it all or nothing; actions are
      * {@code install <component>} (its bundle installed, not started), {@code uninstall <component>},
      * {@code set <component> <parameter> <value>} and {@code update <component> <jar URL> [<sha256>]
-     * [window <cycles>]} (D38), in any number, e.g.
+     * [window <cycles>] [shadow <cycles>] [envelope ...] [tolerance ...]} (D38, D42), in any number, e.g.
      * {@code change apply install teach uninstall trajectory}.
      */
     public String change(String... args) {
         return guard(() -> {
             String usage = "usage: change plan|apply <action>... (actions: install <component>, uninstall <component>,"
                     + " set <component> <parameter> <value>, update <component> <jar URL> [<sha256>] [window <cycles>]"
-                    + " [envelope <port>.<field> <min> <max>]...)";
+                    + " [shadow <cycles>] [envelope <port>.<field> <min> <max>]... [tolerance <port>.<field> <max difference>]...)";
             if (changeSets == null || args.length < 2 || !(args[0].equals("plan") || args[0].equals("apply"))) {
                 return usage;
             }

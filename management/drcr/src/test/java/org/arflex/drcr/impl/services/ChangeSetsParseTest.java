@@ -24,12 +24,12 @@ class ChangeSetsParseTest {
     @Test
     void anUpdateTakesItsJarThenAnOptionalPinAndWindow() {
         String sha = "ab".repeat(32);
-        assertEquals(List.of("update tcp-correction file:/x.jar  ", "uninstall b"),
+        assertEquals(List.of("update tcp-correction file:/x.jar   ", "uninstall b"),
                 flat(List.of("update", "tcp-correction", "file:/x.jar", "uninstall", "b")));
-        assertEquals(List.of("update tcp-correction file:/x.jar " + sha + " 2000", "set a gain 2"),
+        assertEquals(List.of("update tcp-correction file:/x.jar " + sha + " 2000 ", "set a gain 2"),
                 flat(List.of("update tcp-correction file:/x.jar " + sha + " window 2000; set a gain 2")));
-        assertEquals(List.of("update c https://h/c.jar  50"), flat(List.of("update", "c", "https://h/c.jar", "window", "50")));
-        assertEquals(List.of("update c file:/c.jar   corrected.q -3.2 3.2 error.value 0 5", "uninstall d"),
+        assertEquals(List.of("update c https://h/c.jar  50 "), flat(List.of("update", "c", "https://h/c.jar", "window", "50")));
+        assertEquals(List.of("update c file:/c.jar    envelope corrected.q -3.2 3.2 envelope error.value 0 5", "uninstall d"),
                 flat(List.of("update c file:/c.jar envelope corrected.q -3.2 3.2 envelope error.value 0 5 uninstall d")));
         assertEquals("update c: envelope corrected.q: 1 0 is not a range (<min> <max>)",
                 assertThrows(IllegalArgumentException.class,
@@ -37,13 +37,33 @@ class ChangeSetsParseTest {
     }
 
     @Test
+    void anUpdateTakesAShadowRunAndTolerances() {
+        assertEquals(List.of("update c file:/c.jar  100 200 tolerance corrected.q 0.001 envelope corrected.q -3 3",
+                        "uninstall d"),
+                flat(List.of("update c file:/c.jar window 100 shadow 200 tolerance corrected.q 0.001 envelope corrected.q "
+                        + "-3 3 uninstall d")));
+        assertEquals(List.of("update c file:/c.jar   50 tolerance error.value 0"),
+                flat(List.of("update", "c", "file:/c.jar", "shadow", "50", "tolerance", "error.value", "0")));
+        assertEquals("update c: shadow needs a number of cycles", assertThrows(IllegalArgumentException.class,
+                () -> ChangeSets.parse(List.of("update c file:/c.jar shadow many"))).getMessage());
+        assertEquals("update c: tolerance corrected.q: -0.1 is not a tolerance (a finite number >= 0)",
+                assertThrows(IllegalArgumentException.class,
+                        () -> ChangeSets.parse(List.of("update c file:/c.jar shadow 10 tolerance corrected.q -0.1"))).getMessage());
+        assertEquals("update c: tolerance corrected.q: wide is not a tolerance (a finite number >= 0)",
+                assertThrows(IllegalArgumentException.class,
+                        () -> ChangeSets.parse(List.of("update c file:/c.jar tolerance corrected.q wide"))).getMessage());
+        assertEquals("update c: tolerance needs <port>.<field> <max difference>", assertThrows(IllegalArgumentException.class,
+                () -> ChangeSets.parse(List.of("update c file:/c.jar tolerance corrected 0.1"))).getMessage());
+    }
+
+    @Test
     void anUnknownOrIncompleteActionIsRefusedNamingIt() {
         assertEquals("unknown action 'upgrade' (actions: install <component>, uninstall <component>, set <component> "
-                + "<parameter> <value>, update <component> <jar URL> [<sha256>] [window <cycles>] [envelope <port>.<field> <min> "
-                + "<max>]...)",
+                + "<parameter> <value>, update <component> <jar URL> [<sha256>] [window <cycles>] [shadow <cycles>] [envelope "
+                + "<port>.<field> <min> <max>]... [tolerance <port>.<field> <max difference>]...)",
                 assertThrows(IllegalArgumentException.class, () -> ChangeSets.parse(List.of("upgrade", "vision"))).getMessage());
         assertEquals("'update vision' is incomplete (update <component> <jar URL> [<sha256>] [window <cycles>] "
-                + "[envelope <port>.<field> <min> <max>]...)",
+                + "[shadow <cycles>] [envelope <port>.<field> <min> <max>]... [tolerance <port>.<field> <max difference>]...)",
                 assertThrows(IllegalArgumentException.class, () -> ChangeSets.parse(List.of("update", "vision"))).getMessage());
         assertEquals("update vision: window needs a number of cycles", assertThrows(IllegalArgumentException.class,
                 () -> ChangeSets.parse(List.of("update vision file:/v.jar window soon"))).getMessage());

@@ -331,7 +331,7 @@ class CommandsTest {
     void changeWithoutActionsPrintsItsUsage() {
         String usage = "usage: change plan|apply <action>... (actions: install <component>, uninstall <component>,"
                 + " set <component> <parameter> <value>, update <component> <jar URL> [<sha256>] [window <cycles>]"
-                + " [envelope <port>.<field> <min> <max>]...)";
+                + " [shadow <cycles>] [envelope <port>.<field> <min> <max>]... [tolerance <port>.<field> <max difference>]...)";
         assertEquals(usage, cmd.change());
         assertEquals(usage, cmd.change("apply"));
         assertEquals(usage, cmd.change("do", "install", "x"));
