@@ -24,6 +24,8 @@ import java.util.Optional;
  * @param fault        restart and safe-output policy
  * @param update       where updates come from, if anywhere
  * @param source       where this contract was read from, for error messages
+ * @param state        the state block it hands to its next version at a change set's switch, if any
+ *                     (SPEC §12.1)
  */
 public record Contract(
         String name,
@@ -40,12 +42,22 @@ public record Contract(
         int criticality,
         FaultPolicy fault,
         Optional<UpdateSpec> update,
-        String source) {
+        String source,
+        Optional<StateSpec> state) {
 
     public Contract {
         attributes = Map.copyOf(attributes);
         ports = List.copyOf(ports);
         properties = List.copyOf(properties);
+    }
+
+    /** A contract without a state block, as before SPEC §12.1 existed. */
+    public Contract(String name, String version, String description, String executable, TaskType taskType,
+                    boolean movesHardware, Map<String, String> attributes, List<PortSpec> ports,
+                    List<PropertySpec> properties, Timing timing, Resources resources, int criticality,
+                    FaultPolicy fault, Optional<UpdateSpec> update, String source) {
+        this(name, version, description, executable, taskType, movesHardware, attributes, ports, properties, timing,
+                resources, criticality, fault, update, source, Optional.empty());
     }
 
     /** The inputs, in declaration order. */

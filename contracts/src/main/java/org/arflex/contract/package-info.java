@@ -3,5 +3,5 @@
  * DRCR and the web console's contract editor share.
  */
 @org.osgi.annotation.bundle.Export
-@org.osgi.annotation.versioning.Version("0.1.0")
+@org.osgi.annotation.versioning.Version("0.2.0")
 package org.arflex.contract;

@@ -24,6 +24,7 @@ public final class ContractXml extends Located {
     public Text criticality;
     public Fault fault;
     public Update update;
+    public StateXml state;
 
     @JsonSetter("description") void description(Text t) { once(description, "description"); description = t; }
     @JsonSetter("implementation") void implementation(Impl v) { once(implementation, "implementation"); implementation = v; }
@@ -35,6 +36,7 @@ public final class ContractXml extends Located {
     @JsonSetter("criticality") void criticality(Text v) { once(criticality, "criticality"); criticality = v; }
     @JsonSetter("fault") void fault(Fault v) { once(fault, "fault"); fault = v; }
     @JsonSetter("update") void update(Update v) { once(update, "update"); update = v; }
+    @JsonSetter("state") void state(StateXml v) { once(state, "state"); state = v; }
 
     /** {@code <implementation>}. */
     public static final class Impl extends Located {
@@ -137,5 +139,20 @@ public final class ContractXml extends Located {
     public static final class Update extends Located {
         @JacksonXmlProperty(isAttribute = true) public String url;
         @JacksonXmlProperty(isAttribute = true) public String sha256;
+    }
+
+    /** {@code <state type typeVersion>} with {@code <convertsFrom type typeVersion/>} children (SPEC §12.1). */
+    public static final class StateXml extends Located {
+        @JacksonXmlProperty(isAttribute = true) public String type;
+        @JacksonXmlProperty(isAttribute = true) public String typeVersion;
+        public final List<From> convertsFrom = new ArrayList<>();
+
+        @JsonSetter("convertsFrom") void convertsFrom(From f) { convertsFrom.add(f); }
+    }
+
+    /** {@code <convertsFrom type typeVersion/>}. */
+    public static final class From extends Located {
+        @JacksonXmlProperty(isAttribute = true) public String type;
+        @JacksonXmlProperty(isAttribute = true) public String typeVersion;
     }
 }

@@ -238,7 +238,12 @@ final class ChangeSetExecutor {
             return "'" + n + "' has no running RT half to update (" + inst.life.state() + "); install or update it "
                     + "outside a change set";
         }
-        if (inst.contract.movesHardware() || u.contract().movesHardware()) {
+        String state = StateTransfer.problem(inst.contract, u.contract());
+        if (state != null) {
+            return state;
+        }
+        if ((inst.contract.movesHardware() || u.contract().movesHardware())
+                && !StateTransfer.continuesMotion(inst.contract, u.contract())) {
             return "'" + n + "' moves hardware: its new half would drive it beside the old one; update it outside a "
                     + "change set";
         }
@@ -375,6 +380,7 @@ final class ChangeSetExecutor {
                     break;
                 }
                 starter.prepare(inst, plan.cpuAssignment().getOrDefault(inst.name, -1),
+                        nexts.get(inst.name) == inst ? StateTransfer.source(cell.find(inst.name), inst) : null,
                         (half, error, took) -> ready(inst, half, error, took));
             }
         }

@@ -162,6 +162,15 @@ final class Starter {
      * {@link #idle()} completes only after {@code done} ran.
      */
     void prepare(Instance inst, int cpu, Prepared done) {
+        prepare(inst, cpu, null, done);
+    }
+
+    /**
+     * As {@link #prepare(Instance, int, Prepared)}; with {@code adoptFrom} not null the READY
+     * half is also told, on the launch thread, the state segment it adopts at its START (D41,
+     * {@link StateTransfer}); a refused ADOPT stops the half and is the launch's error.
+     */
+    void prepare(Instance inst, int cpu, String adoptFrom, Prepared done) {
         Contract c = inst.contract;
         RtLauncher.Spec spec;
         try {
@@ -182,16 +191,30 @@ final class Starter {
         launches.execute(() -> {
             RtHalf half = null;
             Exception error = null;
+            RtHalf refused = null;
             try {
                 half = launcher.launch(spec);
+                if (adoptFrom != null) {
+                    try {
+                        half.adopt(adoptFrom);
+                    } catch (IOException | RuntimeException e) {
+                        refused = half;
+                        half = null;
+                        error = new IOException("its state block: " + e.getMessage(), e);
+                    }
+                }
             } catch (IOException | RuntimeException e) {
                 error = e;
             }
             long took = cfg.monotonicNs().getAsLong() - t0;
             RtHalf h = half;
+            RtHalf r = refused;
             Exception err = error;
             Runnable back = () -> {
                 inst.launching = false;
+                if (r != null) { // READY but without the state it was to continue from
+                    stops.submit(List.of(new Stops.Going(inst, r, List.of(), 0, "its ADOPT was refused")));
+                }
                 try {
                     done.ready(h, err, took);
                 } finally {
