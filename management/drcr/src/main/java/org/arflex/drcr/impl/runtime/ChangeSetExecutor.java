@@ -395,6 +395,9 @@ final class ChangeSetExecutor {
                 return;
             }
             if (error != null || half == null) {
+                if (half != null) {
+                    prepared.put(inst, half); // READY but its ADOPT refused (D41): stopped with the rest
+                }
                 tearDown("preparing '" + inst.name + "': " + (error == null ? "no RT half" : error.getMessage()));
                 return;
             }

@@ -148,7 +148,8 @@ final class Starter {
         done.forEach(f -> f.complete(null));
     }
 
-    /** Where a change set's launch reports (actor thread): the READY half, or why there is none. */
+    /** Where a change set's launch reports (actor thread): the READY half, or why there is none
+     *  (with a half too when the half is READY but its ADOPT was refused). */
     interface Prepared {
         void ready(RtHalf half, Exception error, long spawnToReadyNs);
     }
@@ -168,7 +169,8 @@ final class Starter {
     /**
      * As {@link #prepare(Instance, int, Prepared)}; with {@code adoptFrom} not null the READY
      * half is also told, on the launch thread, the state segment it adopts at its START (D41,
-     * {@link StateTransfer}); a refused ADOPT stops the half and is the launch's error.
+     * {@link StateTransfer}); a refused ADOPT reports the READY half together with the error,
+     * for the caller to stop with whatever else it prepared.
      */
     void prepare(Instance inst, int cpu, String adoptFrom, Prepared done) {
         Contract c = inst.contract;
@@ -191,15 +193,12 @@ final class Starter {
         launches.execute(() -> {
             RtHalf half = null;
             Exception error = null;
-            RtHalf refused = null;
             try {
                 half = launcher.launch(spec);
                 if (adoptFrom != null) {
                     try {
                         half.adopt(adoptFrom);
-                    } catch (IOException | RuntimeException e) {
-                        refused = half;
-                        half = null;
+                    } catch (IOException | RuntimeException e) { // READY, but not with the state it continues
                         error = new IOException("its state block: " + e.getMessage(), e);
                     }
                 }
@@ -208,13 +207,9 @@ final class Starter {
             }
             long took = cfg.monotonicNs().getAsLong() - t0;
             RtHalf h = half;
-            RtHalf r = refused;
             Exception err = error;
             Runnable back = () -> {
                 inst.launching = false;
-                if (r != null) { // READY but without the state it was to continue from
-                    stops.submit(List.of(new Stops.Going(inst, r, List.of(), 0, "its ADOPT was refused")));
-                }
                 try {
                     done.ready(h, err, took);
                 } finally {
