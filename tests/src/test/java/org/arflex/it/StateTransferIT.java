@@ -45,6 +45,28 @@ class StateTransferIT {
     /** One cycle of the program's fastest motion: speed 0.1 of joint 0's 123 deg/s over 1 ms, rad. */
     static final double ONE_CYCLE = 0.1 * CellRig.VMAX[0] * 1e-3;
 
+    /** arflex.TcpCorrectionState 1.0: its size and the offset of blend_offset[6] (contracts/types). */
+    static final int TCS_SIZE = 368;
+    static final int TCS_BLEND_OFFSET = 208;
+
+    /**
+     * The offset tcp-correction took up at its last provider change, from its state block: its
+     * last reference from the old provider minus its first from the new one (D35's fade starts
+     * from it), i.e. the step of its input at the switch as the consumer saw it. Largest joint.
+     */
+    static double switchOffset(Runtime rt) throws IOException {
+        try (CellRig.Port p = new CellRig.Port(Path.of("/dev/shm/arflex." + rt.rid + ".tcp-correction.state"),
+                TCS_SIZE)) {
+            java.nio.ByteBuffer b = p.read();
+            assertTrue(b != null, "tcp-correction's state block");
+            double m = 0;
+            for (int i = 0; i < 6; i++) {
+                m = Math.max(m, Math.abs(b.getDouble(TCS_BLEND_OFFSET + 8 * i)));
+            }
+            return m;
+        }
+    }
+
     /** A copy of the trajectory bundle with its contract's version set and {@code edit} applied to the contract. */
     static Path version(Path dir, String version, UnaryOperator<String> edit) throws IOException {
         Path out = dir.resolve("trajectory-" + version + ".jar");
@@ -124,6 +146,7 @@ class StateTransferIT {
                 rt.waitUntil("the arm moving and 1000 references seen", T,
                         () -> FailSafeIT.moving(js) && oldOut.size() > 1000);
                 Map<String, Object> robot0 = ChangeSetIT.stats(rt, "sim-robot");
+                double offsetBefore = switchOffset(rt);
                 int mark = oldOut.size();
                 int robotMark = robotRef.size();
                 int logMark = rt.logMark();
@@ -161,7 +184,17 @@ class StateTransferIT {
                     List<CellRig.Ref> o = oldOut.snapshot();
                     List<CellRig.Ref> n = newOut.snapshot();
                     assertTrue(n.size() > 1000, "values of the new half: " + n.size());
-                    double cross = Math.max(UpdateSetIT.crossSteps(o, n), UpdateSetIT.crossSteps(n, o));
+                    // at the switch: the values of both halves from 10 ms before the new half's first
+                    // to 50 ms after it (the consumer's BIND follows its START in the same turn)
+                    long s0 = n.get(0).tNs() - 10_000_000L;
+                    long s1 = n.get(0).tNs() + 50_000_000L;
+                    List<CellRig.Ref> ow = o.stream().filter(r -> r.tNs() >= s0 && r.tNs() <= s1).toList();
+                    List<CellRig.Ref> nw = n.stream().filter(r -> r.tNs() <= s1).toList();
+                    double cross = Math.max(UpdateSetIT.crossSteps(ow, nw), UpdateSetIT.crossSteps(nw, ow));
+                    // over the whole window (both halves run on: a cycle one of them skips puts it a
+                    // program step behind the other)
+                    double crossAll = Math.max(UpdateSetIT.crossSteps(o, n), UpdateSetIT.crossSteps(n, o));
+                    double offset = switchOffset(rt);
                     double before = 0;
                     for (int i = 1; i < mark; i++) {
                         before = Math.max(before, ChangeSetIT.perSourceCycle(o.get(i - 1), o.get(i)));
@@ -187,7 +220,12 @@ class StateTransferIT {
                     CellRig.Safety tripped = ss.stream().filter(s -> s.mode() != CellRig.Safety.NORMAL).findFirst()
                             .orElse(null);
                     Map<String, Object> robot1 = ChangeSetIT.stats(rt, "sim-robot");
-                    System.out.printf(Locale.ROOT, "StateTransferIT: trajectory's own output across the two halves: "
+                    System.out.printf(Locale.ROOT, "StateTransferIT: the step of tcp-correction's input at the switch "
+                            + "(the offset it took up, from its state block): %.3f mrad (%.3f before the apply; bound, "
+                            + "one cycle of the programmed motion: %.3f); between the two halves over the whole window: "
+                            + "%.3f mrad per source cycle%n", offset * 1e3, offsetBefore * 1e3, ONE_CYCLE * 1e3,
+                            crossAll * 1e3);
+                    System.out.printf(Locale.ROOT, "StateTransferIT: trajectory's own output across the two halves at the switch: "
                             + "largest step %.3f mrad per source cycle (bound, one cycle of the programmed motion: "
                             + "%.3f; the program alone before the apply: %.3f); the new half's first value %.3f mrad "
                             + "per source cycle from the old half's value before it (%.3f ms apart); %d values of the "
@@ -197,8 +235,10 @@ class StateTransferIT {
                             (first.tNs() - prior.tNs()) / 1e6, n.size(), robotAfter * 1e3, robotBefore * 1e3,
                             ChangeSetIT.JUMP_BOUND * 1e3, worst.forceNorm(), ChangeSetIT.delta(robot0, robot1,
                             "safeCycles"), tookMs);
+                    assertTrue(offset <= ONE_CYCLE * 1.02, "tcp-correction's reference stepped " + offset
+                            + " rad at the switch");
                     assertTrue(cross <= ONE_CYCLE * 1.02, "trajectory's output stepped " + cross
-                            + " rad per source cycle between its two halves");
+                            + " rad per source cycle between its two halves at the switch");
                     assertTrue(robotAfter <= ChangeSetIT.JUMP_BOUND, "robot reference step " + robotAfter);
                     assertNull(tripped, "the guard left NORMAL: " + tripped);
                     assertEquals(0, ChangeSetIT.delta(robot0, robot1, "safeCycles"), "sim-robot ran safe cycles");
