@@ -26,12 +26,15 @@ import org.junit.jupiter.api.Test;
  * (arflex.TrajectoryState 1.0); the new half adopts the old half's newest state at its START and
  * plays on from there: the same program, the same motion, the same limiter state.
  *
- * <p>What shows the transfer itself is trajectory's own output (tcp-correction fades a provider
- * change of up to 50 mrad, D35, which would hide a jump at the robot): across the two halves'
- * joint_ref segments, from a value of one to the next value (by stamp) of the other, the step
- * per source cycle is at most one cycle of the programmed motion. Without the state the same
- * update cannot happen: a version that declares no state, or another state type without a
- * conversion, is refused by the plan with the reason and nothing is spawned.
+ * <p>What shows the transfer itself is not the robot's reference (tcp-correction fades a provider
+ * change of up to 50 mrad, D35, which would hide a jump there) but (a) the step of
+ * tcp-correction's input at the switch, the offset its fade took up, read from tcp-correction's
+ * own state block: at most one cycle of the programmed motion; and (b) trajectory's own two
+ * outputs: the new half continues the old one's seq and both write the same values under the
+ * same seq. Without the state the same update cannot happen: a version that declares no state,
+ * or another state type without a conversion, is refused by the plan with the reason and
+ * nothing is spawned (cell.state_transfer shows the jump a fresh half would make: its program
+ * from the start).
  *
  * <p>Versions made here from the trajectory bundle the build made, pinned: 1.0.1 (the same
  * executable and state block), 1.0.2-nostate (its contract without the state block),
