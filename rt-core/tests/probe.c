@@ -16,11 +16,15 @@ struct probe_out {
 	uint64_t in_reads;
 	uint64_t in_bound;
 	uint64_t in_binding;    /* arflex_input_binding */
+	uint64_t adopt_calls;   /* D41 */
+	uint64_t adopted;
+	uint64_t state_value;
 };
 
 static const struct arflex_port_type out_type = { "test.ProbeOut", 1, 0,
 						  sizeof(struct probe_out) };
 static const struct arflex_port_type in_type = { "test.Value", 1, 0, sizeof(uint64_t) };
+static const struct arflex_port_type state_type = { "test.ProbeState", 1, 0, sizeof(uint64_t) };
 
 static struct probe {
 	FILE *log;
@@ -57,6 +61,9 @@ static int configure(struct arflex_component *c, void *user)
 		goto out_fail;
 	r = arflex_component_input(c, "in", ARFLEX_PORT_STATE, &in_type, &pr.in);
 	if (r)
+		goto out_fail;
+	r = arflex_component_state(c, &state_type, NULL); /* D41: -ENOENT without a segment */
+	if (r && r != -ENOENT)
 		goto out_fail;
 	pr.gain = arflex_component_param(c, "gain");
 	if (pr.gain < 0) {
@@ -112,7 +119,29 @@ static int update(struct arflex_component *c, void *user, uint64_t release_ns)
 	if (pr.require_reset_at && pr.o.updates == pr.require_reset_at)
 		arflex_component_require_reset(c);
 	pr.logged_update = true;
+	pr.o.state_value = pr.o.adopted + pr.o.updates;
+	arflex_component_state_publish(c, &pr.o.state_value, sizeof(pr.o.state_value), release_ns);
 	return arflex_state_write(pr.out, &pr.o, sizeof(pr.o));
+}
+
+/* D41: test.ProbeState 1.x as it is, test.OldProbeState 0.x converted (x 10), else refused. */
+static int adopt(struct arflex_component *c, void *user, const struct arflex_adopted_state *s)
+{
+	uint64_t v;
+
+	(void)c;
+	(void)user;
+	if (s->length < sizeof(v))
+		return -EMSGSIZE;
+	memcpy(&v, s->data, sizeof(v));
+	if (!strcmp(s->type_name, "test.ProbeState") && s->major == 1)
+		pr.o.adopted = v;
+	else if (!strcmp(s->type_name, "test.OldProbeState") && s->major == 0)
+		pr.o.adopted = v * 10;
+	else
+		return -EPROTOTYPE;
+	pr.o.adopt_calls++;
+	return 0;
 }
 
 static int safe(struct arflex_component *c, void *user, enum arflex_safe_mode mode, bool first)
@@ -151,6 +180,7 @@ static const struct arflex_component_ops ops = {
 	.stop = stop,
 	.cleanup = cleanup,
 	.safe = safe,
+	.adopt = adopt,
 };
 
 int main(int argc, char **argv)

@@ -52,6 +52,8 @@ int probe_prio;
 uint64_t probe_cpus;
 uint64_t probe_hold;
 uint32_t probe_task_type;
+bool probe_state;
+const struct arflex_port_type probe_state_type = { "test.ProbeState", 1, 0, sizeof(uint64_t) };
 
 int probe_host(struct arflex_host *h, const char *inst, uint64_t hb_timeout,
 		      uint32_t cfg_flags, bool with_out)
@@ -69,6 +71,7 @@ int probe_host(struct arflex_host *h, const char *inst, uint64_t hb_timeout,
 			    .priority = probe_prio, .cpu_mask = probe_cpus,
 			    .orphan_hold_ns = probe_hold, .task_type = probe_task_type },
 		.params = p, .nparams = 2, .outputs = &out, .noutputs = with_out ? 1 : 0,
+		.state = probe_state ? &probe_state_type : NULL,
 	};
 
 	th_track(rid, inst);

@@ -16,7 +16,14 @@ struct probe_out {
 	uint64_t updates, safe_calls, safe_firsts;
 	int64_t gain;
 	uint64_t torn, in_value, in_reads, in_bound, in_binding;
+	uint64_t adopt_calls, adopted; /* D41: adopt hook calls, the (converted) value adopted */
+	uint64_t state_value;          /* what it publishes as its state block (adopted + updates) */
 };
+/* The probe's state block (D41): test.ProbeState 1.0, one uint64. It converts
+ * test.OldProbeState 0.x (value x 10) and refuses any other type. */
+extern const struct arflex_port_type probe_state_type;
+/* true: the next probe_host creates the probe's state segment */
+extern bool probe_state;
 
 extern const struct arflex_port_type value_type;
 extern char rid[64];

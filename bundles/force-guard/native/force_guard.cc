@@ -192,7 +192,7 @@ int Safe(struct arflex_component* c, void*, enum arflex_safe_mode, bool) {
 }
 
 const struct arflex_component_ops kOps = {
-    "force-guard", nullptr, Configure, Start, Update, nullptr, nullptr, Safe,
+    "force-guard", nullptr, Configure, Start, Update, nullptr, nullptr, Safe, nullptr,
 };
 
 }  // namespace

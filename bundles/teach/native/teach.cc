@@ -312,7 +312,7 @@ int Safe(struct arflex_component*, void*, enum arflex_safe_mode, bool) {
 }
 
 const struct arflex_component_ops kOps = {
-    "teach", nullptr, Configure, Start, Update, nullptr, Cleanup, Safe,
+    "teach", nullptr, Configure, Start, Update, nullptr, Cleanup, Safe, nullptr,
 };
 
 }  // namespace

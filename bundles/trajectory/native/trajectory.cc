@@ -32,6 +32,7 @@
 #include "arflex_types/safety_state.h"
 #include "arflex_types/sample.h"
 #include "arflex_types/tool_state.h"
+#include "arflex_types/trajectory_state.h"
 #include "cellkin.h"
 #include "trajectory_plan.h"
 
@@ -91,6 +92,8 @@ struct State {
   int64_t playing = 0;  // the program the player plays
   uint32_t state_binding = 0;  // joint_state binding the output last met the arm on
   uint64_t away_since = 0;     // release time since which the idle output is away from the arm
+  struct arflex_trajectory_state state{};  // the state block published every cycle (D41)
+  uint64_t state_seq = 0;
 } g;
 
 // A robot measured further than this from the output when it is (re)bound makes the program
@@ -131,6 +134,15 @@ int Configure(struct arflex_component* c, void*) {
                                                    sizeof(struct arflex_sample)};
   if ((r = arflex_component_output(c, "tool_id", ARFLEX_PORT_STATE, &sample_t, &g.out_tool)) < 0) {
     fprintf(stderr, "trajectory: output tool_id: %s\n", strerror(-r));
+    return r;
+  }
+  // The state block (contract <state>, D41): handed to a new version at a change set's switch.
+  // Without a state segment (a host test that makes none) publishing is a no-op.
+  static const struct arflex_port_type traj_state_t = {
+      ARFLEX_TYPE_TRAJECTORY_STATE_NAME, ARFLEX_TYPE_TRAJECTORY_STATE_VERSION_MAJOR,
+      ARFLEX_TYPE_TRAJECTORY_STATE_VERSION_MINOR, sizeof(struct arflex_trajectory_state)};
+  if ((r = arflex_component_state(c, &traj_state_t, nullptr)) < 0 && r != -ENOENT) {
+    fprintf(stderr, "trajectory: state block: %s\n", strerror(-r));
     return r;
   }
   if ((r = arflex_component_input(c, "safety", ARFLEX_PORT_STATE, &safety_t, &g.in_safety)) < 0 ||
@@ -255,6 +267,127 @@ uint32_t TrackTool(int* err) {
   return id;
 }
 
+// ---- the state block (D41) --------------------------------------------------------------
+
+template <int N, typename V>
+void Put(double (&dst)[N], const V& v) {
+  for (int i = 0; i < N; ++i) dst[i] = v[i];
+}
+
+// Writes where the player is and the component's own command state into the state block.
+void PublishState(struct arflex_component* c, uint64_t release_ns) {
+  if (!arflex_component_state_open(c)) return;
+  const traj::Snapshot s = g.player.Save();
+  struct arflex_trajectory_state& st = g.state;
+  st.t_ns = (int64_t)release_ns;
+  st.seq = ++g.state_seq;
+  st.program = g.playing;
+  st.index = s.index;
+  st.run_begin = s.run_begin;
+  st.run_n = s.run_n;
+  st.cursor = s.cursor;
+  st.out_seq = g.seq;
+  st.tool_seq = g.tool_seq;
+  st.completed = s.completed;
+  st.flags = (s.initialized ? ARFLEX_TRAJECTORY_STATE_FLAG_INITIALIZED : 0u) |
+             (s.done ? ARFLEX_TRAJECTORY_STATE_FLAG_DONE : 0u) |
+             (s.active ? ARFLEX_TRAJECTORY_STATE_FLAG_ACTIVE : 0u) |
+             (s.path ? ARFLEX_TRAJECTORY_STATE_FLAG_PATH : 0u) |
+             (g.permitted ? ARFLEX_TRAJECTORY_STATE_FLAG_PERMITTED : 0u) |
+             (g.await_command ? ARFLEX_TRAJECTORY_STATE_FLAG_AWAIT_COMMAND : 0u);
+  st.profile = (uint32_t)s.profile;
+  st.rate = s.rate;
+  st.tau = s.tau;
+  st.shape_t = s.shape_t;
+  st.shape_ta = s.shape_ta;
+  st.path_len = s.path_len;
+  st.cursor_sigma = s.cursor_sigma;
+  Put(st.q0, s.q0);
+  Put(st.dq, s.dq);
+  Put(st.p0, s.p0);
+  Put(st.p1, s.p1);
+  const double r0[4] = {s.r0.w(), s.r0.x(), s.r0.y(), s.r0.z()};
+  const double r1[4] = {s.r1.w(), s.r1.x(), s.r1.y(), s.r1.z()};
+  Put(st.r0, r0);
+  Put(st.r1, r1);
+  Put(st.ik_q, s.ik_q);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) st.tool[3 * i + j] = s.tool.linear()(i, j);
+  for (int i = 0; i < 3; ++i) st.tool[9 + i] = s.tool.translation()[i];
+  Put(st.q_plan, s.q_plan);
+  Put(st.q_plan_prev, s.q_plan_prev);
+  Put(st.q_out, s.q_out);
+  Put(st.v_out, s.v_out);
+  arflex_component_state_publish(c, &st, sizeof(st), release_ns);
+}
+
+template <typename V, int N>
+void Get(V* dst, const double (&src)[N]) {
+  for (int i = 0; i < N; ++i) (*dst)[i] = src[i];
+}
+
+// The adopt hook (D41): right after Start at the switch of a change set's update, the state
+// the running version published last. arflex.TrajectoryState 1.x is taken as it is; anything
+// else is refused (-EPROTOTYPE: the START is refused), as is a state that does not fit the
+// loaded programs (-ENOENT, -EINVAL). The reference then goes on from the old half's last one.
+int Adopt(struct arflex_component* c, void*, const struct arflex_adopted_state* a) {
+  struct arflex_trajectory_state st;
+  if (std::strcmp(a->type_name, ARFLEX_TYPE_TRAJECTORY_STATE_NAME) != 0 ||
+      a->major != ARFLEX_TYPE_TRAJECTORY_STATE_VERSION_MAJOR || a->length < sizeof(st))
+    return -EPROTOTYPE;
+  std::memcpy(&st, a->data, sizeof(st));
+  if (!arflex_trajectory_state_valid(&st) || st.profile > traj::kTrapezoid) return -EINVAL;
+  if (st.program < 0 || st.program >= kMaxPrograms || g.programs[st.program].motions.empty())
+    return -ENOENT;
+  traj::Snapshot s;
+  s.initialized = (st.flags & ARFLEX_TRAJECTORY_STATE_FLAG_INITIALIZED) != 0;
+  s.done = (st.flags & ARFLEX_TRAJECTORY_STATE_FLAG_DONE) != 0;
+  s.active = (st.flags & ARFLEX_TRAJECTORY_STATE_FLAG_ACTIVE) != 0;
+  s.path = (st.flags & ARFLEX_TRAJECTORY_STATE_FLAG_PATH) != 0;
+  s.index = st.index;
+  s.run_begin = st.run_begin;
+  s.run_n = st.run_n;
+  s.cursor = st.cursor;
+  s.completed = st.completed;
+  s.profile = st.profile == 1 ? traj::kTrapezoid : traj::kQuintic;
+  s.rate = st.rate;
+  s.tau = st.tau;
+  s.shape_t = st.shape_t;
+  s.shape_ta = st.shape_ta;
+  s.path_len = st.path_len;
+  s.cursor_sigma = st.cursor_sigma;
+  Get(&s.q0, st.q0);
+  Get(&s.dq, st.dq);
+  Get(&s.p0, st.p0);
+  Get(&s.p1, st.p1);
+  s.r0 = Eigen::Quaterniond(st.r0[0], st.r0[1], st.r0[2], st.r0[3]);
+  s.r1 = Eigen::Quaterniond(st.r1[0], st.r1[1], st.r1[2], st.r1[3]);
+  Get(&s.ik_q, st.ik_q);
+  s.tool = Eigen::Isometry3d::Identity();
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) s.tool.linear()(i, j) = st.tool[3 * i + j];
+  for (int i = 0; i < 3; ++i) s.tool.translation()[i] = st.tool[9 + i];
+  Get(&s.q_plan, st.q_plan);
+  Get(&s.q_plan_prev, st.q_plan_prev);
+  Get(&s.q_out, st.q_out);
+  Get(&s.v_out, st.v_out);
+  const struct arflex_ctl* ctl = arflex_component_ctl(c);
+  if (!g.player.Restore(s, &g.model, &g.programs[st.program], ctl->config.period_ns * 1e-9))
+    return -EINVAL;
+  g.playing = st.program;
+  g.seq = st.out_seq;
+  g.tool_seq = st.tool_seq;
+  g.state_seq = st.seq;
+  g.permitted = (st.flags & ARFLEX_TRAJECTORY_STATE_FLAG_PERMITTED) != 0;
+  // a stop the old half was holding on holds here too (and a reset this half needs, from Start)
+  g.await_command = g.await_command || (st.flags & ARFLEX_TRAJECTORY_STATE_FLAG_AWAIT_COMMAND) != 0;
+  g.cmd_seq = CommandSeq(c);  // this process's own write counters
+  // the arm was met through the old half's joint_state binding: this binding is no new robot
+  g.state_binding = arflex_input_binding(g.in_state);
+  g.away_since = 0;
+  return 0;
+}
+
 int Step(struct arflex_component* c, uint64_t release_ns, bool force_stop) {
   int input_err = 0;  // an input value rejected this cycle (-EINVAL), returned at the end
   struct arflex_sample tool_id;
@@ -369,6 +502,7 @@ int Step(struct arflex_component* c, uint64_t release_ns, bool force_stop) {
   for (int j = 0; j < 6; ++j) ref.q[j] = g.player.q_out()[j];
   r = arflex_state_write(g.out, &ref, sizeof(ref));
   if (r < 0) return r;
+  PublishState(c, release_ns);
   return input_err < 0 ? input_err : switch_err;
 }
 
@@ -385,7 +519,7 @@ int Safe(struct arflex_component* c, void*, enum arflex_safe_mode, bool) {
 }
 
 const struct arflex_component_ops kOps = {
-    "trajectory", nullptr, Configure, Start, Update, nullptr, nullptr, Safe,
+    "trajectory", nullptr, Configure, Start, Update, nullptr, nullptr, Safe, Adopt,
 };
 
 }  // namespace

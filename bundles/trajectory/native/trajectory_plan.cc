@@ -75,6 +75,86 @@ void Player::Begin(const cellkin::Model* model, const cellkin::Program* program,
   q_plan_prev_ = q_plan_;
 }
 
+Snapshot Player::Save() const {
+  Snapshot s;
+  s.initialized = initialized_;
+  s.done = done_;
+  s.active = active_;
+  s.path = path_;
+  s.index = idx_;
+  s.run_begin = run_begin_;
+  s.run_n = run_n_;
+  s.cursor = cursor_;
+  s.completed = completed_;
+  s.profile = shape_.profile;
+  s.rate = rate_;
+  s.tau = tau_;
+  s.shape_t = shape_.T;
+  s.shape_ta = shape_.ta;
+  s.path_len = path_len_;
+  s.cursor_sigma = cursor_sigma_;
+  s.q0 = q0_;
+  s.dq = dq_;
+  s.ik_q = ik_q_;
+  s.p0 = p0_;
+  s.p1 = p1_;
+  s.r0 = r0_;
+  s.r1 = r1_;
+  s.tool = tool_;
+  s.q_plan = q_plan_;
+  s.q_plan_prev = q_plan_prev_;
+  s.q_out = q_out_;
+  s.v_out = v_out_;
+  return s;
+}
+
+bool Player::Restore(const Snapshot& s, const cellkin::Model* model, const cellkin::Program* program,
+                     double dt) {
+  const size_t n = program ? program->motions.size() : 0;
+  if (!program || s.index > n || (s.path && (s.run_n == 0 || s.run_begin + s.run_n > n || s.cursor >= s.run_n)))
+    return false;
+  const bool finite = std::isfinite(s.rate) && std::isfinite(s.tau) && std::isfinite(s.shape_t) &&
+                      std::isfinite(s.shape_ta) && std::isfinite(s.path_len) &&
+                      std::isfinite(s.cursor_sigma) && s.q0.allFinite() && s.dq.allFinite() &&
+                      s.ik_q.allFinite() && s.p0.allFinite() && s.p1.allFinite() &&
+                      s.r0.coeffs().allFinite() && s.r1.coeffs().allFinite() &&
+                      s.tool.matrix().allFinite() && s.q_plan.allFinite() &&
+                      s.q_plan_prev.allFinite() && s.q_out.allFinite() && s.v_out.allFinite();
+  if (!finite) return false;
+  model_ = model;
+  prog_ = program;
+  dt_ = dt > 0 ? dt : 0.001;
+  initialized_ = s.initialized;
+  done_ = s.done;
+  active_ = s.active;
+  path_ = s.path;
+  idx_ = s.index;
+  run_begin_ = s.run_begin;
+  run_n_ = s.run_n;
+  cursor_ = s.cursor;
+  completed_ = s.completed;
+  shape_.profile = s.profile;
+  shape_.T = s.shape_t;
+  shape_.ta = s.shape_ta;
+  rate_ = s.rate;
+  tau_ = s.tau;
+  path_len_ = s.path_len;
+  cursor_sigma_ = s.cursor_sigma;
+  q0_ = s.q0;
+  dq_ = s.dq;
+  ik_q_ = s.ik_q;
+  p0_ = s.p0;
+  p1_ = s.p1;
+  r0_ = s.r0;
+  r1_ = s.r1;
+  tool_ = s.tool;
+  q_plan_ = s.q_plan;
+  q_plan_prev_ = s.q_plan_prev;
+  q_out_ = s.q_out;
+  v_out_ = s.v_out;
+  return true;
+}
+
 void Player::Switch(const cellkin::Program* program) {
   prog_ = program;
   done_ = false;

@@ -63,8 +63,30 @@ struct Shape {
 // r_a = max D_j / a_j.
 Shape PlanShape(Profile p, double r_v, double r_a);
 
+// Everything a Player is in the middle of (state transfer, docs/DECISIONS.md D41): where it is
+// in its program and its output limiter's state (the "filter" state: last output, speed and
+// plan), so that a Player restored from it in another process continues cycle for cycle.
+struct Snapshot {
+  bool initialized = false, done = false, active = false, path = false;
+  uint64_t index = 0, run_begin = 0, run_n = 0, cursor = 0, completed = 0;
+  Profile profile = kQuintic;
+  double rate = 0, tau = 0, shape_t = 0, shape_ta = 0, path_len = 0, cursor_sigma = 0;
+  Q q0 = Q::Zero(), dq = Q::Zero(), ik_q = Q::Zero();
+  Eigen::Vector3d p0 = Eigen::Vector3d::Zero(), p1 = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond r0 = Eigen::Quaterniond::Identity(), r1 = Eigen::Quaterniond::Identity();
+  Eigen::Isometry3d tool = Eigen::Isometry3d::Identity();
+  Q q_plan = Q::Zero(), q_plan_prev = Q::Zero(), q_out = Q::Zero(), v_out = Q::Zero();
+};
+
 class Player {
  public:
+  // The state to hand over (D41).
+  Snapshot Save() const;
+  // Continues from `s` playing `program` (the one it was taken in). False, and nothing changed,
+  // when `s` does not fit the program (a motion index or path run beyond its end) or holds a
+  // non-finite number.
+  bool Restore(const Snapshot& s, const cellkin::Model* model, const cellkin::Program* program,
+               double dt);
   // Selects the program; keeps the current reference (the robot is where it was).
   void Begin(const cellkin::Model* model, const cellkin::Program* program, double dt);
   void Init(const Q& q0);  // first reference

@@ -8,7 +8,9 @@
 #include "pose.h"
 #include "safety_state.h"
 #include "sample.h"
+#include "tcp_correction_state.h"
 #include "tool_state.h"
+#include "trajectory_state.h"
 #include "wrench.h"
 
 #endif /* ARFLEX_TYPES_ALL_H */

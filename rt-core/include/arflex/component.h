@@ -13,7 +13,9 @@
  *   3. calls configure (main thread), where the component declares its ports with
  *      arflex_component_output() / arflex_component_input() and looks up its parameters;
  *   4. state READY; the mailbox thread serves commands (START, STOP, SET_PARAM, GET_PARAM,
- *      BIND, UNBIND, GET_STATE, GET_STATS, RESET, SHUTDOWN, PING);
+ *      BIND, UNBIND, GET_STATE, GET_STATS, RESET, SHUTDOWN, PING, ADOPT);
+ *      ADOPT (before START, D41) names the state segment of the half this one replaces: at
+ *      the next START, right after the start hook, its newest value goes to the adopt hook;
  *   5. on START: the RT thread (arflex_task: SCHED_FIFO at config.priority when permitted,
  *      affinity config.cpu_mask, mlockall, cpu_dma_latency) calls start, then every period:
  *      picks up new input bindings and parameter requests (cycle boundary), checks the
@@ -72,6 +74,16 @@ enum arflex_exit {
 };
 
 struct arflex_component; /* opaque, one per process */
+
+/** A state block handed over from the half this one replaces (D41), for the adopt hook. */
+struct arflex_adopted_state {
+	const char *type_name; /**< its port type, e.g. "arflex.TrajectoryState" */
+	uint16_t major;        /**< its type version */
+	uint16_t minor;
+	const void *data;      /**< the newest value the old half published (valid in the hook) */
+	uint32_t length;       /**< bytes at data: the old segment's elem_size */
+	uint64_t age_ns;       /**< how old that value was when it was read */
+};
 struct arflex_input;     /* opaque, one per declared input */
 
 /**
@@ -101,6 +113,13 @@ struct arflex_component_ops {
 	 *  simply stop changing (hold). Return as update. */
 	int (*safe)(struct arflex_component *c, void *user, enum arflex_safe_mode mode,
 		    bool first);
+	/** OPTIONAL (ABI 1.3, D41), RT thread, once, right after start at the first START after
+	 *  an ADOPT: take over the state block @s of the half this one replaces (the newest value
+	 *  it published), so the first update continues where the old half was. @s says its type
+	 *  and version: convert an older one (the contract's <convertsFrom>), refuse what is not
+	 *  understood. Must not block, allocate or print. < 0 refuses the START (its reply
+	 *  carries the error). Without this hook the manager's ADOPT is refused (-EOPNOTSUPP). */
+	int (*adopt)(struct arflex_component *c, void *user, const struct arflex_adopted_state *s);
 };
 
 /** Runs an RT half. Returns an enum arflex_exit code for main() to return. */
@@ -128,6 +147,25 @@ ARFLEX_API int arflex_component_input(struct arflex_component *c, const char *po
 				      enum arflex_port_method method,
 				      const struct arflex_port_type *type,
 				      struct arflex_input **out);
+
+/**
+ * The state block (D41): opens /arflex.<rid>.<inst>.state, created by the manager when the
+ * contract declares <state type=...> (SPEC 12.1), as its producer, checking @type exactly.
+ * Configure only. Returns 0 (*@out, if not NULL, is the port; publish with
+ * arflex_component_state_publish), -ENOENT (the manager made no state segment: the contract
+ * declares none, or a host test runs without one; publishing is then a no-op), -EEXIST
+ * (declared twice), -EPROTOTYPE (type mismatch) or another -errno.
+ */
+ARFLEX_API int arflex_component_state(struct arflex_component *c,
+				      const struct arflex_port_type *type,
+				      struct arflex_port **out);
+/** Publishes the state block (a seqlock state write stamped @stamp_ns, as
+ *  arflex_state_write_at): every cycle, after the outputs. 0 without a state segment. RT safe:
+ *  no blocking, no allocation. */
+ARFLEX_API int arflex_component_state_publish(struct arflex_component *c, const void *val,
+					      size_t len, uint64_t stamp_ns);
+/** True when the state segment is open (arflex_component_state returned 0). */
+ARFLEX_API bool arflex_component_state_open(const struct arflex_component *c);
 
 /** Index of parameter @name in the control block, or -ENOENT. */
 ARFLEX_API int arflex_component_param(const struct arflex_component *c, const char *name);

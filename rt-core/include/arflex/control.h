@@ -36,7 +36,7 @@ extern "C" {
 /** ABI minor: additions only; a reader accepts any minor >= the one it needs.
  *  1.1: config.orphan_hold_ns, ARFLEX_CFG_SUPERVISOR_PIPE, ARFLEX_FLAG_SUPERVISOR_LOST.
  *  1.2: inputs[]: rejected values counted per input (in the former tail padding). */
-#define ARFLEX_ABI_MINOR 2u
+#define ARFLEX_ABI_MINOR 3u
 
 /** Magic of the control block: bytes "ARFLXCTL" read as little-endian uint64. */
 #define ARFLEX_CTL_MAGIC UINT64_C(0x4C5443584C465241)

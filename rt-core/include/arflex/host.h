@@ -40,6 +40,9 @@ struct arflex_host_opts {
 	unsigned nparams;
 	const struct arflex_host_output *outputs; /**< may be NULL if noutputs 0 */
 	unsigned noutputs;                   /**< <= ARFLEX_MAX_OUTPUTS */
+	/** ABI 1.3 (D41): the state block's type; not NULL creates /arflex.<rid>.<inst>.state
+	 *  (a state port of that type) as the DRCR does for a contract with <state>. */
+	const struct arflex_port_type *state;
 };
 
 /** One instance. Fields are private. */
@@ -52,6 +55,8 @@ struct arflex_host {
 	struct arflex_port outputs[ARFLEX_MAX_OUTPUTS];
 	char output_ports[ARFLEX_MAX_OUTPUTS][ARFLEX_NAME_SIZE];
 	unsigned noutputs;
+	struct arflex_port state;  /**< the state block's segment (opts.state) */
+	bool has_state;
 	pid_t pid;          /**< 0: no child */
 	int exit_status;    /**< wait status once reaped */
 	bool reaped;
@@ -138,6 +143,12 @@ ARFLEX_API int arflex_host_get_param(struct arflex_host *h, const char *name, ui
 ARFLEX_API int arflex_host_bind(struct arflex_host *h, const char *port, const char *shm_name,
 				uint64_t timeout_ns);
 ARFLEX_API int arflex_host_unbind(struct arflex_host *h, const char *port, uint64_t timeout_ns);
+/** ADOPT (D41): the half takes the newest value of the state segment @shm_name over at its next
+ *  START ("" withdraws it). Refused while running (-EBUSY), by a half without an adopt hook
+ *  (-EOPNOTSUPP), for a segment that does not open (-ENOENT, -EPROTO...). */
+ARFLEX_API int arflex_host_adopt(struct arflex_host *h, const char *shm_name, uint64_t timeout_ns);
+/** The instance's state segment (opts.state), or NULL. */
+ARFLEX_API struct arflex_port *arflex_host_state(struct arflex_host *h);
 
 /** Segment name of output @port of this instance, or NULL. */
 ARFLEX_API const char *arflex_host_output_name(const struct arflex_host *h, const char *port);

@@ -96,6 +96,8 @@ struct arflex_host_contract {
 	unsigned noutputs;
 	struct arflex_host_input inputs[ARFLEX_MAX_INPUTS];
 	unsigned ninputs;
+	struct arflex_port_type state;        /**< <state> (D41), when has_state */
+	bool has_state;                       /**< declared, and its type is in the table */
 };
 
 /**
@@ -111,7 +113,8 @@ ARFLEX_API int arflex_host_load_contract(struct arflex_host_contract *c, const c
 					 char *err, size_t errlen);
 
 /** Fills @o for arflex_host_create(): @runtime, @instance, the contract's configuration,
- *  parameters and outputs (pointing into @c, which must outlive the create call). */
+ *  parameters, outputs and state block (D41: when its type is in the table given to the
+ *  loader; pointing into @c, which must outlive the create call). */
 ARFLEX_API void arflex_host_contract_opts(struct arflex_host_contract *c, const char *runtime,
 					  const char *instance, struct arflex_host_opts *o);
 

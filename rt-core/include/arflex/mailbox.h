@@ -55,6 +55,8 @@ enum arflex_cmd {
 	ARFLEX_CMD_RESET = 9,     /**< operator reset: leave safe mode / clear reset-required */
 	ARFLEX_CMD_SHUTDOWN = 10, /**< stop if running, cleanup, exit 0 (reply sent first) */
 	ARFLEX_CMD_PING = 11,     /**< no-op round trip (benchmarks, liveness) */
+	ARFLEX_CMD_ADOPT = 12,    /**< ABI 1.3: payload bind, shm_name = the state segment of the
+				   *  half this one replaces; adopted at the next START (D41) */
 };
 
 /** msg.flags bits. */

@@ -262,6 +262,7 @@ static int rt_cycle(void *arg, uint64_t release_ns)
 static int rt_start(void *arg)
 {
 	struct arflex_component *c = arg;
+	int r;
 
 	c->safe = false;
 	c->clk_binding = 0; /* the first poll takes the clock's binding as new */
@@ -269,7 +270,8 @@ static int rt_start(void *arg)
 	memset(&c->hbw, 0, sizeof(c->hbw));
 	take_bindings(c);
 	check_heartbeat(c, arflex_sys_now_ns());
-	return c->ops->start ? c->ops->start(c, c->ops->user) : 0;
+	r = c->ops->start ? c->ops->start(c, c->ops->user) : 0;
+	return r < 0 ? r : arflex_comp_adopt_at_start(c); /* after start: it may reset state */
 }
 
 static int rt_stop(void *arg)
@@ -303,6 +305,7 @@ static int do_start(struct arflex_component *c)
 	pthread_sigmask(SIG_BLOCK, &all, &old);
 	r = arflex_task_start(&c->task);
 	pthread_sigmask(SIG_SETMASK, &old, NULL);
+	arflex_comp_adopt_done(c); /* the adopted state is the RT thread's now, or refused */
 	if (r) {
 		STORE(&c->ctl->state, ARFLEX_STATE_READY);
 		return r;
@@ -558,6 +561,9 @@ static bool serve(struct arflex_component *c, struct arflex_msg *m)
 		break;
 	case ARFLEX_CMD_PING:
 		st = 0;
+		break;
+	case ARFLEX_CMD_ADOPT:
+		st = c->running ? -EBUSY : arflex_comp_adopt_cmd(c, m);
 		break;
 	default:
 		st = -ENOSYS;
@@ -863,6 +869,7 @@ int arflex_component_main(int argc, char **argv, const struct arflex_component_o
 		ops->cleanup(c, ops->user);
 	noutputs = c->noutputs;
 	close_ports(c);
+	arflex_comp_state_close(c);
 	arflex_task_report(&c->task, stderr);
 	arflex_task_deinit(&c->task);
 	arflex_mailbox_deinit(&c->mb);
@@ -875,6 +882,7 @@ int arflex_component_main(int argc, char **argv, const struct arflex_component_o
 
 out_task:
 	close_ports(c);
+	arflex_comp_state_close(c);
 	arflex_task_deinit(&c->task);
 out_mailbox:
 	arflex_mailbox_deinit(&c->mb);

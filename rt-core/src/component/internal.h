@@ -33,6 +33,19 @@ struct arflex_input {
 	struct arflex_input_count *count; /* its rejected-value counter in the control block */
 };
 
+/* The state block (D41): the half's own state segment, and the one it adopts at START. */
+struct arflex_state_block {
+	struct arflex_port own;       /* /arflex.<rid>.<inst>.state, producer (configure) */
+	bool open;                    /* own is mapped */
+	struct arflex_port_type type; /* what own carries */
+	char type_name[ARFLEX_TYPE_NAME_SIZE];
+	struct arflex_port *src;      /* mailbox: the segment named by ADOPT (read-only) */
+	void *buf;                    /* mailbox: one value of src */
+	int result;                   /* RT at START: 1 adopted, 0 nothing published yet, < 0 */
+	uint64_t seq;                 /* RT: the adopted value's write count */
+	uint64_t age_ns;              /* RT: its age when it was adopted */
+};
+
 struct arflex_component {
 	const struct arflex_component_ops *ops;
 	const char *name;
@@ -68,11 +81,20 @@ struct arflex_component {
 	struct arflex_input inputs[ARFLEX_MAX_INPUTS];
 	unsigned ninputs;
 	struct arflex_stats stats_copy;
+	struct arflex_state_block state;
 };
 
 /* One log line on stderr, one write (component.c). */
 void arflex_comp_log(const struct arflex_component *c, const char *fmt, ...)
 	__attribute__((format(printf, 2, 3)));
+
+/* state.c (D41): the ADOPT command (mailbox thread, not while running), the adoption at
+ * START (RT thread, in the start hook's place), its report and release after START (mailbox
+ * thread), and closing everything at exit. */
+int arflex_comp_adopt_cmd(struct arflex_component *c, const struct arflex_msg *m);
+int arflex_comp_adopt_at_start(struct arflex_component *c);
+void arflex_comp_adopt_done(struct arflex_component *c);
+void arflex_comp_state_close(struct arflex_component *c);
 
 /* supervisor.c (ABI.md 6.2, DECISIONS.md D10) */
 #define ARFLEX_ORPHAN_POLL_NS 10000000u /* mailbox wakes every 10 ms once the supervisor is lost */

@@ -167,6 +167,8 @@ void arflex_comp_unlink_own(struct arflex_component *c, unsigned noutputs)
 		if (!arflex_ctl_obj_name(name, sizeof(name), c->rid, c->inst, chan))
 			arflex_sys_shm_unlink(name);
 	}
+	if (!arflex_ctl_obj_name(name, sizeof(name), c->rid, c->inst, "state"))
+		arflex_sys_shm_unlink(name); /* the state block (D41), if the manager made one */
 	if (!arflex_ctl_obj_name(name, sizeof(name), c->rid, c->inst, "cmd"))
 		arflex_sys_mq_unlink(name);
 	if (!arflex_ctl_obj_name(name, sizeof(name), c->rid, c->inst, "rsp"))

@@ -29,7 +29,7 @@
 enum kind {
 	K_COMPONENT, K_DESCRIPTION, K_IMPLEMENTATION, K_ATTRIBUTES, K_ATTRIBUTE, K_PORTS, K_IN,
 	K_OUT, K_BIND, K_PROPERTIES, K_PROPERTY, K_TIMING, K_RESOURCES, K_CRITICALITY, K_FAULT,
-	K_UPDATE, K_COUNT
+	K_UPDATE, K_STATE, K_CONVERTS_FROM, K_COUNT
 };
 
 /* Every element of the format: its name, its parent, its attributes, whether text is
@@ -77,6 +77,10 @@ static const struct elem {
 		      "11" },
 	[K_UPDATE] = { "update", K_COMPONENT, (const char *const[]){ "url", "sha256", NULL },
 		       false, "12" },
+	[K_STATE] = { "state", K_COMPONENT, (const char *const[]){ "type", "typeVersion", NULL },
+		      false, "12.1" },
+	[K_CONVERTS_FROM] = { "convertsFrom", K_STATE,
+			      (const char *const[]){ "type", "typeVersion", NULL }, false, "12.1" },
 };
 
 struct loader {
@@ -529,6 +533,34 @@ static bool port_common(struct loader *L, const XML_Char **atts, const char *dir
 	return true;
 }
 
+/* <state type typeVersion> (D41): a state segment of that type when the harness's type table
+ * knows it (the DRCR makes one for every such contract); a type the table does not list is
+ * left to the Java validator and makes no segment (the half then publishes nothing). */
+static void on_state(struct loader *L, const XML_Char **atts)
+{
+	const char *type = attr(atts, "type"), *ver = attr(atts, "typeVersion");
+	struct arflex_host_contract *c = L->c;
+
+	if (!type || !ver) {
+		fail(L, "12.1", "state", "type and typeVersion are required");
+		return;
+	}
+	for (unsigned i = 0; i < L->ntypes; i++) {
+		if (strcmp(L->types[i].name, type))
+			continue;
+		if (!(L->types[i].methods & 1u)) {
+			fail(L, "12.1", "state/@type", "port type %s does not allow the state method",
+			     type);
+			return;
+		}
+		c->state.name = L->types[i].name;
+		c->state.major = L->types[i].major;
+		c->state.minor = L->types[i].minor;
+		c->state.elem_size = L->types[i].size;
+		c->has_state = true;
+	}
+}
+
 static void on_out(struct loader *L, const XML_Char **atts)
 {
 	struct arflex_host_contract *c = L->c;
@@ -938,6 +970,13 @@ static void XMLCALL on_start(void *ud, const XML_Char *qname, const XML_Char **a
 		if (!attr(atts, "url") || !attr(atts, "sha256"))
 			fail(L, "12", "update", "url and sha256 are required");
 		break;
+	case K_STATE:
+		on_state(L, atts);
+		break;
+	case K_CONVERTS_FROM:
+		if (!attr(atts, "type") || !attr(atts, "typeVersion"))
+			fail(L, "12.1", "state/convertsFrom", "type and typeVersion are required");
+		break;
 	default:
 		break;
 	}
@@ -1196,6 +1235,7 @@ void arflex_host_contract_opts(struct arflex_host_contract *c, const char *runti
 		c->outputs[i].port = c->output_ports[i];
 	o->outputs = c->noutputs ? c->outputs : NULL;
 	o->noutputs = c->noutputs;
+	o->state = c->has_state ? &c->state : NULL;
 }
 
 const struct arflex_host_input *arflex_host_contract_input(const struct arflex_host_contract *c,

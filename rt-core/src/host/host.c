@@ -102,6 +102,19 @@ int arflex_host_create(struct arflex_host *h, const struct arflex_host_opts *o)
 		snprintf(h->output_ports[i], ARFLEX_NAME_SIZE, "%s", o->outputs[i].port);
 		h->noutputs = i + 1;
 	}
+	if (o->state) {
+		char name[ARFLEX_OBJ_NAME_SIZE];
+		struct arflex_port_spec spec = { .method = ARFLEX_PORT_STATE, .type = *o->state,
+						 .depth = 1 };
+
+		r = arflex_ctl_obj_name(name, sizeof(name), h->runtime, h->instance, "state");
+		if (r)
+			goto out_ports;
+		r = arflex_port_create(&h->state, name, &spec);
+		if (r)
+			goto out_ports;
+		h->has_state = true;
+	}
 	return 0;
 
 out_ports:
@@ -181,6 +194,9 @@ void arflex_host_destroy(struct arflex_host *h)
 	for (unsigned i = 0; i < h->noutputs; i++)
 		arflex_port_destroy(&h->outputs[i]);
 	h->noutputs = 0;
+	if (h->has_state)
+		arflex_port_destroy(&h->state);
+	h->has_state = false;
 	if (h->mb.tx_name[0])
 		arflex_mailbox_deinit(&h->mb);
 	if (h->ctl) {
@@ -426,6 +442,18 @@ int arflex_host_bind(struct arflex_host *h, const char *port, const char *shm_na
 int arflex_host_unbind(struct arflex_host *h, const char *port, uint64_t timeout_ns)
 {
 	return bind_call(h, ARFLEX_CMD_UNBIND, port, NULL, timeout_ns);
+}
+
+int arflex_host_adopt(struct arflex_host *h, const char *shm_name, uint64_t timeout_ns)
+{
+	if (!shm_name)
+		return -EINVAL;
+	return bind_call(h, ARFLEX_CMD_ADOPT, "", shm_name, timeout_ns);
+}
+
+struct arflex_port *arflex_host_state(struct arflex_host *h)
+{
+	return h->has_state ? &h->state : NULL;
 }
 
 const char *arflex_host_output_name(const struct arflex_host *h, const char *port)

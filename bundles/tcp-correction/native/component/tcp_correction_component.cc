@@ -54,6 +54,7 @@ extern "C" {
 #include "arflex_types/joint_state.h"
 #include "arflex_types/pose.h"
 #include "arflex_types/sample.h"
+#include "arflex_types/tcp_correction_state.h"
 
 namespace {
 
@@ -89,6 +90,7 @@ struct TcpCorrection {
   bool ref_invalid = false;  // the newest reference was rejected: the output holds
   bool js_invalid = false;   // the newest joint state was rejected: measurements are held
   double dt = 0.001;
+  arflex_tcp_correction_state state{};  // the state block published every cycle (D41)
 };
 
 TcpCorrection g;
@@ -149,6 +151,11 @@ int Configure(arflex_component* c, void*) {
   if (r == 0) r = arflex_component_output(c, "error", ARFLEX_PORT_STATE, &kSampleType, &g.error);
   if (r == 0) r = arflex_component_output(c, "correction", ARFLEX_PORT_STATE, &kSampleType, &g.size);
   if (r < 0) return r;
+  // The state block (contract <state>, D41): without a state segment publishing is a no-op.
+  static const arflex_port_type kStateBlock = {
+      ARFLEX_TYPE_TCP_CORRECTION_STATE_NAME, ARFLEX_TYPE_TCP_CORRECTION_STATE_VERSION_MAJOR,
+      ARFLEX_TYPE_TCP_CORRECTION_STATE_VERSION_MINOR, ARFLEX_TYPE_TCP_CORRECTION_STATE_SIZE};
+  if ((r = arflex_component_state(c, &kStateBlock, nullptr)) < 0 && r != -ENOENT) return r;
   g.p_gain = arflex_component_param(c, "gain");
   g.p_step = arflex_component_param(c, "max_step");
   g.p_rate = arflex_component_param(c, "max_rate");
@@ -182,7 +189,74 @@ int Start(arflex_component* c, void*) {
   return 0;
 }
 
-int Update(arflex_component* c, void*, uint64_t) {
+// ---- the state block (D41) --------------------------------------------------------------
+
+// The correction, the fade of a provider change and the reference last passed on.
+void PublishState(arflex_component* c, uint64_t release_ns) {
+  if (!arflex_component_state_open(c)) return;
+  arflex_tcp_correction_state& st = g.state;
+  st.t_ns = (int64_t)release_ns;
+  st.seq++;
+  st.pose_seq = g.pose_seq;
+  st.out_seq = g.out_seq;
+  st.error_seq = g.error_seq;
+  st.updates = (uint64_t)g.law.updates();
+  st.holds = (uint64_t)g.law.holds();
+  st.flags = (g.have_ref ? ARFLEX_TCP_CORRECTION_STATE_FLAG_HAVE_REF : 0u) |
+             (g.law.enabled() ? ARFLEX_TCP_CORRECTION_STATE_FLAG_ENABLED : 0u);
+  for (int i = 0; i < 6; ++i) {
+    st.target[i] = g.law.target()(i);
+    st.applied[i] = g.law.applied()(i);
+    st.last_error[i] = g.law.last_error()(i);
+    st.blend_offset[i] = g.blend_offset[i];
+    st.ref_q[i] = g.ref.q[i];
+    st.last_out[i] = g.last_out[i];
+  }
+  st.blend_t = std::min(g.blend_t, kBlendSeconds);
+  st.ref_t_ns = g.ref.t_ns;
+  arflex_component_state_publish(c, &st, sizeof(st), release_ns);
+}
+
+// The adopt hook (D41): after Start, at the switch of a change set's update, the state the
+// running version published last: the correction goes on where it was instead of restarting
+// at zero (a jump of up to max_correction with vision), a fade in progress goes on, and the
+// reference last passed on is the one the next provider change is faded from.
+// arflex.TcpCorrectionState 1.x only (-EPROTOTYPE refuses the START otherwise).
+int Adopt(arflex_component*, void*, const arflex_adopted_state* a) {
+  arflex_tcp_correction_state st;
+  if (std::strcmp(a->type_name, ARFLEX_TYPE_TCP_CORRECTION_STATE_NAME) != 0 ||
+      a->major != ARFLEX_TYPE_TCP_CORRECTION_STATE_VERSION_MAJOR || a->length < sizeof(st))
+    return -EPROTOTYPE;
+  std::memcpy(&st, a->data, sizeof(st));
+  if (!arflex_tcp_correction_state_valid(&st)) return -EINVAL;
+  arflex::tcpcorr::Vector6d target, applied, last_error;
+  for (int i = 0; i < 6; ++i) {
+    target(i) = st.target[i];
+    applied(i) = st.applied[i];
+    last_error(i) = st.last_error[i];
+  }
+  // enabled is this version's parameter (ApplyParams runs first in every update)
+  if (!g.law.Restore(target, applied, last_error, (long)st.updates, (long)st.holds, g.law.enabled()))
+    return -EINVAL;
+  g.have_ref = (st.flags & ARFLEX_TCP_CORRECTION_STATE_FLAG_HAVE_REF) != 0;
+  for (int i = 0; i < 6; ++i) {
+    g.ref.q[i] = st.ref_q[i];
+    g.last_out[i] = st.last_out[i];
+    g.blend_offset[i] = st.blend_offset[i];
+  }
+  g.ref.t_ns = st.ref_t_ns;
+  g.ref.seq = 0;
+  g.blend_t = st.blend_t;
+  g.pose_seq = st.pose_seq;
+  g.out_seq = st.out_seq;
+  g.error_seq = st.error_seq;
+  g.state = st;
+  // the same provider, through this half's own binding: its first value is no provider change
+  g.ref_binding = 0;
+  return 0;
+}
+
+int Update(arflex_component* c, void*, uint64_t release_ns) {
   ApplyParams(c);
   // A state read returns 1 only for a value newer than the last one it returned (0: none new,
   // the buffer untouched), so only a 1 may be used.
@@ -227,6 +301,7 @@ int Update(arflex_component* c, void*, uint64_t) {
     for (int i = 0; i < 6; ++i) out.q[i] = g.last_out[i];
     out.seq = ++g.out_seq;
     const int w = arflex_state_write(g.out, &out, sizeof(out));
+    PublishState(c, release_ns);
     return w < 0 ? w : err;
   }
   // The reference part of the output: the newest reference plus what is left of a blend.
@@ -299,6 +374,7 @@ int Update(arflex_component* c, void*, uint64_t) {
   arflex_state_write(g.size, &size, sizeof(size));
   for (int i = 0; i < 6; ++i) g.last_out[i] = out.q[i];
   const int w = arflex_state_write(g.out, &out, sizeof(out));
+  PublishState(c, release_ns);
   return w < 0 ? w : err;
 }
 
@@ -315,5 +391,6 @@ int main(int argc, char** argv) {
   ops.start = Start;
   ops.update = Update;
   ops.safe = Safe;
+  ops.adopt = Adopt;
   return arflex_component_main(argc, argv, &ops);
 }

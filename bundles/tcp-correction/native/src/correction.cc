@@ -91,5 +91,18 @@ bool CorrectionLaw::SetOptions(const CorrectionOptions& options) {
   return true;
 }
 
+bool CorrectionLaw::Restore(const Vector6d& target, const Vector6d& applied, const Vector6d& last_error,
+                            long updates, long holds, bool enabled) {
+  if (!target.allFinite() || !applied.allFinite() || !last_error.allFinite()) return false;
+  const double m = options_.max_correction;
+  target_ = target.cwiseMax(-m).cwiseMin(m);
+  applied_ = applied;  // not clipped: Tick ramps it to the clipped target, never a jump
+  last_error_ = last_error;
+  updates_ = updates;
+  holds_ = holds;
+  enabled_ = enabled;
+  return true;
+}
+
 }  // namespace tcpcorr
 }  // namespace arflex

@@ -33,6 +33,7 @@ extern "C" {
 #include "arflex_types/joint_state.h"
 #include "arflex_types/pose.h"
 #include "arflex_types/sample.h"
+#include "arflex_types/tcp_correction_state.h"
 
 namespace {
 
@@ -80,6 +81,7 @@ const arflex::cellmodel::JointVector kRef = {0.2, 0.5, 0.3, 0.1, 0.8, -0.2};
 const Eigen::Vector3d kPlantError(1.2e-3, -0.8e-3, 0.6e-3);  // true arm vs nominal, at the TCP
 
 struct Rig {
+  arflex_host_contract c{};
   arflex_host feeder{}, corr{}, feeder2{};
   bool feeder2_made = false;
   arflex_port out{}, err_out{}, size_out{};
@@ -118,10 +120,10 @@ struct Rig {
     int r = arflex_host_create(&feeder, &o);
     if (r < 0) return r;
     static const arflex_host_type types[] = {ARFLEX_HOST_TYPE(JOINT_REF), ARFLEX_HOST_TYPE(JOINT_STATE),
-                                             ARFLEX_HOST_TYPE(POSE), ARFLEX_HOST_TYPE(SAMPLE)};
-    static arflex_host_contract c;
+                                             ARFLEX_HOST_TYPE(POSE), ARFLEX_HOST_TYPE(SAMPLE),
+                                             ARFLEX_HOST_TYPE(TCP_CORRECTION_STATE)};
     char err[512];
-    r = arflex_host_load_contract(&c, contract_xml, types, 4, err, sizeof(err));
+    r = arflex_host_load_contract(&c, contract_xml, types, 5, err, sizeof(err));
     if (r < 0) {
       std::fprintf(stderr, "%s\n", err);
       return r;
@@ -174,6 +176,24 @@ struct Rig {
     arflex_host_destroy(&corr);
     arflex_host_destroy(&feeder);
     if (feeder2_made) arflex_host_destroy(&feeder2);
+  }
+
+  // Another half of tcp-correction (`inst`) bound to the feeder's reference and tcp_pose, with
+  // its corrected output open in `o`: READY, not started.
+  int Second(arflex_host* h, const char* inst, const char* exe, arflex_port* o) {
+    arflex_host_opts opts;
+    arflex_host_contract_opts(&c, rid, inst, &opts);
+    opts.config.priority = 0;
+    opts.config.hb_timeout_ns = 0;
+    opts.config.cfg_flags |= ARFLEX_CFG_NO_MLOCK | ARFLEX_CFG_NO_DMA_LATENCY;
+    int r = arflex_host_create(h, &opts);
+    if (r == 0) r = arflex_host_spawn(h, exe, nullptr, nullptr);
+    if (r == 0) r = arflex_host_wait_state(h, ARFLEX_STATE_READY, 10 * kSec);
+    const arflex_port_type t = {ARFLEX_TYPE_JOINT_REF_NAME, 1, 0, ARFLEX_TYPE_JOINT_REF_SIZE};
+    if (r == 0) r = arflex_port_open(o, arflex_host_output_name(h, "corrected"), false, false, ARFLEX_PORT_STATE, &t);
+    if (r == 0) r = arflex_host_bind(h, "reference", arflex_host_output_name(&feeder, "reference"), 2 * kSec);
+    if (r == 0) r = arflex_host_bind(h, "tcp_pose", arflex_host_output_name(&feeder, "tcp_pose"), 2 * kSec);
+    return r;
   }
 
   // Reads the newest output; checks that it never jumps. Returns true on a new value.
@@ -491,6 +511,50 @@ int RunCase(const std::string& name, const char* exe) {
     }
     rig.max_jump_excess = excess;  // the steps above are the references' own
   }
+  if (name == "adopt") {
+    // State transfer (D41): a second half told this one's state segment takes the correction
+    // over at its START: its first output is the old half's output, correction included (a
+    // fresh half starts without the correction: its output is the bare reference).
+    CHECK(arflex_host_state(&rig.corr) != nullptr, "the contract's state block has a segment");
+    CHECK(rig.Settle(50), "the correction did not come to rest");
+    const arflex_joint_ref old_out = rig.last;
+    static arflex_host next, fresh;
+    arflex_port nout{}, fout{};
+    int r = rig.Second(&next, "1-corr", exe, &nout);
+    if (r == 0) r = rig.Second(&fresh, "2-corr", exe, &fout);
+    bool ok = r == 0;
+    if (ok) ok = arflex_host_adopt(&next, arflex_host_state(&rig.corr)->name, 2 * kSec) == 0;
+    if (ok) ok = arflex_host_start(&next, 2 * kSec) == 0 && arflex_host_start(&fresh, 2 * kSec) == 0;
+    arflex_joint_ref nv{}, fv{};
+    const uint64_t deadline = arflex_sys_now_ns() + 10 * kSec;
+    bool got_n = false, got_f = false;
+    while (ok && !(got_n && got_f) && arflex_sys_now_ns() < deadline) {
+      got_n = got_n || arflex_state_read(&nout, &nv, sizeof(nv), nullptr) == 1;
+      got_f = got_f || arflex_state_read(&fout, &fv, sizeof(fv), nullptr) == 1;
+    }
+    double d_adopted = 0, d_fresh = 0, d_ref = 0;
+    for (int i = 0; i < 6; ++i) {
+      d_adopted = std::max(d_adopted, std::abs(nv.q[i] - old_out.q[i]));
+      d_fresh = std::max(d_fresh, std::abs(fv.q[i] - old_out.q[i]));
+      d_ref = std::max(d_ref, std::abs(fv.q[i] - kRef[i]));
+    }
+    printf("adopt: the adopting half's first output %.3g mrad from the old half's (seq %llu after %llu); a fresh "
+           "half's %.4f mrad (its output is the bare reference: %.3g mrad from it)\n", 1e3 * d_adopted,
+           (unsigned long long)nv.seq, (unsigned long long)old_out.seq, 1e3 * d_fresh, 1e3 * d_ref);
+    arflex_port_close(&nout);
+    arflex_port_close(&fout);
+    arflex_host_shutdown(&next, 5 * kSec);
+    arflex_host_shutdown(&fresh, 5 * kSec);
+    arflex_host_wait_exit(&next, 10 * kSec);
+    arflex_host_wait_exit(&fresh, 10 * kSec);
+    arflex_host_destroy(&next);
+    arflex_host_destroy(&fresh);
+    CHECK(ok && got_n && got_f, "second halves: r %d, outputs %d %d", r, got_n, got_f);
+    CHECK(d_adopted < 1e-12, "the adopting half's output is %.3g rad from the old half's", d_adopted);
+    CHECK(nv.seq > old_out.seq, "its seq continues the old half's (%llu, %llu)", (unsigned long long)nv.seq,
+          (unsigned long long)old_out.seq);
+    CHECK(d_fresh > 1e-5, "a fresh half's output only %.3g rad away: nothing to transfer", d_fresh);
+  }
   if (name == "hold") {
     // Vision drops out: invalid measurements far off are held, the output does not move.
     const arflex_joint_ref before = rig.last;
@@ -547,13 +611,13 @@ out:
 
 int main(int argc, char** argv) {
   if (argc != 4) {
-    std::fprintf(stderr, "usage: tcpcorr_comp_test <converge|hold|invalid|switch> <tcp-correction exe> <contract>\n");
+    std::fprintf(stderr, "usage: tcpcorr_comp_test <converge|hold|invalid|switch|adopt> <tcp-correction exe> <contract>\n");
     return 2;
   }
   contract_xml = argv[3];
   std::snprintf(rid, sizeof(rid), "tcc%d", static_cast<int>(getpid()));
   const std::string name = argv[1];
-  if (name != "converge" && name != "hold" && name != "invalid" && name != "switch") {
+  if (name != "converge" && name != "hold" && name != "invalid" && name != "switch" && name != "adopt") {
     std::fprintf(stderr, "tcpcorr_comp_test: unknown case '%s'\n", argv[1]);
     return 2;
   }

@@ -75,6 +75,14 @@ class CorrectionLaw {
   bool SetOptions(const CorrectionOptions& options);
   const CorrectionOptions& options() const { return options_; }
 
+  // Continues from a state another instance had (state transfer, docs/DECISIONS.md D41): its
+  // target and applied correction, last error and counters. The target is clipped to this
+  // law's max_correction, the applied
+  // correction ramps there at max_rate (it is not clipped: that would be a jump). False (nothing changed) when a value
+  // is not finite.
+  bool Restore(const Vector6d& target, const Vector6d& applied, const Vector6d& last_error,
+               long updates, long holds, bool enabled);
+
   const Vector6d& target() const { return target_; }
   const Vector6d& applied() const { return applied_; }
   const Vector6d& last_error() const { return last_error_; }

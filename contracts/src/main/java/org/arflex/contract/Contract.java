@@ -24,7 +24,9 @@ import java.util.Optional;
  * @param fault        restart and safe-output policy
  * @param update       where updates come from, if anywhere
  * @param source       where this contract was read from, for error messages
- * @param rollout      how a new version is shadowed, compared and switched in a change set (SPEC §12.1)
+ * @param state        the state block it hands to its next version at a change set's switch, if any
+ *                     (SPEC §12.1)
+ * @param rollout      how a new version is shadowed, compared and switched in a change set (SPEC §12.2)
  */
 public record Contract(
         String name,
@@ -42,22 +44,24 @@ public record Contract(
         FaultPolicy fault,
         Optional<UpdateSpec> update,
         String source,
+        Optional<StateSpec> state,
         Optional<RolloutSpec> rollout) {
 
     public Contract {
         attributes = Map.copyOf(attributes);
+        state = state == null ? Optional.empty() : state;
         rollout = rollout == null ? Optional.empty() : rollout;
         ports = List.copyOf(ports);
         properties = List.copyOf(properties);
     }
 
-    /** A contract without a {@code <rollout>} (SPEC §12.1). */
+    /** A contract without a state block (SPEC §12.1) and without a {@code <rollout>} (SPEC §12.2). */
     public Contract(String name, String version, String description, String executable, TaskType taskType,
                     boolean movesHardware, Map<String, String> attributes, List<PortSpec> ports,
                     List<PropertySpec> properties, Timing timing, Resources resources, int criticality,
                     FaultPolicy fault, Optional<UpdateSpec> update, String source) {
         this(name, version, description, executable, taskType, movesHardware, attributes, ports, properties, timing,
-                resources, criticality, fault, update, source, Optional.empty());
+                resources, criticality, fault, update, source, Optional.empty(), Optional.empty());
     }
 
     /** The inputs, in declaration order. */

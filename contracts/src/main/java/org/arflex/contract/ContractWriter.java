@@ -123,6 +123,27 @@ public final class ContractWriter {
                 w.writeAttribute("url", c.update().get().url().toString());
                 w.writeAttribute("sha256", c.update().get().sha256());
             }
+            if (c.state().isPresent()) {
+                StateSpec st = c.state().get();
+                nl(w, 1);
+                if (st.convertsFrom().isEmpty()) {
+                    w.writeEmptyElement("state");
+                } else {
+                    w.writeStartElement("state");
+                }
+                w.writeAttribute("type", st.type());
+                w.writeAttribute("typeVersion", st.typeVersion().toString());
+                for (StateSpec.From from : st.convertsFrom()) {
+                    nl(w, 2);
+                    w.writeEmptyElement("convertsFrom");
+                    w.writeAttribute("type", from.type());
+                    w.writeAttribute("typeVersion", from.typeVersion().toString());
+                }
+                if (!st.convertsFrom().isEmpty()) {
+                    nl(w, 1);
+                    w.writeEndElement();
+                }
+            }
             if (c.rollout().isPresent()) {
                 RolloutSpec r = c.rollout().get();
                 nl(w, 1);

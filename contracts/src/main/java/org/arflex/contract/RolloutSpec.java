@@ -5,7 +5,7 @@ import java.util.Objects;
 import java.util.OptionalLong;
 
 /**
- * How a new version of this component is taken into a running cell by a change set (SPEC §12.1,
+ * How a new version of this component is taken into a running cell by a change set (SPEC §12.2,
  * docs/DECISIONS.md D38, D42): a shadow run of {@code shadow} cycles on the running version's
  * inputs with its outputs not applied, compared with the running version's outputs field by
  * field within {@code tolerances}; then the switch, and a rollback window of {@code window}

@@ -49,6 +49,24 @@ class ContractParserTest {
     }
 
     @Test
+    void stateBlockIsReadWithItsConversionsAndSaysWhatItAdopts() throws Exception {
+        Contract c = PARSER.parse(resource("/good/state-block.xml"), "state-block.xml");
+        StateSpec st = c.state().orElseThrow();
+        assertEquals("arflex.TrajectoryState", st.type());
+        assertEquals(new TypeVersion(1, 0), st.typeVersion());
+        assertEquals(List.of(new StateSpec.From("arflex.TrajectoryState", new TypeVersion(0, 9)),
+                new StateSpec.From("arflex.JointRef", new TypeVersion(1, 0))), st.convertsFrom());
+        assertTrue(st.adopts("arflex.TrajectoryState", new TypeVersion(1, 0)));
+        assertTrue(st.adopts("arflex.TrajectoryState", new TypeVersion(1, 2)), "a later minor feeds 1.0 (SPEC 13.4)");
+        assertTrue(st.adopts("arflex.TrajectoryState", new TypeVersion(0, 9)), "declared conversion");
+        assertTrue(st.adopts("arflex.JointRef", new TypeVersion(1, 0)), "declared conversion of another type");
+        assertFalse(st.adopts("arflex.TrajectoryState", new TypeVersion(2, 0)), "another major, no conversion");
+        assertFalse(st.adopts("arflex.TcpCorrectionState", new TypeVersion(1, 0)), "another type, no conversion");
+        assertEquals(c, PARSER.parse(ContractWriter.create().write(c), "state-block.xml"), "the writer keeps it");
+        assertTrue(PARSER.parse(resource("/good/sample-scaler.xml"), "s.xml").state().isEmpty());
+    }
+
+    @Test
     void writerRoundTrips() throws Exception {
         Contract c = PARSER.parse(resource("/good/sample-scaler.xml"), "a.xml");
         String xml = ContractWriter.create().write(c);
@@ -271,7 +289,7 @@ class ContractParserTest {
         // a second tolerance of the same field is named
         ContractException e = assertThrows(ContractException.class, () -> PARSER.parse(resource("/good/rollout.xml")
                 .replace("<envelope", "<tolerance port=\"y\" field=\"value\" abs=\"2\"/><envelope"), "r.xml"));
-        assertTrue(e.getMessage().contains("[§12.1] rollout/tolerance[y.value]: a second tolerance for y.value"),
+        assertTrue(e.getMessage().contains("[§12.2] rollout/tolerance[y.value]: a second tolerance for y.value"),
                 e.getMessage());
     }
 }

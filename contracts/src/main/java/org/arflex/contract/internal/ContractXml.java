@@ -24,6 +24,7 @@ public final class ContractXml extends Located {
     public Text criticality;
     public Fault fault;
     public Update update;
+    public StateXml state;
     public Rollout rollout;
 
     @JsonSetter("description") void description(Text t) { once(description, "description"); description = t; }
@@ -36,6 +37,7 @@ public final class ContractXml extends Located {
     @JsonSetter("criticality") void criticality(Text v) { once(criticality, "criticality"); criticality = v; }
     @JsonSetter("fault") void fault(Fault v) { once(fault, "fault"); fault = v; }
     @JsonSetter("update") void update(Update v) { once(update, "update"); update = v; }
+    @JsonSetter("state") void state(StateXml v) { once(state, "state"); state = v; }
     @JsonSetter("rollout") void rollout(Rollout v) { once(rollout, "rollout"); rollout = v; }
 
     /** {@code <implementation>}. */
@@ -141,7 +143,22 @@ public final class ContractXml extends Located {
         @JacksonXmlProperty(isAttribute = true) public String sha256;
     }
 
-    /** {@code <rollout shadow window>} with its tolerances and envelopes (SPEC §12.1). */
+    /** {@code <state type typeVersion>} with {@code <convertsFrom type typeVersion/>} children (SPEC §12.1). */
+    public static final class StateXml extends Located {
+        @JacksonXmlProperty(isAttribute = true) public String type;
+        @JacksonXmlProperty(isAttribute = true) public String typeVersion;
+        public final List<From> convertsFrom = new ArrayList<>();
+
+        @JsonSetter("convertsFrom") void convertsFrom(From f) { convertsFrom.add(f); }
+    }
+
+    /** {@code <convertsFrom type typeVersion/>}. */
+    public static final class From extends Located {
+        @JacksonXmlProperty(isAttribute = true) public String type;
+        @JacksonXmlProperty(isAttribute = true) public String typeVersion;
+    }
+
+    /** {@code <rollout shadow window>} with its tolerances and envelopes (SPEC §12.2). */
     public static final class Rollout extends Located {
         @JacksonXmlProperty(isAttribute = true) public String shadow;
         @JacksonXmlProperty(isAttribute = true) public String window;

@@ -3,5 +3,5 @@
  * reading and writing the same little-endian bytes as the generated C headers.
  */
 @org.osgi.annotation.bundle.Export
-@org.osgi.annotation.versioning.Version("0.1.0")
+@org.osgi.annotation.versioning.Version("0.2.0")
 package org.arflex.contract.types;

@@ -19,7 +19,7 @@ public final class Layout {
 
     // ---- control.h
     public static final int ABI_MAJOR = 1;
-    public static final int ABI_MINOR = 2;
+    public static final int ABI_MINOR = 3;
     public static final long CTL_MAGIC = 0x4c5443584c465241L;
     public static final int CTL_SIZE = 40960;
     public static final int ID_MAX = 40;
@@ -212,6 +212,7 @@ public final class Layout {
     public static final int CMD_RESET = 9;
     public static final int CMD_SHUTDOWN = 10;
     public static final int CMD_PING = 11;
+    public static final int CMD_ADOPT = 12;
 
     // struct arflex_msg
     public static final int SIZEOF_MSG = 512;

@@ -62,7 +62,7 @@ public final class Mailbox implements AutoCloseable {
         START(Layout.CMD_START), STOP(Layout.CMD_STOP), SET_PARAM(Layout.CMD_SET_PARAM),
         GET_PARAM(Layout.CMD_GET_PARAM), BIND(Layout.CMD_BIND), UNBIND(Layout.CMD_UNBIND),
         GET_STATE(Layout.CMD_GET_STATE), GET_STATS(Layout.CMD_GET_STATS), RESET(Layout.CMD_RESET),
-        SHUTDOWN(Layout.CMD_SHUTDOWN), PING(Layout.CMD_PING);
+        SHUTDOWN(Layout.CMD_SHUTDOWN), PING(Layout.CMD_PING), ADOPT(Layout.CMD_ADOPT);
 
         public final int code;
 
@@ -151,6 +151,14 @@ public final class Mailbox implements AutoCloseable {
             }
             b.putInt(OFF_PAYLOAD_LEN, BIND_SIZE);
         };
+    }
+
+    /**
+     * ADOPT (ABI 1.3, D41): the half takes the newest value of the state segment {@code shmName}
+     * (the half it replaces) over at its next START.
+     */
+    public Reply adopt(String shmName, long timeoutMs) throws IOException {
+        return call(Cmd.ADOPT, bindPayload("", shmName), timeoutMs);
     }
 
     /** UNBIND of input {@code port}. */

@@ -159,7 +159,7 @@ public final class ChangeSet {
     /**
      * An update whose window, shadow run, envelopes and tolerances are those given
      * ({@code window}, {@code shadow}: null when not given; envelopes and tolerances by
-     * port.field) over the new version's {@code <rollout>} (contract SPEC §12.1) over the
+     * port.field) over the new version's {@code <rollout>} (contract SPEC §12.2) over the
      * defaults: no shadow run, a window of {@code defaultWindow} cycles (D42).
      */
     public static Update rules(String component, org.arflex.contract.Contract contract, Path exe, String from,

@@ -238,7 +238,12 @@ final class ChangeSetExecutor {
             return "'" + n + "' has no running RT half to update (" + inst.life.state() + "); install or update it "
                     + "outside a change set";
         }
-        if (inst.contract.movesHardware() || u.contract().movesHardware()) {
+        String state = StateTransfer.problem(inst.contract, u.contract());
+        if (state != null) {
+            return state;
+        }
+        if ((inst.contract.movesHardware() || u.contract().movesHardware())
+                && !StateTransfer.continuesMotion(inst.contract, u.contract())) {
             return "'" + n + "' moves hardware: its new half would drive it beside the old one; update it outside a "
                     + "change set";
         }
@@ -383,6 +388,7 @@ final class ChangeSetExecutor {
                     break;
                 }
                 starter.prepare(inst, plan.cpuAssignment().getOrDefault(inst.name, -1),
+                        nexts.get(inst.name) == inst ? StateTransfer.source(cell.find(inst.name), inst) : null,
                         (half, error, took) -> ready(inst, half, error, took));
             }
         }
@@ -397,6 +403,9 @@ final class ChangeSetExecutor {
                 return;
             }
             if (error != null || half == null) {
+                if (half != null) {
+                    prepared.put(inst, half); // READY but its ADOPT refused (D41): stopped with the rest
+                }
                 tearDown("preparing '" + inst.name + "': " + (error == null ? "no RT half" : error.getMessage()));
                 return;
             }

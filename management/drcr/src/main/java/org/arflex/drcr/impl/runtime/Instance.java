@@ -52,6 +52,8 @@ public final class Instance {
     final Map<String, RtLauncher.Output> evaluationOutputs = new LinkedHashMap<>();
     /** Read-only copy of {@link #evaluationOutputs}' names for snapshots: port -> shm name. */
     volatile Map<String, String> evaluationSegments = Map.of();
+    /** The state block's segment ({@link StateTransfer}, D41), when the contract declares one. */
+    RtLauncher.Output stateSegment;
     /** Input port -> provider segment it is bound to. */
     final Map<String, String> bound = new TreeMap<>();
     /** Configured value bits per parameter (contract order). */

@@ -71,6 +71,7 @@ final class Segments {
                     t.version().major(), t.version().minor(), elem, Math.max(1, p.depth()), overflow));
         }
         evaluation.ensure(inst, objectName(inst.objectId, EvaluationSegments.PORT));
+        StateTransfer.ensure(launcher, types, runtimeId, inst);
     }
 
     /** Closes (unlinks) every segment of the instance. */
@@ -80,5 +81,6 @@ final class Segments {
         }
         inst.outputs.clear();
         EvaluationSegments.close(inst);
+        StateTransfer.close(inst);
     }
 }

@@ -8,7 +8,7 @@ import org.arflex.contract.RolloutSpec;
 
 /**
  * The shadow run's rules of an update (D42): checked when the set is planned, and merged from
- * the new version's contract ({@code <rollout>}, SPEC §12.1) with what the command line gives.
+ * the new version's contract ({@code <rollout>}, SPEC §12.2) with what the command line gives.
  */
 final class ShadowRules {
 

@@ -148,7 +148,8 @@ final class Starter {
         done.forEach(f -> f.complete(null));
     }
 
-    /** Where a change set's launch reports (actor thread): the READY half, or why there is none. */
+    /** Where a change set's launch reports (actor thread): the READY half, or why there is none
+     *  (with a half too when the half is READY but its ADOPT was refused). */
     interface Prepared {
         void ready(RtHalf half, Exception error, long spawnToReadyNs);
     }
@@ -162,6 +163,16 @@ final class Starter {
      * {@link #idle()} completes only after {@code done} ran.
      */
     void prepare(Instance inst, int cpu, Prepared done) {
+        prepare(inst, cpu, null, done);
+    }
+
+    /**
+     * As {@link #prepare(Instance, int, Prepared)}; with {@code adoptFrom} not null the READY
+     * half is also told, on the launch thread, the state segment it adopts at its START (D41,
+     * {@link StateTransfer}); a refused ADOPT reports the READY half together with the error,
+     * for the caller to stop with whatever else it prepared.
+     */
+    void prepare(Instance inst, int cpu, String adoptFrom, Prepared done) {
         Contract c = inst.contract;
         RtLauncher.Spec spec;
         try {
@@ -184,6 +195,13 @@ final class Starter {
             Exception error = null;
             try {
                 half = launcher.launch(spec);
+                if (adoptFrom != null) {
+                    try {
+                        half.adopt(adoptFrom);
+                    } catch (IOException | RuntimeException e) { // READY, but not with the state it continues
+                        error = new IOException("its state block: " + e.getMessage(), e);
+                    }
+                }
             } catch (IOException | RuntimeException e) {
                 error = e;
             }

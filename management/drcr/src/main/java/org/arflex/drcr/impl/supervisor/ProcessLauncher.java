@@ -319,6 +319,15 @@ public final class ProcessLauncher implements RtLauncher {
         }
 
         @Override
+        public void adopt(String stateSegment) throws IOException {
+            Mailbox.Reply r = mb.adopt(stateSegment, CALL_TIMEOUT_MS);
+            if (r.status() != 0) {
+                throw new IOException("ADOPT of " + stateSegment + " refused by " + inst + ": status " + r.status()
+                        + (r.status() == -95 ? " (EOPNOTSUPP: its executable has no adopt hook)" : ""));
+            }
+        }
+
+        @Override
         public CompletableFuture<Void> rebind(String port, String segment, long waitMs) {
             Mailbox.Cmd c = segment != null ? Mailbox.Cmd.BIND : Mailbox.Cmd.UNBIND;
             String what = c + " " + inst + "." + port + (segment != null ? " to " + segment : "");

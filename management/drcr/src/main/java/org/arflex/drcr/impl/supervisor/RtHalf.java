@@ -24,6 +24,14 @@ public interface RtHalf {
     void unbind(String port) throws IOException;
 
     /**
+     * ADOPT (D41): before START, names the state segment of the half this one replaces; the
+     * RT half takes its newest value over at START. Refused by a half that cannot adopt.
+     */
+    default void adopt(String stateSegment) throws IOException {
+        throw new IOException("this RT half cannot adopt a state block");
+    }
+
+    /**
      * BIND ({@code segment} not null) or UNBIND of input {@code port} of a running half, waiting
      * at most {@code waitMs} for its answer (D39: the actor does not wait on a process). The
      * stage completes when the half has answered; exceptionally when it refused, did not answer

@@ -23,6 +23,8 @@ final class FakeLauncher implements RtLauncher {
     final Map<String, String> damaged = new HashMap<>();
     /** Segment name -> the newest value's payload its output reports (tests set it; none: never written). */
     final Map<String, byte[]> values = new java.util.concurrent.ConcurrentHashMap<>();
+    /** Instance id -> why its ADOPT is refused (tests set it). */
+    final Map<String, String> refuseAdopt = new java.util.concurrent.ConcurrentHashMap<>();
     /** Instances whose next launches fail. */
     final Map<String, Integer> failLaunches = new java.util.concurrent.ConcurrentHashMap<>();
     private final java.util.concurrent.atomic.AtomicLong nextPid = new java.util.concurrent.atomic.AtomicLong(1000);
@@ -72,6 +74,15 @@ final class FakeLauncher implements RtLauncher {
         @Override
         public void unbind(String port) {
             events.add(inst + " UNBIND " + port);
+        }
+
+        @Override
+        public void adopt(String stateSegment) throws IOException {
+            String why = refuseAdopt.get(inst);
+            events.add(inst + " ADOPT " + stateSegment + (why != null ? " (refused)" : ""));
+            if (why != null) {
+                throw new IOException(why);
+            }
         }
 
         /** When set, a running rebind is answered by what this returns (a test holds it open). */

@@ -1,0 +1,185 @@
+package org.arflex.drcr.impl.runtime;
+
+import static org.junit.jupiter.api.Assertions.assertEquals;
+import static org.junit.jupiter.api.Assertions.assertFalse;
+import static org.junit.jupiter.api.Assertions.assertTrue;
+
+import java.nio.file.Path;
+import java.util.concurrent.CompletableFuture;
+import org.arflex.contract.Contract;
+import org.arflex.contract.ContractParser;
+import org.arflex.contract.PortTypes;
+import org.arflex.drcr.impl.abi.ControlBlock;
+import org.arflex.drcr.impl.lifecycle.ManualActor;
+import org.arflex.drcr.impl.lifecycle.State;
+import org.junit.jupiter.api.AfterEach;
+import org.junit.jupiter.api.Test;
+
+/**
+ * State transfer in a change set's update (D41): a contract's state block has a segment beside
+ * the half's outputs; the new version is told the old half's segment (ADOPT) after READY and
+ * before START; a new version that does not adopt the running one's state block is refused by
+ * the plan naming both, before anything is launched; a refused ADOPT tears the set down; a
+ * rollback hands nothing back (the old half never stopped). Steppable actor, fake halves.
+ */
+class CellStateTransferTest {
+
+    private static final String IN_SRC = "<in name=\"x\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\">"
+            + "<bind filter=\"(role=src)\"/></in>";
+    private static final String OUT = "<out name=\"y\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\"/>";
+    private static final String IN_STAGE = "<in name=\"x\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\">"
+            + "<bind filter=\"(role=stage)\"/></in>";
+    private static final String TRAJ = "<state type=\"arflex.TrajectoryState\" typeVersion=\"1.0\"/>";
+    private static final String TCP = "<state type=\"arflex.TcpCorrectionState\" typeVersion=\"1.0\"/>";
+    private static final String TCP_FROM_TRAJ = "<state type=\"arflex.TcpCorrectionState\" typeVersion=\"1.0\">"
+            + "<convertsFrom type=\"arflex.TrajectoryState\" typeVersion=\"1.0\"/></state>";
+
+    private final FakeLauncher fake = new FakeLauncher();
+    private final SteppedCell rig = new SteppedCell(fake, fake, true);
+    private final ManualActor actor = rig.actor;
+    private final Cell cell = rig.cell;
+
+    @AfterEach
+    void nothingLeaks() {
+        rig.close(); // fails on any half or segment (state segments included) left behind
+    }
+
+    private static Contract parse(String name, String role, String ports, String version, String state)
+            throws Exception {
+        String xml = CellChangeSetTest.contract(name, role, ports, "50us")
+                .replace("version=\"1.0.0\"", "version=\"" + version + "\"")
+                .replace("</component>", state + "</component>");
+        return ContractParser.create(PortTypes.builtin()).parse(xml, "test.xml");
+    }
+
+    private void install(Contract c) {
+        assertTrue(actor.call(() -> cell.install(c, c.name().hashCode(), Path.of("/nonexistent/" + c.name())), 0),
+                rig.log::toString);
+        rig.stepUntil(c.name() + " ACTIVE", () -> rig.state(c.name()) == State.ACTIVE);
+    }
+
+    private void runningCell(String stageState) throws Exception {
+        install(parse("src", "src", OUT, "1.0.0", ""));
+        install(parse("stage", "stage", IN_SRC + OUT, "1.0.0", stageState));
+        install(parse("user", null, IN_STAGE, "1.0.0", ""));
+    }
+
+    private ChangeSet update(String state) throws Exception {
+        return ChangeSet.builder().update("stage", parse("stage", "stage", IN_SRC + OUT, "1.1.0", state),
+                Path.of("/nonexistent/stage-1.1"), "file:/x/stage-1.1.jar", 100).build();
+    }
+
+    private ChangeSetResult apply(ChangeSet set) {
+        CompletableFuture<ChangeSetResult> f = actor.call(() -> cell.applyChangeSet(set), 0);
+        rig.stepUntil("the change set's outcome", f::isDone);
+        return f.join();
+    }
+
+    private int index(String event) {
+        int i = fake.events.indexOf(event);
+        assertTrue(i >= 0, "no event '" + event + "' in " + fake.events);
+        return i;
+    }
+
+    private void watch() {
+        actor.advance(ChangeSetExecutor.WATCH_MS);
+        actor.runAll();
+    }
+
+    @Test
+    void theNewVersionIsToldTheOldHalfsStateSegmentBeforeItsStart() throws Exception {
+        runningCell(TRAJ);
+        assertTrue(fake.openOutputs.containsKey("/arflex.t.stage.state"), fake.openOutputs::toString);
+        assertTrue(fake.events.stream().anyMatch(e -> e.startsWith("CREATE /arflex.t.stage.state arflex.TrajectoryState ")),
+                fake.events::toString);
+        ChangeSetResult r = apply(update(TRAJ));
+        assertTrue(r.applied(), r.text());
+        int launched = index("1-stage LAUNCH");
+        int adopt = index("1-stage ADOPT /arflex.t.stage.state");
+        int started = index("1-stage START");
+        int moved = index("user BIND x /arflex.t.1-stage.out.y");
+        assertTrue(launched < adopt && adopt < started && started < moved, fake.events.toString());
+        assertTrue(fake.openOutputs.containsKey("/arflex.t.1-stage.state"), "the new half publishes its own");
+        assertTrue(fake.openOutputs.containsKey("/arflex.t.stage.state"), "the old half still publishes in the window");
+        fake.running.get("1-stage").stats = new ControlBlock.Stats(100, 0, 0, 0, 0, 0, 0, 0, 0, 0);
+        watch();
+        rig.stepUntil("the verdict", () -> r.verdict().isDone());
+        assertTrue(r.verdict().join().startsWith("update stage: committed"), r.verdict().join());
+        rig.stepUntil("the old state segment gone with the old half", () -> !fake.running.containsKey("stage")
+                && !fake.openOutputs.containsKey("/arflex.t.stage.state"));
+    }
+
+    @Test
+    void aDeclaredConversionIsAdmittedAndAdopts() throws Exception {
+        runningCell(TRAJ);
+        ChangeSetResult r = apply(update(TCP_FROM_TRAJ));
+        assertTrue(r.applied(), r.text());
+        index("1-stage ADOPT /arflex.t.stage.state");
+        fake.running.get("1-stage").stats = new ControlBlock.Stats(100, 0, 0, 0, 0, 0, 0, 0, 0, 0);
+        watch();
+        rig.stepUntil("the verdict", () -> r.verdict().isDone());
+    }
+
+    @Test
+    void aNewVersionWithAnotherStateTypeOrNoneIsRefusedByThePlanNamingBoth() throws Exception {
+        runningCell(TRAJ);
+        int before = fake.events.size();
+        ChangeSetResult other = apply(update(TCP));
+        assertFalse(other.applied());
+        assertTrue(other.refusal().contains("update stage file:/x/stage-1.1.jar: state block: the running version 1.0.0 "
+                + "hands over arflex.TrajectoryState 1.0, the new version 1.1.0 takes arflex.TcpCorrectionState 1.0 and "
+                + "declares no conversion from arflex.TrajectoryState 1.0"), other.text());
+        ChangeSetResult none = apply(update(""));
+        assertFalse(none.applied());
+        assertTrue(none.refusal().contains("state block: the running version 1.0.0 hands over arflex.TrajectoryState "
+                + "1.0, the new version 1.1.0 declares no state and would start from nothing"), none.text());
+        assertEquals(before, fake.events.size(), "nothing launched, created or bound: " + fake.events);
+        assertEquals("1.0.0", cell.instance("stage").orElseThrow().contract().version());
+    }
+
+    @Test
+    void aVersionWithoutStateGetsNoAdoptAndAStatelessOneMayGainAState() throws Exception {
+        runningCell("");
+        assertFalse(fake.openOutputs.keySet().stream().anyMatch(n -> n.endsWith(".state")), fake.openOutputs::toString);
+        ChangeSetResult r = apply(update(TRAJ));
+        assertTrue(r.applied(), r.text());
+        assertTrue(fake.events.stream().noneMatch(e -> e.contains(" ADOPT ")), "nothing to adopt: " + fake.events);
+        assertTrue(fake.openOutputs.containsKey("/arflex.t.1-stage.state"));
+        fake.running.get("1-stage").stats = new ControlBlock.Stats(100, 0, 0, 0, 0, 0, 0, 0, 0, 0);
+        watch();
+        rig.stepUntil("the verdict", () -> r.verdict().isDone());
+    }
+
+    @Test
+    void aRefusedAdoptTearsTheSetDownAndLeavesTheOldHalf() throws Exception {
+        runningCell(TRAJ);
+        FakeLauncher.FakeHalf old = fake.running.get("stage");
+        fake.refuseAdopt.put("1-stage", "ADOPT refused by 1-stage: status -95");
+        ChangeSetResult r = apply(update(TRAJ));
+        assertFalse(r.applied());
+        assertTrue(r.refusal().startsWith("preparation failed, nothing changed: preparing 'stage': its state block: "
+                + "ADOPT refused by 1-stage: status -95"), r.text());
+        rig.stepUntil("the refused half stopped and its segments gone", () -> !fake.running.containsKey("1-stage")
+                && fake.openOutputs.keySet().stream().noneMatch(n -> n.contains(".1-stage.")));
+        assertTrue(fake.events.stream().noneMatch(e -> e.equals("1-stage START")), fake.events::toString);
+        assertEquals(old, fake.running.get("stage"));
+        assertTrue(fake.events.stream().noneMatch(e -> e.startsWith("user BIND x /arflex.t.1-stage")), fake.events::toString);
+    }
+
+    @Test
+    void aRollbackHandsNothingBackTheOldHalfKeptPublishing() throws Exception {
+        runningCell(TRAJ);
+        FakeLauncher.FakeHalf old = fake.running.get("stage");
+        ChangeSetResult r = apply(update(TRAJ));
+        assertTrue(r.applied(), r.text());
+        int mark = fake.events.size();
+        fake.running.get("1-stage").crash(139, "killed by signal 11");
+        rig.stepUntil("the verdict", () -> r.verdict().isDone());
+        assertTrue(r.verdict().join().contains("rolled back"), r.verdict().join());
+        assertEquals(old.pid, cell.instance("stage").orElseThrow().half.pid());
+        assertTrue(fake.openOutputs.containsKey("/arflex.t.stage.state"), "the old half's state segment stays");
+        rig.stepUntil("the new state segment gone", () -> !fake.openOutputs.containsKey("/arflex.t.1-stage.state"));
+        assertTrue(fake.events.subList(mark, fake.events.size()).stream().noneMatch(e -> e.contains(" ADOPT ")),
+                "nothing is handed back: " + fake.events);
+    }
+}
