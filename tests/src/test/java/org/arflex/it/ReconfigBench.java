@@ -234,7 +234,7 @@ class ReconfigBench {
             c.operator().tick();
             return "ACTIVE".equals(rt.state("sim-robot")) && "ACTIVE".equals(rt.state("force-guard"))
                     && "ACTIVE".equals(rt.state("tcp-correction")) && "ACTIVE".equals(rt.state(source))
-                    && Runtime.rtProcesses(rt.rid).stream().filter(p -> p.matches(".*--instance (\\d+-)?tcp-correction"))
+                    && Runtime.rtProcesses(rt.rid).stream().filter(p -> p.matches(".*--instance (\\d+-)?tcp-correction "))
                             .count() == 1
                     && (source.equals("teach") || FailSafeIT.moving(c.js()));
         });
@@ -288,8 +288,12 @@ class ReconfigBench {
                 ok = out.contains("rolled back after ");
                 note = out.lines().filter(l -> l.contains("update tcp-correction:")).findFirst().orElse("no verdict");
             } else if (update) {
-                ok = out.contains("committed: ");
+                // a good version is committed; the window's overrun criterion (D38: more overruns
+                // and deadline misses than the old half's plus 2) may also roll it back on this
+                // loaded machine: measured and counted (a spurious rollback), not a failure
                 note = out.lines().filter(l -> l.contains("update tcp-correction:")).findFirst().orElse("no verdict");
+                ok = out.contains("committed: ") || (out.contains("rolled back after ")
+                        && out.contains("overran or missed its deadline"));
             } else {
                 String to = toTrajectory ? "trajectory" : "teach";
                 ok = CellRig.armFollows(rt, to);
@@ -417,6 +421,11 @@ class ReconfigBench {
         long perSet = rows.stream().mapToLong(r -> r.excess(rate)).sum();
         long longestRun = rows.stream().mapToLong(Row::longest).max().orElse(0);
         long x = rows.stream().filter(Row::safeStop).count();
+        List<Row> spurious = rows.stream().filter(r -> !r.example().contains("faulty") && r.note().contains("rolled back"))
+                .toList();
+        System.out.printf(Locale.ROOT, "reconfig: good versions rolled back by the window's overrun criterion: %d of %d "
+                + "updates%s%n", spurious.size(), rows.stream().filter(r -> r.example().startsWith("tcp-correction")).count(),
+                spurious.stream().map(r -> "\nreconfig:   " + r.example() + " #" + r.rep() + ": " + r.note()).reduce("", String::concat));
         long resets = rows.stream().mapToLong(Row::resets).sum();
         long restarts = rows.stream().mapToLong(Row::restarts).sum();
         double j = rows.stream().mapToDouble(Row::jump).max().orElse(0);
@@ -436,8 +445,8 @@ class ReconfigBench {
         Files.writeString(out, String.format(Locale.ROOT, "{\"sets\":%d,\"missed_cycles\":%d,\"safe_stops\":%d,"
                 + "\"resets\":%d,\"restarts\":%d,\"max_jump_rad\":%.6g,\"jump_bound_rad\":%.6g,\"quiet_releases\":%d,"
                 + "\"quiet_missed\":%d,\"switch_releases\":%d,\"switch_missed\":%d,\"missed_per_set_floored_sum\":%d,"
-                + "\"rows\":[\n%s]}%n", rows.size(), m, x,
-                resets, restarts, j, ChangeSetIT.JUMP_BOUND, qr, qm, releases, missedRaw, perSet, sb));
+                + "\"spurious_rollbacks\":%d,\"rows\":[\n%s]}%n", rows.size(), m, x,
+                resets, restarts, j, ChangeSetIT.JUMP_BOUND, qr, qm, releases, missedRaw, perSet, spurious.size(), sb));
         System.out.println("JSON: " + out.toAbsolutePath());
         System.out.printf(Locale.ROOT, "reconfig: %d sets, missed cycles %d, safe stops %d, resets %d, max jump %.6f rad%n",
                 rows.size(), m, x, resets, j);

@@ -79,6 +79,8 @@ class VisionChangeSetIT {
             long trajPid = rt.pid("trajectory");
             long corrPid = rt.pid("tcp-correction");
             long visionPid = rt.pid("vision");
+            assertTrue(Runtime.rtProcesses(rt.rid).stream().anyMatch(p -> p.contains("--instance vision ")),
+                    "vision's process is seen before the update");
             CellRig.Trace<CellRig.Ref> ref = new CellRig.Trace<>();
             CellRig.Trace<CellRig.JointState> js = new CellRig.Trace<>();
             CellRig.Trace<CellRig.Safety> safety = new CellRig.Trace<>();
@@ -136,7 +138,7 @@ class VisionChangeSetIT {
             assertNotEquals(visionPid, rt.pid("vision"), "the new version runs");
             assertTrue(rt.cmd("arflex:info vision").contains("1.0.1"), rt.cmd("arflex:info vision"));
             rt.waitUntil("the old version's process and segment gone", T, () -> Runtime.rtProcesses(rt.rid).stream()
-                    .noneMatch(p -> p.endsWith("--instance vision")) && !Files.exists(rt.segment("vision", "tcp_pose")));
+                    .noneMatch(p -> p.contains("--instance vision ")) && !Files.exists(rt.segment("vision", "tcp_pose")));
         }
     }
 }
