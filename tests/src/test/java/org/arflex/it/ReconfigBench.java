@@ -60,17 +60,18 @@ class ReconfigBench {
     record Row(String example, int rep, boolean ok, String note, double prepMs, double switchMs, double cmdMs,
                long quietReleases, long quietMissed, long releases, long missed, long longest,
                CellChurnBench.Tally quiet, CellChurnBench.Tally window, double jump, double jumpBefore,
-               boolean safeStop, long safeCycles, double force, int resets, long restarts, String gaps) {
+               boolean safeStop, long safeCycles, double force, int resets, long restarts, String gaps,
+               long missedInCommand) {
         String json(double rate) {
             return String.format(Locale.ROOT, "{\"example\":\"%s\",\"rep\":%d,\"ok\":%b,\"note\":\"%s\",\"prepare_ms\":%s,"
                     + "\"switch_turn_ms\":%s,\"command_ms\":%.1f,\"quiet_releases\":%d,\"quiet_missed\":%d,"
                     + "\"releases\":%d,\"missed\":%d,\"longest_missed_run\":%d,\"expected_missed\":%.2f,"
                     + "\"missed_in_excess\":%d,\"quiet\":%s,\"switch\":%s,\"max_jump_rad\":%.6g,"
                     + "\"max_step_before_rad\":%.6g,\"safe_stop\":%b,\"safe_cycles\":%d,\"max_force_n\":%.1f,"
-                    + "\"resets\":%d,\"restarts\":%d,\"not_run_at_ms\":\"%s\"}", example, rep, ok, note.replace("\\", "\\\\").replace("\"", "'"),
+                    + "\"resets\":%d,\"restarts\":%d,\"not_run_at_ms\":\"%s\",\"not_run_in_command\":%d}", example, rep, ok, note.replace("\\", "\\\\").replace("\"", "'"),
                     num(prepMs), num(switchMs), cmdMs, quietReleases, quietMissed, releases, missed, longest,
                     rate * releases, excess(rate), quiet.json(), window.json(), jump, jumpBefore, safeStop, safeCycles,
-                    force, resets, restarts, gaps);
+                    force, resets, restarts, gaps, missedInCommand);
         }
 
         long excess(double rate) {
@@ -186,6 +187,20 @@ class ReconfigBench {
             }
         }
         return sb.toString();
+    }
+
+    /** Releases not run whose gap began while the command ran (from {@code t0} to {@code t1}, System.nanoTime). */
+    static long inCommand(List<CellRig.JointState> js, long t0, long t1) {
+        long n = 0;
+        for (int i = 1; i < js.size(); i++) {
+            CellRig.JointState a = js.get(i - 1);
+            CellRig.JointState b = js.get(i);
+            long skipped = Math.round((b.tNs() - a.tNs()) / 1e6) - (b.seq() - a.seq());
+            if (skipped != 0 && a.tNs() >= t0 && a.tNs() <= t1) {
+                n += skipped;
+            }
+        }
+        return n;
     }
 
     static long releases(List<CellRig.JointState> js) {
@@ -351,7 +366,7 @@ class ReconfigBench {
             return new Row(example, rep, ok, note, applied ? Double.parseDouble(m.group(1)) : Double.NaN,
                     applied ? Double.parseDouble(m.group(2)) : Double.NaN, cmdMs, releases(qjs), qs[0], releases(wjs),
                     ws[0], ws[1], quiet, window, jump, before, safeStop, safe1 - safe0, force, resets,
-                    restarts(rt) - restarts0, gaps);
+                    restarts(rt) - restarts0, gaps, inCommand(wjs, a0, aRet));
         } finally {
             if (np != null) {
                 np.close();
@@ -421,6 +436,11 @@ class ReconfigBench {
         long perSet = rows.stream().mapToLong(r -> r.excess(rate)).sum();
         long longestRun = rows.stream().mapToLong(Row::longest).max().orElse(0);
         long x = rows.stream().filter(Row::safeStop).count();
+        long inCmd = rows.stream().mapToLong(Row::missedInCommand).sum();
+        double cmdMs = rows.stream().mapToDouble(Row::cmdMs).sum();
+        System.out.printf(Locale.ROOT, "reconfig: while the commands ran (%.1f s in all): %d releases not run, the quiet "
+                + "windows' rate predicts %.1f; after they returned (%.1f s): %d, predicted %.1f%n", cmdMs / 1e3, inCmd,
+                rate * cmdMs, (releases - cmdMs) / 1e3, missedRaw - inCmd, rate * (releases - cmdMs));
         List<Row> spurious = rows.stream().filter(r -> !r.example().contains("faulty") && r.note().contains("rolled back"))
                 .toList();
         System.out.printf(Locale.ROOT, "reconfig: good versions rolled back by the window's overrun criterion: %d of %d "
