@@ -374,7 +374,12 @@ final class Runtime implements AutoCloseable {
         return l;
     }
 
-    /** Processes (anywhere) started for this runtime id. */
+    /**
+     * Processes (anywhere) started for this runtime id: "pid: command line ", every argument
+     * followed by a space, so {@code contains("--instance " + name + " ")} matches that whole
+     * instance name (the launcher passes {@code --instance} last: trimmed, such a check never
+     * matched and "no process of X" held vacuously).
+     */
     static List<String> rtProcesses(String rid) throws IOException {
         List<String> l = new ArrayList<>();
         try (DirectoryStream<Path> ds = Files.newDirectoryStream(Path.of("/proc"))) {
@@ -385,7 +390,7 @@ final class Runtime implements AutoCloseable {
                 try {
                     String cl = new String(Files.readAllBytes(p.resolve("cmdline")), StandardCharsets.UTF_8).replace('\0', ' ');
                     if (cl.contains("--runtime " + rid + " ")) {
-                        l.add(p.getFileName() + ": " + cl.trim());
+                        l.add(p.getFileName() + ": " + cl.strip() + " ");
                     }
                 } catch (IOException ignored) {
                     // process ended while we looked

@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Reconfiguration of the moving cell (./arflex bench reconfig [--sets N] [--mlock]): issue #19's change sets
+# on the moving simulated arm, each example N times (3) in one runtime: teach replaces trajectory
+# and trajectory replaces teach again, tcp-correction updated to 1.0.1 and back to 1.0.0, a faulty
+# version (SIGSEGV 250 ms after its spawn) rolled back. Per set: preparation time, the switch's
+# actor turn, sim-robot's latency and overruns around the switch against a quiet window before it,
+# released cycles it did not run (against the quiet windows' rate), the largest step of the robot's
+# reference per source cycle, safe stops, operator resets. Prints a table, writes
+# target/bench/reconfig.json; the last line is "reconfig: S sets, missed cycles M, safe stops X,
+# resets R, max jump J rad". --mlock: the RT halves lock their memory (mlockall, as outside the
+# tests; the tests' runtime passes arflex.nomlock). docs/DECISIONS.md D40, docs/reconfig.md. Needs the build of ./arflex test or ./arflex run.
+set -euo pipefail
+ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
+cd "$ROOT"
+sets=3
+mlock=false
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --sets) sets="${2:?--sets needs a number}"; shift 2 ;;
+    --mlock) mlock=true; shift ;;
+    *) echo "arflex bench reconfig: unknown option '$1' (--sets N, --mlock)" >&2; exit 2 ;;
+  esac
+done
+[[ "$sets" =~ ^[1-9][0-9]*$ ]] || { echo "arflex bench reconfig: --sets '$sets' is not a whole number above 0" >&2; exit 2; }
+log=$(mktemp)
+trap 'rm -f "$log"' EXIT
+set +e
+mvn -B -o -Darflex.native.skip=true -Darflex.native.tests.skip=true -pl tests verify \
+  -Dtest=none -Dsurefire.failIfNoSpecifiedTests=false -Dit.test=ReconfigBench -Dfailsafe.failIfNoSpecifiedTests=false \
+  -Darflex.bench.sets="$sets" -Darflex.it.mlock="$mlock" -Darflex.bench.out="$ROOT/target/bench/reconfig.json" >"$log" 2>&1
+status=$?
+set -e
+grep -E '^(reconfig:|JSON:)' "$log" | grep -v '^reconfig: [0-9]* sets, ' || true
+if ! grep -q '^reconfig: [0-9]* sets, missed cycles' "$log"; then
+  tail -40 "$log" >&2
+  exit 1
+fi
+grep '^reconfig: [0-9]* sets, missed cycles' "$log" | tail -1
+exit $status
