@@ -52,6 +52,7 @@ class SoakBench {
     private final List<Double> handlings = Collections.synchronizedList(new ArrayList<>());
     private final List<long[]> samples = Collections.synchronizedList(new ArrayList<>()); // cycles, heapKB, threads, fds, shm, mq, procs
     private final AtomicInteger cycles = new AtomicInteger();
+    private long stopAtNs;
     /** Each step of a cycle, from the Felix command to the state it leads to, as the shell sees it (ms). */
     private final List<Double> installs = Collections.synchronizedList(new ArrayList<>());
     private final List<Double> updates = Collections.synchronizedList(new ArrayList<>());
@@ -97,6 +98,10 @@ class SoakBench {
     @Test
     void soak() throws Exception {
         int total = Integer.getInteger("arflex.bench.cycles", 300);
+        // a time bound (arflex.bench.minutes, 0: none): no cycle starts after it, and the report
+        // says how many cycles were done
+        long minutes = Long.getLong("arflex.bench.minutes", 0);
+        stopAtNs = System.nanoTime() + (minutes > 0 ? minutes * 60_000_000_000L : Long.MAX_VALUE / 2);
         int kills = Integer.getInteger("arflex.bench.kills", 30);
         int threads = Math.max(1, Math.min(2, Integer.getInteger("arflex.bench.threads", 2)));
         int every = Math.max(1, Integer.getInteger("arflex.bench.every", Math.max(1, total / 10)));
@@ -126,7 +131,7 @@ class SoakBench {
                 int k = w;
                 workers.add(pool.submit(() -> {
                     int mine = 0;
-                    while (cycles.get() < total) {
+                    while (cycles.get() < total && System.nanoTime() - stopAtNs < 0) {
                         boolean frozen = frozenEvery > 0 && ++mine % frozenEvery == 0;
                         int c;
                         quiesce.readLock().lock();
