@@ -525,6 +525,27 @@ final class CellRig {
             });
         }
 
+        /**
+         * Waits for a joint reference segment {@code seg} that a command in progress creates (a
+         * change set's new half), until it exists with its header or {@code command} is done,
+         * within {@link #T}; records its values into {@code sink} from then on. Returns the port,
+         * or null when the command ended without it.
+         */
+        Port recordRefsWhenItAppears(Path seg, java.util.concurrent.Future<?> command, Consumer<Ref> sink)
+                throws java.io.IOException {
+            long deadline = System.nanoTime() + T * 1_000_000L;
+            while (!(Files.exists(seg) && Files.size(seg) >= 4096) && !command.isDone()) {
+                org.junit.jupiter.api.Assertions.assertTrue(System.nanoTime() - deadline < 0, "no segment " + seg);
+                java.util.concurrent.locks.LockSupport.parkNanos(200_000);
+            }
+            if (!(Files.exists(seg) && Files.size(seg) >= 4096)) {
+                return null;
+            }
+            Port np = new Port(seg, REF_SIZE);
+            add(np, Ref::of, Ref::seq, sink);
+            return np;
+        }
+
         void start() {
             thread.start();
         }

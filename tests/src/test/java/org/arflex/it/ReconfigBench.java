@@ -276,16 +276,7 @@ class ReconfigBench {
             long a0 = System.nanoTime();
             CompletableFuture<String> apply = CompletableFuture.supplyAsync(() -> rt.cmd("arflex:change apply " + actions));
             if (update) {
-                Path seg = rt.segment(nextId, "corrected");
-                long deadline = System.nanoTime() + T * 1_000_000L;
-                while (!(Files.exists(seg) && Files.size(seg) >= 4096) && !apply.isDone()) {
-                    assertTrue(System.nanoTime() - deadline < 0, "no segment " + seg);
-                    java.util.concurrent.locks.LockSupport.parkNanos(200_000);
-                }
-                if (Files.exists(seg) && Files.size(seg) >= 4096) {
-                    np = new CellRig.Port(seg, CellRig.REF_SIZE);
-                    rec.add(np, CellRig.Ref::of, CellRig.Ref::seq, newRef::add);
-                }
+                np = rec.recordRefsWhenItAppears(rt.segment(nextId, "corrected"), apply, newRef::add);
             }
             String out = apply.get(T, TimeUnit.MILLISECONDS);
             long aRet = System.nanoTime();

@@ -159,15 +159,7 @@ class StateTransferIT {
                         "arflex:change apply update trajectory file:" + jar + " " + pin + " window 1000"));
                 CellRig.Port np = null;
                 try {
-                    long deadline = System.nanoTime() + T * 1_000_000L;
-                    while (!(Files.exists(newSeg) && Files.size(newSeg) >= 4096) && !apply.isDone()) {
-                        assertTrue(System.nanoTime() - deadline < 0, "no segment " + newSeg);
-                        java.util.concurrent.locks.LockSupport.parkNanos(200_000);
-                    }
-                    if (Files.exists(newSeg) && Files.size(newSeg) >= 4096) {
-                        np = new CellRig.Port(newSeg, CellRig.REF_SIZE);
-                        rec.add(np, CellRig.Ref::of, CellRig.Ref::seq, newOut::add);
-                    }
+                    np = rec.recordRefsWhenItAppears(newSeg, apply, newOut::add);
                     String out = apply.get(T, java.util.concurrent.TimeUnit.MILLISECONDS);
                     long tookMs = (System.nanoTime() - t0) / 1_000_000;
                     List<String> log = rt.logSince(logMark);

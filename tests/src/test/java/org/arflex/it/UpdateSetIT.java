@@ -151,15 +151,7 @@ class UpdateSetIT {
                     "arflex:change apply update tcp-correction file:" + jar + " " + pin + " " + options));
             CellRig.Port np = null;
             try {
-                long deadline = System.nanoTime() + T * 1_000_000L;
-                while (!(Files.exists(newSeg) && Files.size(newSeg) >= 4096) && !apply.isDone()) {
-                    assertTrue(System.nanoTime() - deadline < 0, "no segment " + newSeg);
-                    java.util.concurrent.locks.LockSupport.parkNanos(200_000);
-                }
-                if (Files.exists(newSeg) && Files.size(newSeg) >= 4096) {
-                    np = new CellRig.Port(newSeg, CellRig.REF_SIZE);
-                    rec.add(np, CellRig.Ref::of, CellRig.Ref::seq, newRef::add);
-                }
+                np = rec.recordRefsWhenItAppears(newSeg, apply, newRef::add);
                 long tSeen = System.nanoTime();
                 String out = apply.get(T, java.util.concurrent.TimeUnit.MILLISECONDS);
                 System.out.printf(Locale.ROOT, "UpdateSetIT: the new version's segment seen %.1f ms after the apply "

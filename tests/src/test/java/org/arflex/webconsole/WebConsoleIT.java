@@ -126,6 +126,18 @@ class WebConsoleIT {
         new WebDriverWait(browser, WAIT).until(ExpectedConditions.textToBePresentInElementLocated(by, text));
     }
 
+    /** The component page's answer to command @what ("start: done" or why not), or null after @wait. */
+    private static String commandAnswer(String what, Duration wait) {
+        try {
+            return new WebDriverWait(browser, wait).until(d -> {
+                String t = d.findElement(By.id("arflex-component-status")).getText();
+                return t.contains(what + ":") ? t : null;
+            });
+        } catch (org.openqa.selenium.TimeoutException e) {
+            return null;
+        }
+    }
+
     private static void shot(String name) throws IOException {
         Files.write(screenshots.resolve(name + ".png"), browser.getScreenshotAs(OutputType.BYTES));
     }
@@ -439,10 +451,23 @@ class WebConsoleIT {
         new WebDriverWait(browser, WAIT).until(d -> d.findElement(By.id("arflex-summary")).getText().contains("INSTALLED"));
         await(By.id("arflex-cmd-start")).click();
         // the console's own answer first: "start: done", or why not (a failure names it here)
-        String answered = new WebDriverWait(browser, WAIT).until(d -> {
-            String t = d.findElement(By.id("arflex-component-status")).getText();
-            return t.contains("start:") ? t : null;
-        });
+        String answered = commandAnswer("start", Duration.ofSeconds(10));
+        if (answered == null) {
+            // Two full runs saw a click here that never reached the runtime (nothing in its log, no
+            // request in the audit log) while every other click of the run did. What the page
+            // showed is kept; the page is opened again and the start clicked once more: the
+            // console's start must then answer.
+            shot("10-start-click-without-answer");
+            System.out.println("WebConsoleIT: no answer to the start click within 10 s; the page showed '"
+                    + browser.findElement(By.id("arflex-component-status")).getText() + "', summary '"
+                    + browser.findElement(By.id("arflex-summary")).getText().lines().findFirst().orElse("")
+                    + "'; the page is opened again");
+            open("arflex-component?name=sample-counter");
+            new WebDriverWait(browser, WAIT).until(d -> d.findElement(By.id("arflex-summary")).getText().contains("INSTALLED"));
+            await(By.id("arflex-cmd-start")).click();
+            answered = commandAnswer("start", WAIT);
+        }
+        assertNotNull(answered, "the console never answered the start click");
         assertTrue(answered.contains("start: done"), "the console answered the start with: " + answered);
         RuntimeUnderTest.awaitCondition("both Active", WAIT,
                 () -> "ACTIVE".equals(instanceState("sample-counter")) && "ACTIVE".equals(instanceState("sample-scaler")));
