@@ -118,7 +118,7 @@ static const char EVERY_KIND[] =
 	"<!-- every kind of port and property -->\n"
 	"<component xmlns=\"urn:arflex:contract:1\" name=\"every-kind\" version=\"2.1.0-rc.1\">\n"
 	"  <description>All of it.</description>\n"
-	"  <implementation executable=\"every_kind.bin\" task=\"sporadic\" movesHardware=\"true\"/>\n"
+	"  <implementation executable=\"every_kind.bin\" task=\"sporadic\" movesHardware=\"true\" motionThrough=\"outputs\"/>\n"
 	"  <attributes><attribute name=\"role\" value=\"arm\"/></attributes>\n"
 	"  <ports>\n"
 	"    <in name=\"x\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"stream\" optional=\"true\">\n"
@@ -395,6 +395,19 @@ static const struct bad BAD[] = {
 	  "<resources memory='1MiB'/><criticality>1</criticality>"
 	  "<fault restart='permanent' safe='zero'/></component>\n", 1,
 	  "declares a safety input" },
+	{ "motion-through-unknown", NULL, NULL, NULL, NULL,
+	  "<component xmlns='urn:arflex:contract:1' name='m' version='1.0.0'>\n"
+	  "<implementation executable='m' task='service' movesHardware='true' motionThrough='robot'/>\n"
+	  "<ports><in name='g' type='arflex.SafetyState' typeVersion='1.0' method='state' safety='true'/></ports>"
+	  "<resources memory='1MiB'/><criticality>1</criticality>"
+	  "<fault restart='permanent' safe='zero'/></component>\n", 2,
+	  "[§4.3] implementation/@motionThrough: 'robot' is not where motion goes (device or outputs)" },
+	{ "motion-through-without-moves", NULL, NULL, NULL, NULL,
+	  "<component xmlns='urn:arflex:contract:1' name='m' version='1.0.0'>\n"
+	  "<implementation executable='m' task='service' motionThrough='outputs'/>\n"
+	  "<resources memory='1MiB'/><criticality>1</criticality>"
+	  "<fault restart='permanent' safe='zero'/></component>\n", 2,
+	  "only a component that moves hardware" },
 	{ "criticality-101", NULL, NULL, NULL, NULL,
 	  "<component xmlns='urn:arflex:contract:1' name='m' version='1.0.0'>\n"
 	  "<implementation executable='m' task='service'/>\n"

@@ -47,7 +47,7 @@ static const struct elem {
 			    "3.3" },
 	[K_IMPLEMENTATION] = { "implementation", K_COMPONENT,
 			       (const char *const[]){ "executable", "task", "movesHardware",
-						      NULL }, false, "4" },
+						      "motionThrough", NULL }, false, "4" },
 	[K_ATTRIBUTES] = { "attributes", K_COMPONENT, (const char *const[]){ NULL }, false, "5" },
 	[K_ATTRIBUTE] = { "attribute", K_ATTRIBUTES, (const char *const[]){ "name", "value", NULL },
 			  false, "5" },
@@ -440,6 +440,13 @@ static void on_implementation(struct loader *L, const XML_Char **atts)
 		return;
 	}
 	opt_bool(L, atts, "4.3", "implementation", "movesHardware", &L->moves_hw);
+	const char *through = attr(atts, "motionThrough");
+	if (through && strcmp(through, "device") && strcmp(through, "outputs"))
+		fail(L, "4.3", "implementation/@motionThrough",
+		     "'%s' is not where motion goes (device or outputs)", through);
+	else if (through && !L->moves_hw)
+		fail(L, "4.3", "implementation/@motionThrough",
+		     "only a component that moves hardware (movesHardware=\"true\") says where its motion goes");
 }
 
 static bool port_declared(const struct arflex_host_contract *c, const char *name)

@@ -11,7 +11,7 @@
   const form = el('form', {id: 'arflex-contract-form', onsubmit: e => e.preventDefault()});
 
   const blank = () => ({name: 'my-component', version: '1.0.0', description: '', executable: 'my-component', task: 'periodic',
-    movesHardware: 'false', ports: [], props: [], timing: {period: '1ms', deadline: '1ms', wcet: '100us', priority: '80', cpus: ''},
+    movesHardware: 'false', motionThrough: '', ports: [], props: [], timing: {period: '1ms', deadline: '1ms', wcet: '100us', priority: '80', cpus: ''},
     resources: {memory: '8MiB', network: '0'}, criticality: '5',
     fault: {restart: 'permanent', intensity: '3', window: '10s', backoff: '100ms', safe: 'hold', heartbeatTimeout: '100ms'},
     update: {url: '', sha256: ''}});
@@ -70,7 +70,8 @@
       el('fieldset', {'data-field': 'implementation'}, el('legend', {}, 'Implementation'),
         labelled('executable', input('implementation/@executable', m.executable, v => { m.executable = v; })),
         labelled('task', select('implementation/@task', m.task, ['periodic', 'sporadic', 'service'], v => { m.task = v; })),
-        labelled('moves hardware', select('implementation/@movesHardware', m.movesHardware, ['false', 'true'], v => { m.movesHardware = v; }))),
+        labelled('moves hardware', select('implementation/@movesHardware', m.movesHardware, ['false', 'true'], v => { m.movesHardware = v; })),
+        labelled('motion through', select('implementation/@motionThrough', m.motionThrough, ['', 'device', 'outputs'], v => { m.motionThrough = v; }))),
       el('fieldset', {'data-field': 'ports'}, el('legend', {}, 'Ports'), portRows,
         el('button', {type: 'button', id: 'arflex-add-port', onclick: () => { m.ports.push({dir: 'out', name: 'y', type: 'arflex.Sample', typeVersion: '1.0', method: 'stream', depth: '64', overflow: 'drop-oldest', optional: 'false', bindComponent: '', bindPort: ''}); renderForm(); toXml(); }}, 'add port')),
       el('fieldset', {'data-field': 'properties'}, el('legend', {}, 'Properties'), propRows,
@@ -103,7 +104,7 @@
     };
     root.setAttribute('name', m.name); root.setAttribute('version', m.version);
     if (m.description) add(root, 'description', {}, m.description);
-    add(root, 'implementation', {executable: m.executable, task: m.task, movesHardware: m.movesHardware});
+    add(root, 'implementation', {executable: m.executable, task: m.task, movesHardware: m.movesHardware, motionThrough: m.motionThrough});
     if (m.ports.length) {
       const ports = add(root, 'ports');
       for (const p of m.ports) {
@@ -160,7 +161,7 @@
     m.name = at(r, 'name'); m.version = at(r, 'version');
     m.description = one('description') ? one('description').textContent : '';
     const impl = one('implementation');
-    m.executable = at(impl, 'executable'); m.task = at(impl, 'task') || 'periodic'; m.movesHardware = at(impl, 'movesHardware') || 'false';
+    m.executable = at(impl, 'executable'); m.task = at(impl, 'task') || 'periodic'; m.movesHardware = at(impl, 'movesHardware') || 'false'; m.motionThrough = at(impl, 'motionThrough') || '';
     m.ports = one('ports') ? Array.from(one('ports').children).map(p => {
       const b = Array.from(p.children).find(c => c.localName === 'bind');
       return {dir: p.localName, name: at(p, 'name'), type: at(p, 'type'), typeVersion: at(p, 'typeVersion'), method: at(p, 'method'),

@@ -27,6 +27,11 @@ import java.util.Optional;
  * @param state        the state block it hands to its next version at a change set's switch, if any
  *                     (SPEC §12.1)
  * @param rollout      how a new version is shadowed, compared and switched in a change set (SPEC §12.2)
+ * @param motionThroughOutputs true when a component that moves hardware commands its motion only
+ *                     through its output ports, to a component that drives the device
+ *                     ({@code implementation/@motionThrough="outputs"}, SPEC §4.3); false (the
+ *                     default) when its RT half drives a device itself, so two of its halves must
+ *                     never run side by side
  */
 public record Contract(
         String name,
@@ -45,7 +50,8 @@ public record Contract(
         Optional<UpdateSpec> update,
         String source,
         Optional<StateSpec> state,
-        Optional<RolloutSpec> rollout) {
+        Optional<RolloutSpec> rollout,
+        boolean motionThroughOutputs) {
 
     public Contract {
         attributes = Map.copyOf(attributes);
@@ -55,13 +61,23 @@ public record Contract(
         properties = List.copyOf(properties);
     }
 
+    /** A contract whose motion, if it moves hardware, goes to a device of its own (SPEC §4.3). */
+    public Contract(String name, String version, String description, String executable, TaskType taskType,
+                    boolean movesHardware, Map<String, String> attributes, List<PortSpec> ports,
+                    List<PropertySpec> properties, Timing timing, Resources resources, int criticality,
+                    FaultPolicy fault, Optional<UpdateSpec> update, String source, Optional<StateSpec> state,
+                    Optional<RolloutSpec> rollout) {
+        this(name, version, description, executable, taskType, movesHardware, attributes, ports, properties, timing,
+                resources, criticality, fault, update, source, state, rollout, false);
+    }
+
     /** A contract without a state block (SPEC §12.1) and without a {@code <rollout>} (SPEC §12.2). */
     public Contract(String name, String version, String description, String executable, TaskType taskType,
                     boolean movesHardware, Map<String, String> attributes, List<PortSpec> ports,
                     List<PropertySpec> properties, Timing timing, Resources resources, int criticality,
                     FaultPolicy fault, Optional<UpdateSpec> update, String source) {
         this(name, version, description, executable, taskType, movesHardware, attributes, ports, properties, timing,
-                resources, criticality, fault, update, source, Optional.empty(), Optional.empty());
+                resources, criticality, fault, update, source, Optional.empty(), Optional.empty(), false);
     }
 
     /** The inputs, in declaration order. */

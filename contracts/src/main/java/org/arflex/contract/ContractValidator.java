@@ -80,6 +80,7 @@ final class ContractValidator {
         String executable = null;
         Contract.TaskType task = null;
         boolean moves = false;
+        boolean throughOutputs = false;
         ContractXml.Impl impl = x.implementation;
         if (impl == null) {
             p.at(x, "4", "implementation", "required element <implementation> is missing");
@@ -106,6 +107,16 @@ final class ContractValidator {
                 };
             }
             moves = bool(p, impl, impl.movesHardware, false, "4.3", "implementation/@movesHardware");
+            if (impl.motionThrough != null) {
+                if (!impl.motionThrough.equals("device") && !impl.motionThrough.equals("outputs")) {
+                    p.at(impl, "4.3", "implementation/@motionThrough", "'" + impl.motionThrough
+                            + "' is not where motion goes (device or outputs)");
+                } else if (!moves) {
+                    p.at(impl, "4.3", "implementation/@motionThrough", "only a component that moves hardware "
+                            + "(movesHardware=\"true\") says where its motion goes");
+                }
+                throughOutputs = moves && impl.motionThrough.equals("outputs");
+            }
         }
 
         // §5 attributes
@@ -247,7 +258,7 @@ final class ContractValidator {
             return null;
         }
         return new Contract(name, x.version, description, executable, task, moves, attributes, ports, properties,
-                timing, resources, criticality, fault, update, source, state, rollout);
+                timing, resources, criticality, fault, update, source, state, rollout, throughOutputs);
     }
 
     private PortSpec port(Problems p, ContractXml.Port x, Set<String> seen) {

@@ -49,6 +49,9 @@ public final class ContractWriter {
             w.writeAttribute("executable", c.executable());
             w.writeAttribute("task", c.taskType().name().toLowerCase(Locale.ROOT));
             w.writeAttribute("movesHardware", Boolean.toString(c.movesHardware()));
+            if (c.motionThroughOutputs()) {
+                w.writeAttribute("motionThrough", "outputs");
+            }
             if (!c.attributes().isEmpty()) {
                 nl(w, 1);
                 w.writeStartElement("attributes");

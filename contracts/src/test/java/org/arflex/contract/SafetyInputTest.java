@@ -43,7 +43,8 @@ class SafetyInputTest {
         List<Problem> q = PARSER.validate(trajectory().replace("safety=\"true\"", "optional=\"true\""), "t.xml");
         assertTrue(q.stream().anyMatch(x -> x.field().equals("implementation/@movesHardware")), q.toString());
         // A component that does not move needs none.
-        assertEquals(List.of(), PARSER.validate(xml.replace("movesHardware=\"true\"", "movesHardware=\"false\""), "t.xml"));
+        assertEquals(List.of(), PARSER.validate(xml.replace("movesHardware=\"true\" motionThrough=\"outputs\"",
+                "movesHardware=\"false\""), "t.xml"));
     }
 
     @Test

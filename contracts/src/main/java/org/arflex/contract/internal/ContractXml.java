@@ -45,6 +45,7 @@ public final class ContractXml extends Located {
         @JacksonXmlProperty(isAttribute = true) public String executable;
         @JacksonXmlProperty(isAttribute = true) public String task;
         @JacksonXmlProperty(isAttribute = true) public String movesHardware;
+        @JacksonXmlProperty(isAttribute = true) public String motionThrough;
     }
 
     /** {@code <attributes>}. */

@@ -242,10 +242,11 @@ final class ChangeSetExecutor {
         if (state != null) {
             return state;
         }
-        if ((inst.contract.movesHardware() || u.contract().movesHardware())
-                && !StateTransfer.continuesMotion(inst.contract, u.contract())) {
-            return "'" + n + "' moves hardware: its new half would drive it beside the old one; update it outside a "
-                    + "change set";
+        if (inst.contract.movesHardware() || u.contract().movesHardware()) {
+            String beside = StateTransfer.besideProblem(inst.contract, u.contract());
+            if (beside != null) {
+                return "'" + n + "' moves hardware: " + beside + "; update it outside a change set";
+            }
         }
         for (ChangeSet.Envelope e : u.envelopes()) {
             org.arflex.contract.PortSpec out = u.contract().outputs().stream().filter(o -> o.name().equals(e.port()))

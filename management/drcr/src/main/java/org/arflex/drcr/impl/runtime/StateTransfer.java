@@ -72,12 +72,27 @@ final class StateTransfer {
     }
 
     /**
-     * True when both versions of a component that moves hardware declare a state block: its
-     * motion reaches the hardware through its outputs and the new half continues it from the
-     * old one's state, so the two may run side by side for the window (the consumers read one).
+     * Why the two versions of a component that moves hardware may not run side by side for an
+     * update's window, or null when they may: both send their motion only through their outputs
+     * (SPEC §4.3 {@code motionThrough="outputs"}: the consumers read one of them, a device of its
+     * own would be driven by both) and both declare a state block, so the new half continues
+     * the old one's motion. A contract that does not say where its motion goes drives a device
+     * itself: fail closed.
      */
-    static boolean continuesMotion(Contract old, Contract next) {
-        return old.state().isPresent() && next.state().isPresent();
+    static String besideProblem(Contract old, Contract next) {
+        for (Contract c : new Contract[] {old, next}) {
+            if (c.movesHardware() && !c.motionThroughOutputs()) {
+                return "version " + c.version() + " drives its device itself (implementation/@motionThrough is not "
+                        + "\"outputs\"): a new half would drive it beside the old one";
+            }
+        }
+        for (Contract c : new Contract[] {old, next}) {
+            if (c.state().isEmpty()) {
+                return "version " + c.version() + " declares no state block (§12.1): a new half would drive it beside "
+                        + "the old one without continuing its motion";
+            }
+        }
+        return null;
     }
 
     /** The state segment the new half {@code next} adopts at START: the running half's, or null. */

@@ -150,6 +150,83 @@ class CellStateTransferTest {
         rig.stepUntil("the verdict", () -> r.verdict().isDone());
     }
 
+    private static final String IN_GUARD = "<in name=\"safety\" type=\"arflex.SafetyState\" typeVersion=\"1.0\" "
+            + "method=\"state\" safety=\"true\"><bind filter=\"(role=guard)\"/></in>";
+    private static final String OUT_SAFETY = "<out name=\"safety\" type=\"arflex.SafetyState\" typeVersion=\"1.0\" "
+            + "method=\"state\"/>";
+
+    /** The stage as a component that moves hardware, its motion going to {@code through} (null: not said). */
+    private static Contract moving(String version, String through, String state) throws Exception {
+        String xml = CellChangeSetTest.contract("stage", "stage", IN_SRC + IN_GUARD + OUT, "50us")
+                .replace("version=\"1.0.0\"", "version=\"" + version + "\"")
+                .replace("movesHardware=\"false\"", "movesHardware=\"true\""
+                        + (through == null ? "" : " motionThrough=\"" + through + "\""))
+                .replace("</component>", state + "</component>");
+        return ContractParser.create(PortTypes.builtin()).parse(xml, "test.xml");
+    }
+
+    /**
+     * A component that moves hardware runs two halves side by side in an update's window only
+     * when both versions send their motion through their outputs and both continue it from a
+     * state block; a version that drives its device itself, or says nothing (fail closed), or
+     * has no state is refused by the plan naming the version, and nothing is launched.
+     */
+    @Test
+    void aMovingComponentThatDoesNotSayWhereItsMotionGoesDrivesItsDeviceAndIsNotUpdatedBesideIt() throws Exception {
+        install(parse("src", "src", OUT, "1.0.0", ""));
+        install(parse("guard", "guard", OUT_SAFETY, "1.0.0", ""));
+        install(moving("1.0.0", null, TRAJ));
+        install(parse("user", null, IN_STAGE, "1.0.0", ""));
+        int before = fake.events.size();
+        ChangeSetResult device = apply(ChangeSet.builder().update("stage", moving("1.1.0", "outputs", TRAJ),
+                Path.of("/nonexistent/stage-1.1"), "file:/x/stage-1.1.jar", 100).build());
+        assertFalse(device.applied(), device.text());
+        assertTrue(device.refusal().contains("'stage' moves hardware: version 1.0.0 drives its device itself "
+                + "(implementation/@motionThrough is not \"outputs\"): a new half would drive it beside the old one; "
+                + "update it outside a change set"), device.text());
+        assertEquals(before, fake.events.size(), "nothing launched, created or bound: " + fake.events);
+    }
+
+    @Test
+    void aMovingComponentsNewVersionThatDrivesADeviceOrHasNoStateIsRefusedThroughOutputsWithStateIsCommitted()
+            throws Exception {
+        install(parse("src", "src", OUT, "1.0.0", ""));
+        install(parse("guard", "guard", OUT_SAFETY, "1.0.0", ""));
+        install(moving("1.0.0", "outputs", TRAJ));
+        install(parse("user", null, IN_STAGE, "1.0.0", ""));
+        int before = fake.events.size();
+        ChangeSetResult device = apply(ChangeSet.builder().update("stage", moving("1.1.0", "device", TRAJ),
+                Path.of("/nonexistent/stage-1.1"), "file:/x/stage-1.1.jar", 100).build());
+        assertFalse(device.applied(), device.text());
+        assertTrue(device.refusal().contains("version 1.1.0 drives its device itself"), device.text());
+        ChangeSetResult unsaid = apply(ChangeSet.builder().update("stage", moving("1.1.0", null, TRAJ),
+                Path.of("/nonexistent/stage-1.1"), "file:/x/stage-1.1.jar", 100).build());
+        assertFalse(unsaid.applied(), unsaid.text());
+        assertTrue(unsaid.refusal().contains("version 1.1.0 drives its device itself"), unsaid.text());
+        assertEquals(before, fake.events.size(), "nothing launched, created or bound: " + fake.events);
+        ChangeSetResult through = apply(ChangeSet.builder().update("stage", moving("1.1.0", "outputs", TRAJ),
+                Path.of("/nonexistent/stage-1.1"), "file:/x/stage-1.1.jar", 100).build());
+        assertTrue(through.applied(), through.text());
+        index("1-stage ADOPT /arflex.t.stage.state");
+        fake.running.get("1-stage").stats = new ControlBlock.Stats(100, 0, 0, 0, 0, 0, 0, 0, 0, 0);
+        watch();
+        rig.stepUntil("the verdict", () -> through.verdict().isDone());
+        assertTrue(through.verdict().join().startsWith("update stage: committed"), through.verdict().join());
+    }
+
+    @Test
+    void aMovingComponentWithoutStateIsNotUpdatedBesideItsOldHalf() throws Exception {
+        install(parse("src", "src", OUT, "1.0.0", ""));
+        install(parse("guard", "guard", OUT_SAFETY, "1.0.0", ""));
+        install(moving("1.0.0", "outputs", ""));
+        install(parse("user", null, IN_STAGE, "1.0.0", ""));
+        ChangeSetResult r = apply(ChangeSet.builder().update("stage", moving("1.1.0", "outputs", ""),
+                Path.of("/nonexistent/stage-1.1"), "file:/x/stage-1.1.jar", 100).build());
+        assertFalse(r.applied(), r.text());
+        assertTrue(r.refusal().contains("'stage' moves hardware: version 1.0.0 declares no state block (§12.1): a new "
+                + "half would drive it beside the old one without continuing its motion"), r.text());
+    }
+
     @Test
     void aRefusedAdoptTearsTheSetDownAndLeavesTheOldHalf() throws Exception {
         runningCell(TRAJ);
