@@ -26,7 +26,9 @@ import org.junit.jupiter.api.Test;
  * hashes, and a set whose update changes the method of the output sim-robot reads is refused
  * naming the component, the port, the peer and both formats; after either nothing is installed
  * (no bundle, the gripper unknown to the cell, no process, no shm segment or queue of it or of a
- * second tcp-correction half) and the cell runs as before. The good set's dry run installs
+ * second tcp-correction half) and the cell runs as before. A set whose new gripper's executable
+ * exits before READY is torn down by the change set after the gripper's bundle was installed for
+ * it: that bundle is uninstalled again, and nothing is left either. The good set's dry run installs
  * nothing; applied, the gripper runs with trajectory's tool input bound to it and tcp-correction
  * runs 1.0.1 (committed after its window), in one change set. Throughout: the guard never leaves
  * NORMAL, sim-robot runs no safe cycle, nothing waits for a reset or a fresh command, sim-robot,
@@ -49,6 +51,24 @@ class DeploymentSetIT {
                     assertFalse(s.equals(xml), "tcp-correction's contract declares 'corrected' as expected");
                     return s;
                 });
+        // a gripper whose executable exits at once: its half never gets READY, the set is torn down
+        try (java.util.zip.ZipFile in = new java.util.zip.ZipFile(CellRig.GRIPPER.toFile());
+                java.util.zip.ZipOutputStream zo = new java.util.zip.ZipOutputStream(
+                        Files.newOutputStream(dir.resolve("tool-gripper-broken.jar")))) {
+            boolean found = false;
+            for (java.util.zip.ZipEntry e : java.util.Collections.list(in.entries())) {
+                byte[] b = in.getInputStream(e).readAllBytes();
+                if (e.getName().equals("native/linux-x86_64/tool-gripper")) {
+                    b = "#!/bin/sh\n# DeploymentSetIT's broken gripper: exits before READY\nexit 3\n"
+                            .getBytes(java.nio.charset.StandardCharsets.UTF_8);
+                    found = true;
+                }
+                zo.putNextEntry(new java.util.zip.ZipEntry(e.getName()));
+                zo.write(b);
+                zo.closeEntry();
+            }
+            assertTrue(found, "the gripper's executable in " + CellRig.GRIPPER);
+        }
         return dir;
     }
 
@@ -81,16 +101,18 @@ class DeploymentSetIT {
         return out;
     }
 
-    /** Nothing of the set is in Felix, the cell, the process table or /dev/shm and /dev/mqueue. */
+    /**
+     * Nothing of the set is in Felix, the cell, the process table or /dev/shm and /dev/mqueue
+     * (a torn-down half's exit and its objects' removal are waited for, with a deadline).
+     */
     private static void nothingInstalled(Runtime rt, long tcpPid) throws IOException {
         String lb = rt.cmd("lb -l");
         String sets = rt.dir.resolve("sets") + "/";
         assertTrue(lb.lines().noneMatch(l -> l.contains(sets)), "no bundle of the set's folder " + sets + ":\n" + lb);
         assertNull(rt.instance("tool-gripper"), "the gripper is unknown to the cell");
-        assertTrue(Runtime.rtProcesses(rt.rid).stream().noneMatch(p -> p.contains("--instance tool-gripper ")
-                || p.contains("--instance 1-tcp-correction ")), Runtime.rtProcesses(rt.rid)::toString);
-        assertEquals(List.of(), objects(rt, "tool-gripper"));
-        assertEquals(List.of(), objects(rt, "1-tcp-correction"));
+        rt.waitUntil("no process, segment or queue of the set's halves", T, () -> Runtime.rtProcesses(rt.rid).stream()
+                .noneMatch(p -> p.contains("--instance tool-gripper ") || p.contains("--instance 1-tcp-correction "))
+                && objects(rt, "tool-gripper").isEmpty() && objects(rt, "1-tcp-correction").isEmpty());
         assertEquals(tcpPid, rt.pid("tcp-correction"), "the running tcp-correction untouched");
         assertTrue(rt.cmd("arflex:info tcp-correction").startsWith("tcp-correction 1.0.0 "), rt.cmd("arflex:info tcp-correction"));
     }
@@ -195,7 +217,19 @@ class DeploymentSetIT {
                         || l.contains("tool-gripper ACTIVE") || l.contains("contracts read")),
                         "nothing spawned or installed:\n" + String.join("\n", rt.logSince(mark)));
                 nothingInstalled(rt, tcpPid);
-                w.unharmed("after two refused sets");
+
+                // a set the change set tears down after the gripper's bundle was installed for it:
+                // the bundle is uninstalled again, the prepared tcp-correction half stopped
+                Path broken = Files.writeString(dir.resolve("broken.xml"), Files.readString(bad)
+                        .replace("tool-gripper.jar\" sha256=\"" + wrongPin, "tool-gripper-broken.jar\" sha256=\""
+                                + Jars.sha256(dir.resolve("tool-gripper-broken.jar"))));
+                out = rt.cmd("arflex:deploy set " + broken.toUri());
+                System.out.println("DeploymentSetIT: a set torn down:\n" + out);
+                assertTrue(out.startsWith("error: "), out);
+                assertTrue(out.contains("\nuninstalled again: bundle "), out);
+                assertTrue(out.contains("tool-gripper"), out);
+                nothingInstalled(rt, tcpPid);
+                w.unharmed("after three refused sets");
             }
         }
     }

@@ -185,11 +185,11 @@ public final class DeploymentSets {
             dto.admitted = true;
             return dto;
         }
-        return applySet(url, text, jars, installs);
+        return applySet(url, text, jars);
     }
 
     /** 6: the bundles of new components installed, not started; the set applied; undone when refused. */
-    private ChangeSetDTO applySet(String url, StringBuilder text, List<Jar> jars, List<Contract> installs) {
+    private ChangeSetDTO applySet(String url, StringBuilder text, List<Jar> jars) {
         List<Bundle> installed = new ArrayList<>();
         List<String> actions = new ArrayList<>();
         List<String> keys = new ArrayList<>();
@@ -316,7 +316,9 @@ public final class DeploymentSets {
                         Services.CALL_MS);
                 if (state != null) {
                     problems.add("install " + c.name() + " (" + j.entry().jar() + "): '" + c.name() + "' is known to "
-                            + "the cell already (" + state + "); update it instead");
+                            + "the cell already (" + state + ")" + (state.equals("INSTALLED")
+                            ? ": its bundle is installed, name it in arflex:change (install " + c.name() + ")"
+                            : ": update it instead"));
                 }
             }
         }
