@@ -260,7 +260,7 @@ public final class Commands {
                 return d.refusal != null ? "error: " + d.text.stripTrailing() : d.text.stripTrailing();
             });
         }
-        return guard(() -> args.length == 1 || args.length == 2
+        return guard(() -> (args.length == 1 || args.length == 2) && !args[0].equals("set")
                 ? bundles.deploy(args[0], args.length == 2 ? args[1] : null)
                 : "usage: deploy <https-or-file-url> [<sha256>] (without a SHA-256: a jar signed by a trusted key)"
                         + " | deploy set <descriptor https-or-file-url> [plan] (a deployment set, D45; plan: the dry run)");
