@@ -28,4 +28,16 @@ public interface ChangeSetService {
      * refused or torn down.
      */
     ChangeSetDTO apply(List<String> actions);
+
+    /**
+     * A deployment set (docs/DECISIONS.md D45): the descriptor at {@code url} (https or file;
+     * docs/deployment-sets.md) names bundles of new components and updates of running ones, each
+     * jar pinned or signed; every jar passes the code gate and the port formats of the new
+     * contracts are checked against their peers before anything is installed, then the whole is
+     * one change set. {@code apply} false: the dry run (nothing installed, nothing changed).
+     * Refused, nothing is left installed.
+     *
+     * @since 0.7.0
+     */
+    ChangeSetDTO deploy(String url, boolean apply);
 }

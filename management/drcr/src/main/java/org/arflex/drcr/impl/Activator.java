@@ -181,9 +181,14 @@ public final class Activator implements BundleActivator {
         org.arflex.drcr.impl.services.ChangeSets changeSets = new org.arflex.drcr.impl.services.ChangeSets(cell, ctx, log);
         regs.add(ctx.registerService(org.arflex.drcr.ChangeSetService.class, changeSets, null));
         // updates in change sets (D38): the new version's jar through the same gate as a deploy
-        changeSets.versions(new org.arflex.drcr.impl.services.UpdateJars(installer, gate, reader, executables,
-                java.util.Objects.requireNonNull(ctx.getDataFile("updates"), "the framework has no data area for bundles")
-                        .toPath()));
+        org.arflex.drcr.impl.services.UpdateJars updateJars = new org.arflex.drcr.impl.services.UpdateJars(installer, gate,
+                reader, executables, java.util.Objects.requireNonNull(ctx.getDataFile("updates"),
+                        "the framework has no data area for bundles").toPath());
+        // deployment sets (D45): several jars through the same gate, then one change set
+        org.arflex.drcr.impl.services.DeploymentSets deployments = new org.arflex.drcr.impl.services.DeploymentSets(cell,
+                ctx, installer, gate, services::readJar, updateJars, changeSets, log);
+        changeSets.versions(deployments.versions());
+        changeSets.deployments(deployments);
         Hashtable<String, Object> shell = new Hashtable<>();
         shell.put("osgi.command.scope", Commands.SCOPE);
         shell.put("osgi.command.function", Commands.FUNCTIONS);

@@ -80,6 +80,7 @@ public final class ChangeSets implements ChangeSetService {
         throw new IOException("the DRCR is not started yet");
     };
     private volatile UpdatedBundles bundles;
+    private volatile DeploymentSets deployments;
     private final Consumer<String> log;
 
     public ChangeSets(Cell cell, BundleContext context, Consumer<String> log) {
@@ -96,6 +97,17 @@ public final class ChangeSets implements ChangeSetService {
     /** Who updates the bundle of a committed update (built with the extender, after this service). */
     public void bundles(UpdatedBundles b) {
         bundles = b;
+    }
+
+    /** Who applies deployment sets (D45). */
+    public void deployments(DeploymentSets d) {
+        deployments = d;
+    }
+
+    @Override
+    public ChangeSetDTO deploy(String url, boolean apply) {
+        DeploymentSets d = deployments;
+        return d != null ? d.deploy(url, apply) : refused(List.of("deploy " + url), "the DRCR is not started yet");
     }
 
     /** Where the executables of installs come from (the extender, built after this service). */

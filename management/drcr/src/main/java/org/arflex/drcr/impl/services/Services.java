@@ -270,7 +270,7 @@ public final class Services implements DrcrService, UpdateService {
     }
 
     /** Reads the contracts of a jar held in memory (a broken jar is a problem, not an exception). */
-    ContractReader.Result readJar(String label, byte[] jar) {
+    public ContractReader.Result readJar(String label, byte[] jar) {
         Map<String, byte[]> entries = new HashMap<>();
         String header;
         try (JarInputStream in = new JarInputStream(new ByteArrayInputStream(jar))) {

@@ -248,11 +248,22 @@ public final class Commands {
     /**
      * {@code deploy <https-or-file-url> [<sha256>]}: the verified install of a bundle, then its
      * start; without a SHA-256 only a jar signed by a key of the runtime's trust store.
+     * {@code deploy set <descriptor-url> [plan]}: a deployment set (D45), several bundles from one
+     * descriptor as one change set; with {@code plan} the dry run (every jar gated, port formats
+     * and admission checked, nothing installed).
      */
     public String deploy(String... args) {
-        return guard(() -> args.length == 1 || args.length == 2
+        if (args.length >= 2 && args.length <= 3 && args[0].equals("set") && changeSets != null
+                && (args.length == 2 || args[2].equals("plan"))) {
+            return guard(() -> {
+                org.arflex.drcr.dto.ChangeSetDTO d = changeSets.deploy(args[1], args.length == 2);
+                return d.refusal != null ? "error: " + d.text.stripTrailing() : d.text.stripTrailing();
+            });
+        }
+        return guard(() -> (args.length == 1 || args.length == 2) && !args[0].equals("set")
                 ? bundles.deploy(args[0], args.length == 2 ? args[1] : null)
-                : "usage: deploy <https-or-file-url> [<sha256>] (without a SHA-256: a jar signed by a trusted key)");
+                : "usage: deploy <https-or-file-url> [<sha256>] (without a SHA-256: a jar signed by a trusted key)"
+                        + " | deploy set <descriptor https-or-file-url> [plan] (a deployment set, D45; plan: the dry run)");
     }
 
     /** {@code resources} prints capacities; {@code resources set cpus 0,1 memory 512m network 10m} changes them. */
