@@ -28,4 +28,11 @@ public interface ChangeSetService {
      * refused or torn down.
      */
     ChangeSetDTO apply(List<String> actions);
+
+    /**
+     * The outcomes of the sets applied in this runtime (refused ones included; dry runs not),
+     * newest first, at most 50, each with {@link ChangeSetDTO#finishedMillis}; in memory only
+     * (D46).
+     */
+    List<ChangeSetDTO> history();
 }
