@@ -38,7 +38,8 @@ class ChangeSetHistoryTest {
         assertEquals(1_000 + newest, l.get(0).finishedMillis);
         assertEquals("install c7", l.get(l.size() - 1).actions[0], "the seven oldest were dropped");
         assertEquals("refused 7", l.get(l.size() - 1).refusal);
-        assertNull(l.get(1).refusal);
+        assertNull(l.get(0).refusal, "the newest (56, applied)");
+        assertEquals("refused 55", l.get(1).refusal);
     }
 
     @Test
