@@ -348,4 +348,56 @@ class ChangeSetConsoleIT {
         assertTrue(entries.stream().anyMatch(e -> apply.equals(e.get("path")) && ((Number) e.get("status")).intValue() == 409
                 && String.valueOf(e.get("reason")).startsWith("the cell changed since the plan was shown")), body);
     }
+
+    /** Sets the page's actions as typed (the input event included) and clicks Plan. */
+    private static void planInTheBrowser(Browser b, String actions) {
+        b.js("const t = document.getElementById('arflex-cs-actions'); t.value = arguments[0];"
+                + "t.dispatchEvent(new Event('input'));", actions);
+        b.click(b.findAll("#arflex-cs-plan-btn").get(0));
+    }
+
+    private static String textOf(Browser b, String css) {
+        List<String> e = b.findAll(css);
+        return e.isEmpty() ? null : b.text(e.get(0));
+    }
+
+    @Test
+    @Order(7)
+    void thePageShowsThePlanAppliesItAndShowsTheOutcomeWithMarkupKeptAsText() throws IOException {
+        Browser.requireInstalled();
+        Path work = Path.of(System.getProperty("arflex.it.work", "target/it")).resolve("changeset-console").toAbsolutePath();
+        try (Browser b = Browser.start(work.resolve("chromedriver.log"))) {
+            b.cdp("Network.enable", Map.of());
+            b.cdp("Network.setExtraHTTPHeaders", Map.of("headers", Map.of("Authorization", rt.basicAuth())));
+            b.open(rt.base() + PAGE);
+            b.await("the page", WAIT, () -> textOf(b, "#arflex-cs-history-table"), b::url);
+            // markup typed as an action stays text in the refusal, and runs nothing
+            planInTheBrowser(b, "install <img id=xss src=x onerror=window.__pwned=1>");
+            String error = b.await("the refusal of line 1", WAIT, () -> textOf(b, "#arflex-cs-plan-error"), b::source);
+            assertTrue(error.startsWith("line 1 ('install <img id=xss"), error);
+            assertTrue(b.findAll("#xss").isEmpty(), "no element made of the text");
+            assertEquals(null, b.js("return window.__pwned === undefined ? null : window.__pwned;"));
+            // the plan of the whole set, then applied from the page
+            planInTheBrowser(b, "install sample-scaler");
+            b.await("START sample-scaler in the plan", WAIT,
+                    () -> b.findAll("#arflex-cs-plan-steps tr[data-op='START'][data-component='sample-scaler']").isEmpty()
+                            ? null : Boolean.TRUE, b::source);
+            assertTrue(textOf(b, "#arflex-cs-admission").startsWith("Admitted (dry run: nothing changed)"));
+            assertFalse(b.findAll("#arflex-cs-plan-cpus tr[data-cpu]").isEmpty(), "the admission per CPU is shown");
+            b.screenshot(Path.of(System.getProperty("arflex.screenshots", "target/screenshots")).resolve("changesets-plan.png"));
+            assertEquals("INSTALLED", state("sample-scaler"), "nothing happens before the apply");
+            b.click(b.findAll("#arflex-cs-apply").get(0));
+            String outcome = b.await("the outcome", WAIT, () -> {
+                List<String> e = b.findAll("#arflex-cs-outcome[data-outcome]");
+                String t = e.isEmpty() ? null : b.text(e.get(0));
+                return t != null && t.contains("install sample-scaler") ? t : null;
+            }, b::source);
+            assertTrue(outcome.contains("committed"), outcome);
+            RuntimeUnderTest.awaitCondition("sample-scaler ACTIVE", WAIT, () -> "ACTIVE".equals(state("sample-scaler")));
+            b.await("three sets in the history", WAIT,
+                    () -> b.findAll("#arflex-cs-history-table tr[data-outcome='committed']").size() == 3 ? Boolean.TRUE : null,
+                    b::source);
+            b.screenshot(Path.of(System.getProperty("arflex.screenshots", "target/screenshots")).resolve("changesets-outcome.png"));
+        }
+    }
 }
