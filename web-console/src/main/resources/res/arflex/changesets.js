@@ -17,6 +17,8 @@
   // The plan on the page: the text it was made for and its id; editing the text withdraws it.
   let shown = null;
   let historyKey = null;
+  // the "Applying the set…" note, cleared once the outcome is shown
+  let applyingShown = false;
 
   const OUTCOME_TEXT = {
     'committed': 'committed', 'applied': 'applied (no verdict of the window)', 'refused': 'refused, nothing changed',
@@ -71,6 +73,7 @@
         await post('changeset-apply', null, new URLSearchParams({actions: text, plan: r.planId}),
           'application/x-www-form-urlencoded');
         message(status, 'Applying the set…', 'info');
+        applyingShown = true;
         planBox.replaceChildren();
         shown = null;
       } catch (e) {
@@ -112,7 +115,7 @@
       + (u.cycles !== null && u.cycles !== undefined ? ' after ' + u.cycles + ' cycles' : '')).join('; ');
     return el('tr', {'data-outcome': o.outcome, 'data-index': i},
       el('td', {}, when(o.finishedMillis)),
-      el('td', {}, (o.actions || []).join('\n')),
+      el('td', {}, (o.actions || []).join('; ')),
       el('td', {class: o.outcome === 'committed' ? '' : 'arflex-bad'}, OUTCOME_TEXT[o.outcome] || o.outcome),
       el('td', {}, o.why || ''), el('td', {}, ups),
       el('td', {}, o.applied ? (o.prepareMs.toFixed(1) + ' ms / ' + (o.switchUs / 1000).toFixed(1) + ' ms') : ''),
@@ -126,6 +129,7 @@
         'Applying: ' + s.applying.actions.join('; ') + ' — since ' + when(s.applying.startedMillis)
         + ' (' + (s.applying.forMs / 1000).toFixed(1) + ' s; prepared halves, shadow runs and rollback windows take their cycles)'));
     } else if (s.last) {
+      if (applyingShown) { status.replaceChildren(); applyingShown = false; }
       const o = s.last;
       progress.replaceChildren(el('div', {class: 'arflex-msg ' + (o.outcome === 'committed' ? 'arflex-msg-ok' : 'arflex-msg-error'),
         id: 'arflex-cs-outcome', 'data-outcome': o.outcome},

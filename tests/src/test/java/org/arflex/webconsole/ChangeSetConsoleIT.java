@@ -356,9 +356,9 @@ class ChangeSetConsoleIT {
         b.click(b.findAll("#arflex-cs-plan-btn").get(0));
     }
 
+    /** The text of the first element matching {@code css}, read in one call (the page redraws parts every second). */
     private static String textOf(Browser b, String css) {
-        List<String> e = b.findAll(css);
-        return e.isEmpty() ? null : b.text(e.get(0));
+        return (String) b.js("const e = document.querySelector(arguments[0]); return e ? e.innerText : null;", css);
     }
 
     @Test
@@ -388,10 +388,10 @@ class ChangeSetConsoleIT {
             assertEquals("INSTALLED", state("sample-scaler"), "nothing happens before the apply");
             b.click(b.findAll("#arflex-cs-apply").get(0));
             String outcome = b.await("the outcome", WAIT, () -> {
-                List<String> e = b.findAll("#arflex-cs-outcome[data-outcome]");
-                String t = e.isEmpty() ? null : b.text(e.get(0));
-                return t != null && t.contains("install sample-scaler") ? t : null;
+                String t = textOf(b, "#arflex-cs-outcome[data-outcome]");
+                return t != null && t.startsWith("Last set applied here: install sample-scaler \u2014") ? t : null;
             }, b::source);
+            assertEquals(null, textOf(b, "#arflex-cs-status .arflex-msg"), "the note 'Applying the set' is gone");
             assertTrue(outcome.contains("committed"), outcome);
             RuntimeUnderTest.awaitCondition("sample-scaler ACTIVE", WAIT, () -> "ACTIVE".equals(state("sample-scaler")));
             b.await("three sets in the history", WAIT,
