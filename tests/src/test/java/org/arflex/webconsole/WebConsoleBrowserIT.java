@@ -393,7 +393,7 @@ class WebConsoleBrowserIT {
         assertEquals(0L, browser.js("return window.__submitted;"), "answered no: nothing submitted");
         own.put("system information, buttons", ownViolations());
         for (String page : List.of("arflex-cell", "arflex-deploy", "arflex-contract", "arflex-graph", "arflex-debug",
-                "arflex-audit")) {
+                "arflex-audit", "arflex-changesets")) {
             own.put(page, checkPage(page, "/system/console/" + page, "#arflex-app h2"));
         }
         List<String> errors = policyErrors();

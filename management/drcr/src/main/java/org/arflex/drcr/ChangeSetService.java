@@ -40,4 +40,11 @@ public interface ChangeSetService {
      * @since 0.7.0
      */
     ChangeSetDTO deploy(String url, boolean apply);
+
+    /**
+     * The outcomes of the sets applied in this runtime (refused ones included; dry runs not),
+     * newest first, at most 50, each with {@link ChangeSetDTO#finishedMillis}; in memory only
+     * (D46).
+     */
+    List<ChangeSetDTO> history();
 }

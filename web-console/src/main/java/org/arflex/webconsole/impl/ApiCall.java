@@ -40,6 +40,16 @@ final class ApiCall {
         return name;
     }
 
+    /** The authenticated user, as the audit log names it (null when unknown). */
+    String user() {
+        return AuditFilter.user(req);
+    }
+
+    /** The client's address. */
+    String remote() {
+        return req.getRemoteAddr();
+    }
+
     /** The request body as it comes; the caller closes it. */
     InputStream body() throws IOException {
         return req.getInputStream();

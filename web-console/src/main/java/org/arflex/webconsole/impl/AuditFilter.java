@@ -46,7 +46,7 @@ public class AuditFilter implements Filter {
     static final String HOME_PROPERTY = "arflex.home";
     /** The parameters recorded, when present. */
     static final List<String> PARAMS = List.of("action", "name", "param", "value", "cmd", "id", "file", "url",
-            "sha256", "targets", "apply", "delete", "propertylist", "factoryPid", "shutdown_type");
+            "sha256", "targets", "apply", "delete", "propertylist", "factoryPid", "shutdown_type", "actions", "plan");
     private static final Set<String> SAFE = Set.of("GET", "HEAD", "OPTIONS", "TRACE");
 
     private AuditLog log;

@@ -16,4 +16,9 @@ public class ChangeSetDTO {
     public double prepareMs;
     /** The switch's actor turn, µs (0 for a dry run or a refusal). */
     public double switchUs;
+    /**
+     * When the apply came back (ms since the epoch, the runtime's wall clock): set on the sets
+     * {@link org.arflex.drcr.ChangeSetService#history} lists; 0 for a dry run (D46).
+     */
+    public long finishedMillis;
 }

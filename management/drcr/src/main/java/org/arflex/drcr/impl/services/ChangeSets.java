@@ -82,6 +82,8 @@ public final class ChangeSets implements ChangeSetService {
     private volatile UpdatedBundles bundles;
     private volatile DeploymentSets deployments;
     private final Consumer<String> log;
+    /** The outcomes of the sets applied, for {@link #history} (D46). */
+    private final ChangeSetHistory history = new ChangeSetHistory(System::currentTimeMillis);
 
     public ChangeSets(Cell cell, BundleContext context, Consumer<String> log) {
         this.cell = cell;
@@ -219,6 +221,15 @@ public final class ChangeSets implements ChangeSetService {
 
     @Override
     public ChangeSetDTO apply(List<String> actions) {
+        return history.record(applyOnce(actions));
+    }
+
+    @Override
+    public List<ChangeSetDTO> history() {
+        return history.list();
+    }
+
+    private ChangeSetDTO applyOnce(List<String> actions) {
         List<String[]> parsed;
         try {
             parsed = parse(actions);

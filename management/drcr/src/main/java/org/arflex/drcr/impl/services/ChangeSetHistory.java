@@ -1,0 +1,58 @@
+package org.arflex.drcr.impl.services;
+
+import java.util.ArrayDeque;
+import java.util.ArrayList;
+import java.util.Deque;
+import java.util.List;
+import java.util.function.LongSupplier;
+import org.arflex.drcr.dto.ChangeSetDTO;
+
+/**
+ * The outcomes of the change sets applied in this runtime, newest first, at most {@link #MAX}
+ * (D46): what the console's Change sets page shows as its history, whether the set came from
+ * the console or from {@code arflex:change apply}. In memory only; a restart of the DRCR starts
+ * an empty history.
+ */
+final class ChangeSetHistory {
+    /** Outcomes kept; the oldest goes first. */
+    static final int MAX = 50;
+
+    private final Deque<ChangeSetDTO> entries = new ArrayDeque<>();
+    private final LongSupplier clock;
+
+    ChangeSetHistory(LongSupplier wallClockMillis) {
+        this.clock = wallClockMillis;
+    }
+
+    /** Records an apply's outcome (a copy, stamped with the time it came back); returns it. */
+    synchronized ChangeSetDTO record(ChangeSetDTO d) {
+        d.finishedMillis = clock.getAsLong();
+        entries.addFirst(copy(d));
+        while (entries.size() > MAX) {
+            entries.removeLast();
+        }
+        return d;
+    }
+
+    /** Newest first; copies, so a caller cannot change what is kept. */
+    synchronized List<ChangeSetDTO> list() {
+        List<ChangeSetDTO> out = new ArrayList<>(entries.size());
+        for (ChangeSetDTO d : entries) {
+            out.add(copy(d));
+        }
+        return out;
+    }
+
+    private static ChangeSetDTO copy(ChangeSetDTO d) {
+        ChangeSetDTO c = new ChangeSetDTO();
+        c.actions = d.actions == null ? new String[0] : d.actions.clone();
+        c.admitted = d.admitted;
+        c.applied = d.applied;
+        c.refusal = d.refusal;
+        c.text = d.text;
+        c.prepareMs = d.prepareMs;
+        c.switchUs = d.switchUs;
+        c.finishedMillis = d.finishedMillis;
+        return c;
+    }
+}
