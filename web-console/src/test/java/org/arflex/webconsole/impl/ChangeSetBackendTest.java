@@ -77,6 +77,11 @@ class ChangeSetBackendTest {
             }
 
             @Override
+            public ChangeSetDTO deploy(String url, boolean apply) {
+                throw new AssertionError("no deployment set here");
+            }
+
+            @Override
             public List<ChangeSetDTO> history() {
                 return applyAnswer == null ? List.of() : List.of(applyAnswer);
             }

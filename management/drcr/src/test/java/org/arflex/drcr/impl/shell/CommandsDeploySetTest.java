@@ -34,6 +34,11 @@ class CommandsDeploySetTest {
             d.refusal = url.contains("bad") ? "a jar" : null;
             return d;
         }
+
+        @Override
+        public List<ChangeSetDTO> history() {
+            throw new AssertionError("not a change set");
+        }
     };
 
     private final Commands cmd = new Commands(null, null, null, n -> Optional.empty(), new Commands.BundleUpdater() {
