@@ -9,7 +9,6 @@ import java.io.IOException;
 import java.nio.charset.StandardCharsets;
 import java.nio.file.Files;
 import java.nio.file.Path;
-import java.nio.file.attribute.PosixFilePermissions;
 import java.util.LinkedHashMap;
 import java.util.List;
 import java.util.Locale;
@@ -156,15 +155,9 @@ class ShadowRunIT {
         try (Runtime rt = new Runtime("shadow-crash")) {
             FailSafeIT.movingCell(rt);
             Path dir = Files.createDirectories(rt.dir.resolve("versions"));
-            Path real = dir.resolve("tcp-correction-rt");
-            Files.write(real, UpdateSetIT.entry(CellRig.TCP_CORRECTION, UpdateSetIT.EXE));
-            Files.setPosixFilePermissions(real, PosixFilePermissions.fromString("r-x------"));
-            String script = "#!/bin/sh\n"
-                    + "# ShadowRunIT's deliberately faulty tcp-correction: the real one, killed by SIGSEGV 150 ms after its spawn\n"
-                    + "( sleep 0.15; kill -SEGV $$ ) </dev/null >/dev/null 2>&1 &\n"
-                    + "exec " + real + " \"$@\"\n";
+            byte[] script = FaultyVersions.crashingAfterMs(dir, CellRig.TCP_CORRECTION, UpdateSetIT.EXE, 150, "ShadowRunIT");
             Path jar = version(dir, CellRig.TCP_CORRECTION, "tcp-correction-1.0.2-faulty", UpdateSetIT.CONTRACT,
-                    versioned("tcp-correction", "1.0.2-faulty"), UpdateSetIT.EXE, script.getBytes(StandardCharsets.UTF_8));
+                    versioned("tcp-correction", "1.0.2-faulty"), UpdateSetIT.EXE, script);
             long oldPid = rt.pid("tcp-correction");
             String out = rejected(rt, "tcp-correction", jar, "shadow 200 tolerance corrected.q 0.000001");
             Matcher m = Pattern.compile("rejected in shadow after (\\d+) cycles: the new version \\(pid \\d+\\) exited: "

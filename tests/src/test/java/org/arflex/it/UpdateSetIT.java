@@ -9,7 +9,6 @@ import java.io.IOException;
 import java.nio.charset.StandardCharsets;
 import java.nio.file.Files;
 import java.nio.file.Path;
-import java.nio.file.attribute.PosixFilePermissions;
 import java.security.MessageDigest;
 import java.util.HexFormat;
 import java.util.List;
@@ -84,6 +83,14 @@ class UpdateSetIT {
             assertTrue(found, CONTRACT + " in " + CellRig.TCP_CORRECTION);
         }
         return out;
+    }
+
+    /**
+     * The deliberately faulty build 1.0.2-faulty (also ReconfigBench's): the real executable, run by a
+     * script that kills it by SIGSEGV 250 ms after its spawn (some 200 cycles after the switch).
+     */
+    static Path faulty(Path dir, String who) throws IOException {
+        return version(dir, "1.0.2-faulty", FaultyVersions.crashingAfterMs(dir, CellRig.TCP_CORRECTION, EXE, 250, who));
     }
 
     static byte[] entry(Path jar, String name) throws IOException {
@@ -337,16 +344,7 @@ class UpdateSetIT {
         CellRig.assertBuilt(CellRig.SIM_ROBOT, CellRig.TRAJECTORY, CellRig.FORCE_GUARD, CellRig.TCP_CORRECTION);
         try (Runtime rt = new Runtime("update-rollback")) {
             FailSafeIT.movingCell(rt);
-            Path dir = Files.createDirectories(rt.dir.resolve("versions"));
-            // the real executable beside a script that runs it and crashes it: a faulty build
-            Path real = dir.resolve("tcp-correction-rt");
-            Files.write(real, entry(CellRig.TCP_CORRECTION, EXE));
-            Files.setPosixFilePermissions(real, PosixFilePermissions.fromString("r-x------"));
-            String script = "#!/bin/sh\n"
-                    + "# UpdateSetIT's deliberately faulty tcp-correction: the real one, killed by SIGSEGV 250 ms after its spawn\n"
-                    + "( sleep 0.25; kill -SEGV $$ ) </dev/null >/dev/null 2>&1 &\n"
-                    + "exec " + real + " \"$@\"\n";
-            Path jar = version(dir, "1.0.2-faulty", script.getBytes(StandardCharsets.UTF_8));
+            Path jar = faulty(Files.createDirectories(rt.dir.resolve("versions")), "UpdateSetIT");
 
             Run r = update(rt, jar, 5000);
             assertTrue(r.out().contains("update tcp-correction: rolled back after ") && r.out().contains("killed by signal 11")
