@@ -6,7 +6,6 @@ import static org.junit.jupiter.api.Assertions.assertNull;
 import static org.junit.jupiter.api.Assertions.assertTrue;
 
 import java.io.IOException;
-import java.nio.charset.StandardCharsets;
 import java.nio.file.Files;
 import java.nio.file.Path;
 import java.util.LinkedHashMap;
@@ -16,9 +15,6 @@ import java.util.Map;
 import java.util.function.UnaryOperator;
 import java.util.regex.Matcher;
 import java.util.regex.Pattern;
-import java.util.zip.ZipEntry;
-import java.util.zip.ZipFile;
-import java.util.zip.ZipOutputStream;
 import org.junit.jupiter.api.Test;
 
 /**
@@ -50,27 +46,12 @@ class ShadowRunIT {
      */
     static Path version(Path dir, Path bundle, String name, String contractEntry, UnaryOperator<String> contract,
                         String exeEntry, byte[] exe) throws IOException {
-        Path out = dir.resolve(name + ".jar");
-        try (ZipFile in = new ZipFile(bundle.toFile()); ZipOutputStream zo = new ZipOutputStream(Files.newOutputStream(out))) {
-            boolean found = false;
-            for (ZipEntry e : java.util.Collections.list(in.entries())) {
-                byte[] b = in.getInputStream(e).readAllBytes();
-                if (e.getName().equals(contractEntry)) {
-                    String xml = new String(b, StandardCharsets.UTF_8);
-                    String changed = contract.apply(xml);
-                    assertNotEquals(xml, changed, "the contract of " + name);
-                    b = changed.getBytes(StandardCharsets.UTF_8);
-                    found = true;
-                } else if (e.getName().equals(exeEntry) && exe != null) {
-                    b = exe;
-                }
-                zo.putNextEntry(new ZipEntry(e.getName()));
-                zo.write(b);
-                zo.closeEntry();
-            }
-            assertTrue(found, contractEntry + " in " + bundle);
+        Map<String, UnaryOperator<byte[]>> edits = new LinkedHashMap<>();
+        edits.put(contractEntry, BundleCopies.text(contract, "the contract of " + name));
+        if (exe != null) {
+            edits.put(exeEntry, b -> exe);
         }
-        return out;
+        return BundleCopies.copy(dir, bundle, name, edits);
     }
 
     static UnaryOperator<String> versioned(String component, String version) {

@@ -6,18 +6,17 @@ import static org.junit.jupiter.api.Assertions.assertNull;
 import static org.junit.jupiter.api.Assertions.assertTrue;
 
 import java.io.IOException;
-import java.nio.charset.StandardCharsets;
 import java.nio.file.Files;
 import java.nio.file.Path;
 import java.security.MessageDigest;
 import java.util.HexFormat;
+import java.util.LinkedHashMap;
 import java.util.List;
 import java.util.Locale;
 import java.util.Map;
 import java.util.concurrent.CompletableFuture;
-import java.util.zip.ZipEntry;
+import java.util.function.UnaryOperator;
 import java.util.zip.ZipFile;
-import java.util.zip.ZipOutputStream;
 import org.junit.jupiter.api.Test;
 
 /**
@@ -54,35 +53,16 @@ class UpdateSetIT {
 
     /** A copy of the tcp-correction bundle with its contract's version set, and its executable replaced when given. */
     static Path version(Path dir, String version, byte[] exe) throws IOException {
-        Path out = dir.resolve("tcp-correction-" + version + ".jar");
-        try (ZipFile in = new ZipFile(CellRig.TCP_CORRECTION.toFile());
-                ZipOutputStream zo = new ZipOutputStream(Files.newOutputStream(out))) {
-            boolean found = false;
-            for (ZipEntry e : java.util.Collections.list(in.entries())) {
-                byte[] b = in.getInputStream(e).readAllBytes();
-                if (e.getName().equals(CONTRACT)) {
-                    String xml = new String(b, StandardCharsets.UTF_8);
-                    String bumped = xml.replaceFirst("name=\"tcp-correction\" version=\"[^\"]+\"",
-                            "name=\"tcp-correction\" version=\"" + version + "\"");
-                    assertNotEquals(xml, bumped, "the contract's version attribute");
-                    b = bumped.getBytes(StandardCharsets.UTF_8);
-                    found = true;
-                } else if (e.getName().equals(EXE) && exe != null) {
-                    b = exe;
-                } else if (e.getName().equals("META-INF/MANIFEST.MF")) {
-                    // the bundle's version too, as a release would have it (OSGi: 1.0.2.faulty)
-                    String mf = new String(b, StandardCharsets.UTF_8);
-                    String bumped = mf.replaceFirst("Bundle-Version: [^\r\n]+", "Bundle-Version: " + version.replace('-', '.'));
-                    assertNotEquals(mf, bumped, "the manifest's Bundle-Version");
-                    b = bumped.getBytes(StandardCharsets.UTF_8);
-                }
-                zo.putNextEntry(new ZipEntry(e.getName()));
-                zo.write(b);
-                zo.closeEntry();
-            }
-            assertTrue(found, CONTRACT + " in " + CellRig.TCP_CORRECTION);
+        Map<String, UnaryOperator<byte[]>> edits = new LinkedHashMap<>();
+        edits.put(CONTRACT, BundleCopies.text(xml -> xml.replaceFirst("name=\"tcp-correction\" version=\"[^\"]+\"",
+                "name=\"tcp-correction\" version=\"" + version + "\""), "the contract's version attribute"));
+        if (exe != null) {
+            edits.put(EXE, b -> exe);
         }
-        return out;
+        // the bundle's version too, as a release would have it (OSGi: 1.0.2.faulty)
+        edits.put("META-INF/MANIFEST.MF", BundleCopies.text(mf -> mf.replaceFirst("Bundle-Version: [^\r\n]+",
+                "Bundle-Version: " + version.replace('-', '.')), "the manifest's Bundle-Version"));
+        return BundleCopies.copy(dir, CellRig.TCP_CORRECTION, "tcp-correction-" + version, edits);
     }
 
     /**
