@@ -45,9 +45,13 @@ final class ContractValidator {
     static final int MAX_INTENSITY = 1000;
 
     private final PortTypes types;
+    private final StateValidation stateValidation;
+    private final RolloutValidation rolloutValidation;
 
     ContractValidator(PortTypes types) {
         this.types = types;
+        this.stateValidation = new StateValidation(types);
+        this.rolloutValidation = new RolloutValidation(types);
     }
 
     Contract freeze(ContractXml x, String source, List<Problem> out) {
@@ -245,13 +249,13 @@ final class ContractValidator {
         // §12.1 state
         Optional<StateSpec> state = Optional.empty();
         if (x.state != null) {
-            state = state(p, x.state);
+            state = stateValidation.check(p, x.state);
         }
 
         // §12.2 rollout
         Optional<RolloutSpec> rollout = Optional.empty();
         if (x.rollout != null) {
-            rollout = rollout(p, x.rollout, ports);
+            rollout = rolloutValidation.check(p, x.rollout, ports);
         }
 
         if (!p.clean()) {
@@ -779,80 +783,6 @@ final class ContractValidator {
         return ms;
     }
 
-    /** §12.1: the state block's type (known, a state type), its version and the conversions it declares. */
-    private Optional<StateSpec> state(Problems p, ContractXml.StateXml x) {
-        boolean ok = true;
-        PortType type = null;
-        if (x.type == null) {
-            p.at(x, "12.1", "state/@type", "required attribute is missing (a port type, e.g. arflex.TrajectoryState)");
-            ok = false;
-        } else if (!PortTypes.TYPE_NAME.matcher(x.type).matches()) {
-            p.at(x, "12.1", "state/@type", "'" + x.type + "' is not a port type name (namespace.TypeName)");
-            ok = false;
-        } else {
-            type = types.find(x.type).orElse(null);
-            if (type == null) {
-                p.at(x, "12.1", "state/@type", "unknown port type '" + x.type + "'; known types: "
-                        + types.all().stream().map(PortType::name).toList());
-                ok = false;
-            } else if (!type.methods().contains(PortSpec.Method.STATE)) {
-                p.at(x, "12.1", "state/@type", "port type " + x.type + " does not allow the state method (it allows "
-                        + type.methods().stream().map(m -> m.name().toLowerCase(Locale.ROOT)).sorted().toList() + ")");
-                ok = false;
-            }
-        }
-        TypeVersion tv = null;
-        if (x.typeVersion == null) {
-            p.at(x, "12.1", "state/@typeVersion", "required attribute is missing");
-            ok = false;
-        } else if (!TYPE_VERSION.matcher(x.typeVersion).matches()) {
-            p.at(x, "12.1", "state/@typeVersion", "'" + x.typeVersion + "' is not MAJOR.MINOR (e.g. 1.0)");
-            ok = false;
-        } else {
-            tv = TypeVersion.parse(x.typeVersion);
-            if (type != null && !type.version().canFeed(tv)) {
-                p.at(x, "12.1", "state/@typeVersion", "version mismatch: the contract is built against " + x.type + " "
-                        + tv + " but the known definition is " + type.version() + " (needs major " + tv.major()
-                        + " and minor >= " + tv.minor() + ")");
-                ok = false;
-            }
-        }
-        List<StateSpec.From> froms = new ArrayList<>();
-        for (ContractXml.From f : x.convertsFrom) {
-            String at = "state/convertsFrom[" + (f.type == null ? "" : f.type) + "]";
-            boolean fine = true;
-            if (f.type == null) {
-                p.at(f, "12.1", at + "/@type", "required attribute is missing");
-                fine = false;
-            } else if (!PortTypes.TYPE_NAME.matcher(f.type).matches()) {
-                p.at(f, "12.1", at + "/@type", "'" + f.type + "' is not a port type name (namespace.TypeName)");
-                fine = false;
-            }
-            if (f.typeVersion == null) {
-                p.at(f, "12.1", at + "/@typeVersion", "required attribute is missing");
-                fine = false;
-            } else if (!TYPE_VERSION.matcher(f.typeVersion).matches()) {
-                p.at(f, "12.1", at + "/@typeVersion", "'" + f.typeVersion + "' is not MAJOR.MINOR (e.g. 1.0)");
-                fine = false;
-            }
-            if (!fine) {
-                ok = false;
-                continue;
-            }
-            StateSpec.From from = new StateSpec.From(f.type, TypeVersion.parse(f.typeVersion));
-            if (froms.contains(from)) {
-                p.at(f, "12.1", at, "conversion from " + from + " is declared twice");
-                ok = false;
-            } else if (tv != null && from.type().equals(x.type) && from.typeVersion().canFeed(tv)) {
-                p.at(f, "12.1", at, "no conversion needed: " + from + " is adopted as it is (same type, a version that "
-                        + "feeds " + tv + ")");
-                ok = false;
-            }
-            froms.add(from);
-        }
-        return ok ? Optional.of(new StateSpec(x.type, tv, froms)) : Optional.empty();
-    }
-
     private static Optional<UpdateSpec> update(Problems p, ContractXml.Update u) {
         boolean ok = true;
         URI uri = null;
@@ -890,105 +820,6 @@ final class ContractValidator {
             ok = false;
         }
         return ok ? Optional.of(new UpdateSpec(uri, u.sha256.toLowerCase(Locale.ROOT))) : Optional.empty();
-    }
-
-    /** §12.2: the shadow run's and the window's cycles, and rules on the outputs' numeric fields. */
-    private Optional<RolloutSpec> rollout(Problems p, ContractXml.Rollout r, List<PortSpec> ports) {
-        boolean ok = true;
-        java.util.OptionalLong shadow = java.util.OptionalLong.empty();
-        java.util.OptionalLong window = java.util.OptionalLong.empty();
-        for (String[] a : new String[][] {{"shadow", r.shadow}, {"window", r.window}}) {
-            if (a[1] == null) {
-                continue;
-            }
-            Long n = Values.longValue(a[1].trim());
-            if (n == null || n < 0 || n > RolloutSpec.MAX_CYCLES) {
-                p.at(r, "12.2", "rollout/@" + a[0], "'" + a[1] + "' is not a number of cycles (an integer 0.."
-                        + RolloutSpec.MAX_CYCLES + ")");
-                ok = false;
-            } else if (a[0].equals("shadow")) {
-                shadow = java.util.OptionalLong.of(n);
-            } else {
-                window = java.util.OptionalLong.of(n);
-            }
-        }
-        List<RolloutSpec.Tolerance> tolerances = new ArrayList<>();
-        Set<String> seen = new HashSet<>();
-        for (ContractXml.OutputRule t : r.tolerances) {
-            String f = "rollout/tolerance[" + t.port + "." + t.field + "]";
-            boolean good = outputField(p, t, ports, f);
-            if (good && !seen.add(t.port + "." + t.field)) {
-                p.at(t, "12.2", f, "a second tolerance for " + t.port + "." + t.field);
-                good = false;
-            }
-            Double abs = t.abs == null ? null : Values.decimal(t.abs.trim());
-            if (t.abs == null) {
-                p.at(t, "12.2", f + "/@abs", "required attribute is missing (the largest difference, >= 0)");
-                good = false;
-            } else if (abs == null || !Double.isFinite(abs) || abs < 0) {
-                p.at(t, "12.2", f + "/@abs", "'" + t.abs + "' is not a tolerance (a finite number >= 0)");
-                good = false;
-            }
-            if (good) {
-                tolerances.add(new RolloutSpec.Tolerance(t.port, t.field, abs));
-            }
-            ok &= good;
-        }
-        List<RolloutSpec.Envelope> envelopes = new ArrayList<>();
-        for (ContractXml.OutputRule e : r.envelopes) {
-            String f = "rollout/envelope[" + e.port + "." + e.field + "]";
-            boolean good = outputField(p, e, ports, f);
-            Double min = e.min == null ? null : Values.decimal(e.min.trim());
-            Double max = e.max == null ? null : Values.decimal(e.max.trim());
-            for (String[] a : new String[][] {{"min", e.min}, {"max", e.max}}) {
-                if (a[1] == null) {
-                    p.at(e, "12.2", f + "/@" + a[0], "required attribute is missing (a number)");
-                    good = false;
-                } else if (Values.decimal(a[1].trim()) == null || !Double.isFinite(Values.decimal(a[1].trim()))) {
-                    p.at(e, "12.2", f + "/@" + a[0], "'" + a[1] + "' is not a finite number");
-                    good = false;
-                }
-            }
-            if (good && !(min <= max)) {
-                p.at(e, "12.2", f, "min " + e.min + " is greater than max " + e.max);
-                good = false;
-            }
-            if (good) {
-                envelopes.add(new RolloutSpec.Envelope(e.port, e.field, min, max));
-            }
-            ok &= good;
-        }
-        return ok ? Optional.of(new RolloutSpec(shadow, window, tolerances, envelopes)) : Optional.empty();
-    }
-
-    /** The rule names an output of this contract and a numeric field of its port type. */
-    private boolean outputField(Problems p, ContractXml.OutputRule r, List<PortSpec> ports, String f) {
-        if (r.port == null || r.field == null) {
-            p.at(r, "12.2", f + (r.port == null ? "/@port" : "/@field"), "required attribute is missing");
-            return false;
-        }
-        PortSpec out = ports.stream().filter(q -> q.name().equals(r.port)).findFirst().orElse(null);
-        if (out == null || out.direction() != PortSpec.Direction.OUT) {
-            p.at(r, "12.2", f + "/@port", out == null ? "no output '" + r.port + "' is declared (ports/out)"
-                    : "'" + r.port + "' is an input; only outputs are compared");
-            return false;
-        }
-        PortType type = types.find(out.type()).orElse(null);
-        if (type == null) {
-            return false; // reported under §6.2
-        }
-        PortType.Field fd = type.field(r.field).orElse(null);
-        if (fd == null || fd.padding()) {
-            p.at(r, "12.2", f + "/@field", "port type " + type.name() + " has no field '" + r.field + "'; its fields: "
-                    + type.fields().stream().filter(x -> !x.padding()).map(PortType.Field::name).toList());
-            return false;
-        }
-        if (fd.scalar() == PortType.Scalar.U8 && fd.count() > 1) {
-            p.at(r, "12.2", f + "/@field", "field '" + r.field + "' of " + type.name() + " is bytes (u8["
-                    + fd.count() + "]), not a numeric value");
-            return false;
-        }
-        return true;
     }
 
     private static boolean bool(Problems p, Located node, String text, boolean dflt, String section, String field) {

@@ -5,7 +5,6 @@ import static org.junit.jupiter.api.Assertions.assertTrue;
 import java.nio.charset.StandardCharsets;
 import java.nio.file.Files;
 import java.nio.file.Path;
-import java.nio.file.attribute.PosixFilePermissions;
 import java.util.ArrayList;
 import java.util.List;
 import java.util.Locale;
@@ -100,7 +99,7 @@ class ReconfigBench {
             Path dir = Files.createDirectories(rt.dir.resolve("versions"));
             Path v101 = UpdateSetIT.version(dir, "1.0.1", null);
             Path v100 = Files.copy(CellRig.TCP_CORRECTION, dir.resolve("tcp-correction-1.0.0.jar"));
-            Path faulty = faulty(dir);
+            Path faulty = UpdateSetIT.faulty(dir, "ReconfigBench");
             String upd = "update tcp-correction file:";
             String[][] examples = {
                 {"teach replaces trajectory", "install teach uninstall trajectory"},
@@ -128,18 +127,6 @@ class ReconfigBench {
         report(rows);
         assertTrue(rows.stream().allMatch(Row::ok), "sets that did not end as their example says: "
                 + rows.stream().filter(r -> !r.ok()).map(r -> r.example() + " #" + r.rep() + ": " + r.note()).toList());
-    }
-
-    /** UpdateSetIT's deliberately faulty build: the real executable, killed by SIGSEGV 250 ms after its spawn. */
-    static Path faulty(Path dir) throws Exception {
-        Path real = dir.resolve("tcp-correction-rt");
-        Files.write(real, UpdateSetIT.entry(CellRig.TCP_CORRECTION, UpdateSetIT.EXE));
-        Files.setPosixFilePermissions(real, PosixFilePermissions.fromString("r-x------"));
-        String script = "#!/bin/sh\n"
-                + "# ReconfigBench's (UpdateSetIT's) deliberately faulty tcp-correction: SIGSEGV 250 ms after its spawn\n"
-                + "( sleep 0.25; kill -SEGV $$ ) </dev/null >/dev/null 2>&1 &\n"
-                + "exec " + real + " \"$@\"\n";
-        return UpdateSetIT.version(dir, "1.0.2-faulty", script.getBytes(StandardCharsets.UTF_8));
     }
 
     /** The object id the running half of {@code name} has (its process's --instance argument). */

@@ -6,10 +6,8 @@ import static org.junit.jupiter.api.Assertions.assertNull;
 import static org.junit.jupiter.api.Assertions.assertTrue;
 
 import java.io.IOException;
-import java.nio.charset.StandardCharsets;
 import java.nio.file.Files;
 import java.nio.file.Path;
-import java.nio.file.attribute.PosixFilePermissions;
 import java.util.LinkedHashMap;
 import java.util.List;
 import java.util.Locale;
@@ -17,9 +15,6 @@ import java.util.Map;
 import java.util.function.UnaryOperator;
 import java.util.regex.Matcher;
 import java.util.regex.Pattern;
-import java.util.zip.ZipEntry;
-import java.util.zip.ZipFile;
-import java.util.zip.ZipOutputStream;
 import org.junit.jupiter.api.Test;
 
 /**
@@ -51,27 +46,12 @@ class ShadowRunIT {
      */
     static Path version(Path dir, Path bundle, String name, String contractEntry, UnaryOperator<String> contract,
                         String exeEntry, byte[] exe) throws IOException {
-        Path out = dir.resolve(name + ".jar");
-        try (ZipFile in = new ZipFile(bundle.toFile()); ZipOutputStream zo = new ZipOutputStream(Files.newOutputStream(out))) {
-            boolean found = false;
-            for (ZipEntry e : java.util.Collections.list(in.entries())) {
-                byte[] b = in.getInputStream(e).readAllBytes();
-                if (e.getName().equals(contractEntry)) {
-                    String xml = new String(b, StandardCharsets.UTF_8);
-                    String changed = contract.apply(xml);
-                    assertNotEquals(xml, changed, "the contract of " + name);
-                    b = changed.getBytes(StandardCharsets.UTF_8);
-                    found = true;
-                } else if (e.getName().equals(exeEntry) && exe != null) {
-                    b = exe;
-                }
-                zo.putNextEntry(new ZipEntry(e.getName()));
-                zo.write(b);
-                zo.closeEntry();
-            }
-            assertTrue(found, contractEntry + " in " + bundle);
+        Map<String, UnaryOperator<byte[]>> edits = new LinkedHashMap<>();
+        edits.put(contractEntry, BundleCopies.text(contract, "the contract of " + name));
+        if (exe != null) {
+            edits.put(exeEntry, b -> exe);
         }
-        return out;
+        return BundleCopies.copy(dir, bundle, name, edits);
     }
 
     static UnaryOperator<String> versioned(String component, String version) {
@@ -156,15 +136,9 @@ class ShadowRunIT {
         try (Runtime rt = new Runtime("shadow-crash")) {
             FailSafeIT.movingCell(rt);
             Path dir = Files.createDirectories(rt.dir.resolve("versions"));
-            Path real = dir.resolve("tcp-correction-rt");
-            Files.write(real, UpdateSetIT.entry(CellRig.TCP_CORRECTION, UpdateSetIT.EXE));
-            Files.setPosixFilePermissions(real, PosixFilePermissions.fromString("r-x------"));
-            String script = "#!/bin/sh\n"
-                    + "# ShadowRunIT's deliberately faulty tcp-correction: the real one, killed by SIGSEGV 150 ms after its spawn\n"
-                    + "( sleep 0.15; kill -SEGV $$ ) </dev/null >/dev/null 2>&1 &\n"
-                    + "exec " + real + " \"$@\"\n";
+            byte[] script = FaultyVersions.crashingAfterMs(dir, CellRig.TCP_CORRECTION, UpdateSetIT.EXE, 150, "ShadowRunIT");
             Path jar = version(dir, CellRig.TCP_CORRECTION, "tcp-correction-1.0.2-faulty", UpdateSetIT.CONTRACT,
-                    versioned("tcp-correction", "1.0.2-faulty"), UpdateSetIT.EXE, script.getBytes(StandardCharsets.UTF_8));
+                    versioned("tcp-correction", "1.0.2-faulty"), UpdateSetIT.EXE, script);
             long oldPid = rt.pid("tcp-correction");
             String out = rejected(rt, "tcp-correction", jar, "shadow 200 tolerance corrected.q 0.000001");
             Matcher m = Pattern.compile("rejected in shadow after (\\d+) cycles: the new version \\(pid \\d+\\) exited: "

@@ -6,7 +6,6 @@ import static org.junit.jupiter.api.Assertions.assertNull;
 import static org.junit.jupiter.api.Assertions.assertTrue;
 
 import java.io.IOException;
-import java.nio.charset.StandardCharsets;
 import java.nio.file.Files;
 import java.nio.file.Path;
 import java.util.List;
@@ -14,9 +13,6 @@ import java.util.Locale;
 import java.util.Map;
 import java.util.concurrent.CompletableFuture;
 import java.util.function.UnaryOperator;
-import java.util.zip.ZipEntry;
-import java.util.zip.ZipFile;
-import java.util.zip.ZipOutputStream;
 import org.junit.jupiter.api.Test;
 
 /**
@@ -72,28 +68,11 @@ class StateTransferIT {
 
     /** A copy of the trajectory bundle with its contract's version set and {@code edit} applied to the contract. */
     static Path version(Path dir, String version, UnaryOperator<String> edit) throws IOException {
-        Path out = dir.resolve("trajectory-" + version + ".jar");
-        try (ZipFile in = new ZipFile(CellRig.TRAJECTORY.toFile());
-                ZipOutputStream zo = new ZipOutputStream(Files.newOutputStream(out))) {
-            boolean found = false;
-            for (ZipEntry e : java.util.Collections.list(in.entries())) {
-                byte[] b = in.getInputStream(e).readAllBytes();
-                if (e.getName().equals(CONTRACT)) {
-                    String xml = new String(b, StandardCharsets.UTF_8);
-                    assertTrue(xml.contains(STATE), "the built trajectory declares its state block");
-                    String bumped = edit.apply(xml.replaceFirst("name=\"trajectory\" version=\"[^\"]+\"",
-                            "name=\"trajectory\" version=\"" + version + "\""));
-                    assertNotEquals(xml, bumped);
-                    b = bumped.getBytes(StandardCharsets.UTF_8);
-                    found = true;
-                }
-                zo.putNextEntry(new ZipEntry(e.getName()));
-                zo.write(b);
-                zo.closeEntry();
-            }
-            assertTrue(found, CONTRACT + " in " + CellRig.TRAJECTORY);
-        }
-        return out;
+        return BundleCopies.copy(dir, CellRig.TRAJECTORY, "trajectory-" + version, Map.of(CONTRACT, BundleCopies.text(xml -> {
+            assertTrue(xml.contains(STATE), "the built trajectory declares its state block");
+            return edit.apply(xml.replaceFirst("name=\"trajectory\" version=\"[^\"]+\"",
+                    "name=\"trajectory\" version=\"" + version + "\""));
+        }, "the contract of trajectory " + version)));
     }
 
     @Test

@@ -6,19 +6,17 @@ import static org.junit.jupiter.api.Assertions.assertNull;
 import static org.junit.jupiter.api.Assertions.assertTrue;
 
 import java.io.IOException;
-import java.nio.charset.StandardCharsets;
 import java.nio.file.Files;
 import java.nio.file.Path;
-import java.nio.file.attribute.PosixFilePermissions;
 import java.security.MessageDigest;
 import java.util.HexFormat;
+import java.util.LinkedHashMap;
 import java.util.List;
 import java.util.Locale;
 import java.util.Map;
 import java.util.concurrent.CompletableFuture;
-import java.util.zip.ZipEntry;
+import java.util.function.UnaryOperator;
 import java.util.zip.ZipFile;
-import java.util.zip.ZipOutputStream;
 import org.junit.jupiter.api.Test;
 
 /**
@@ -55,35 +53,24 @@ class UpdateSetIT {
 
     /** A copy of the tcp-correction bundle with its contract's version set, and its executable replaced when given. */
     static Path version(Path dir, String version, byte[] exe) throws IOException {
-        Path out = dir.resolve("tcp-correction-" + version + ".jar");
-        try (ZipFile in = new ZipFile(CellRig.TCP_CORRECTION.toFile());
-                ZipOutputStream zo = new ZipOutputStream(Files.newOutputStream(out))) {
-            boolean found = false;
-            for (ZipEntry e : java.util.Collections.list(in.entries())) {
-                byte[] b = in.getInputStream(e).readAllBytes();
-                if (e.getName().equals(CONTRACT)) {
-                    String xml = new String(b, StandardCharsets.UTF_8);
-                    String bumped = xml.replaceFirst("name=\"tcp-correction\" version=\"[^\"]+\"",
-                            "name=\"tcp-correction\" version=\"" + version + "\"");
-                    assertNotEquals(xml, bumped, "the contract's version attribute");
-                    b = bumped.getBytes(StandardCharsets.UTF_8);
-                    found = true;
-                } else if (e.getName().equals(EXE) && exe != null) {
-                    b = exe;
-                } else if (e.getName().equals("META-INF/MANIFEST.MF")) {
-                    // the bundle's version too, as a release would have it (OSGi: 1.0.2.faulty)
-                    String mf = new String(b, StandardCharsets.UTF_8);
-                    String bumped = mf.replaceFirst("Bundle-Version: [^\r\n]+", "Bundle-Version: " + version.replace('-', '.'));
-                    assertNotEquals(mf, bumped, "the manifest's Bundle-Version");
-                    b = bumped.getBytes(StandardCharsets.UTF_8);
-                }
-                zo.putNextEntry(new ZipEntry(e.getName()));
-                zo.write(b);
-                zo.closeEntry();
-            }
-            assertTrue(found, CONTRACT + " in " + CellRig.TCP_CORRECTION);
+        Map<String, UnaryOperator<byte[]>> edits = new LinkedHashMap<>();
+        edits.put(CONTRACT, BundleCopies.text(xml -> xml.replaceFirst("name=\"tcp-correction\" version=\"[^\"]+\"",
+                "name=\"tcp-correction\" version=\"" + version + "\""), "the contract's version attribute"));
+        if (exe != null) {
+            edits.put(EXE, b -> exe);
         }
-        return out;
+        // the bundle's version too, as a release would have it (OSGi: 1.0.2.faulty)
+        edits.put("META-INF/MANIFEST.MF", BundleCopies.text(mf -> mf.replaceFirst("Bundle-Version: [^\r\n]+",
+                "Bundle-Version: " + version.replace('-', '.')), "the manifest's Bundle-Version"));
+        return BundleCopies.copy(dir, CellRig.TCP_CORRECTION, "tcp-correction-" + version, edits);
+    }
+
+    /**
+     * The deliberately faulty build 1.0.2-faulty (also ReconfigBench's): the real executable, run by a
+     * script that kills it by SIGSEGV 250 ms after its spawn (some 200 cycles after the switch).
+     */
+    static Path faulty(Path dir, String who) throws IOException {
+        return version(dir, "1.0.2-faulty", FaultyVersions.crashingAfterMs(dir, CellRig.TCP_CORRECTION, EXE, 250, who));
     }
 
     static byte[] entry(Path jar, String name) throws IOException {
@@ -337,16 +324,7 @@ class UpdateSetIT {
         CellRig.assertBuilt(CellRig.SIM_ROBOT, CellRig.TRAJECTORY, CellRig.FORCE_GUARD, CellRig.TCP_CORRECTION);
         try (Runtime rt = new Runtime("update-rollback")) {
             FailSafeIT.movingCell(rt);
-            Path dir = Files.createDirectories(rt.dir.resolve("versions"));
-            // the real executable beside a script that runs it and crashes it: a faulty build
-            Path real = dir.resolve("tcp-correction-rt");
-            Files.write(real, entry(CellRig.TCP_CORRECTION, EXE));
-            Files.setPosixFilePermissions(real, PosixFilePermissions.fromString("r-x------"));
-            String script = "#!/bin/sh\n"
-                    + "# UpdateSetIT's deliberately faulty tcp-correction: the real one, killed by SIGSEGV 250 ms after its spawn\n"
-                    + "( sleep 0.25; kill -SEGV $$ ) </dev/null >/dev/null 2>&1 &\n"
-                    + "exec " + real + " \"$@\"\n";
-            Path jar = version(dir, "1.0.2-faulty", script.getBytes(StandardCharsets.UTF_8));
+            Path jar = faulty(Files.createDirectories(rt.dir.resolve("versions")), "UpdateSetIT");
 
             Run r = update(rt, jar, 5000);
             assertTrue(r.out().contains("update tcp-correction: rolled back after ") && r.out().contains("killed by signal 11")

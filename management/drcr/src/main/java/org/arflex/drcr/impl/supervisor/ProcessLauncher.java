@@ -11,7 +11,6 @@ import java.security.SecureRandom;
 import java.util.ArrayDeque;
 import java.util.Deque;
 import java.util.List;
-import java.util.Optional;
 import java.util.concurrent.CompletableFuture;
 import java.util.concurrent.TimeUnit;
 import java.util.concurrent.locks.LockSupport;
@@ -35,12 +34,6 @@ public final class ProcessLauncher implements RtLauncher {
 
     /** Mailbox call timeout. */
     static final long CALL_TIMEOUT_MS = 2_000;
-    /** Waits for the answers the actor did not wait for (D39); daemon threads, made as needed. */
-    private static final java.util.concurrent.ExecutorService CONFIRMER = java.util.concurrent.Executors.newCachedThreadPool(r -> {
-        Thread t = new Thread(r, "arflex-mailbox-confirm");
-        t.setDaemon(true);
-        return t;
-    });
     /**
      * Deadline of each mailbox command on the way out (UNBIND, STOP, SHUTDOWN): a cooperating
      * half answers within a cycle or two; one that does not is terminated, not waited for.
@@ -53,6 +46,7 @@ public final class ProcessLauncher implements RtLauncher {
 
     private final Consumer<String> log;
     private final VerifiedExecutables executables;
+    private final RebindConfirmer confirmer = new RebindConfirmer();
 
     /** @param executables every executable is checked against it before it is spawned */
     public ProcessLauncher(Consumer<String> log, VerifiedExecutables executables) {
@@ -150,7 +144,7 @@ public final class ProcessLauncher implements RtLauncher {
         // p.getOutputStream() is the supervisor pipe: held open until cleanup(); its first 8
         // bytes are the token (a half that died at once is reported by the wait below)
         mb.watch(p::isAlive); // a call to a half that has exited ends at once, not at its timeout
-        ProcessRtHalf half = new ProcessRtHalf(inst, p, ctl, mb, p.getOutputStream());
+        ProcessRtHalf half = new ProcessRtHalf(inst, p, ctl, mb, p.getOutputStream(), confirmer);
         sendToken(p.getOutputStream(), token);
         half.pumpOutput(log);
         // Wait for READY (or a failure) with a deadline; the RT half attaches, configures and
@@ -217,6 +211,7 @@ public final class ProcessLauncher implements RtLauncher {
         private final ControlBlock ctl;
         private final Mailbox mb;
         private final OutputStream supervisorPipe;
+        private final RebindConfirmer confirmer;
         private final Deque<String> tail = new ArrayDeque<>();
         private Thread pump;
         private final CompletableFuture<Exit> exit;
@@ -225,12 +220,14 @@ public final class ProcessLauncher implements RtLauncher {
         // control block, so every ctl access and the cleanup hold this object's lock.
         private boolean cleaned;
 
-        ProcessRtHalf(String inst, Process process, ControlBlock ctl, Mailbox mb, OutputStream supervisorPipe) {
+        ProcessRtHalf(String inst, Process process, ControlBlock ctl, Mailbox mb, OutputStream supervisorPipe,
+                      RebindConfirmer confirmer) {
             this.inst = inst;
             this.process = process;
             this.ctl = ctl;
             this.mb = mb;
             this.supervisorPipe = supervisorPipe;
+            this.confirmer = confirmer;
             this.exit = new CompletableFuture<>();
             // Its own waiter, woken by the JDK's reaper (which waits in waitpid) directly:
             // Process.onExit() would complete on the common fork-join pool (one thread on two
@@ -329,50 +326,7 @@ public final class ProcessLauncher implements RtLauncher {
 
         @Override
         public CompletableFuture<Void> rebind(String port, String segment, long waitMs) {
-            Mailbox.Cmd c = segment != null ? Mailbox.Cmd.BIND : Mailbox.Cmd.UNBIND;
-            String what = c + " " + inst + "." + port + (segment != null ? " to " + segment : "");
-            int s;
-            try {
-                s = segment != null ? mb.sendBind(port, segment, CALL_TIMEOUT_MS) : mb.sendUnbind(port, CALL_TIMEOUT_MS);
-            } catch (IOException | RuntimeException e) {
-                return CompletableFuture.failedFuture(e);
-            }
-            CompletableFuture<Void> done = new CompletableFuture<>();
-            long t0 = System.nanoTime();
-            Runnable rest = () -> {
-                try {
-                    long left = CALL_TIMEOUT_MS - (System.nanoTime() - t0) / 1_000_000L;
-                    Optional<Mailbox.Reply> r = mb.await(c, s, Math.max(0, left));
-                    if (r.isEmpty()) {
-                        done.completeExceptionally(new IOException(what + ": no reply within " + CALL_TIMEOUT_MS + " ms"));
-                    } else if (r.get().status() != 0) {
-                        done.completeExceptionally(new IOException(what + " refused: status " + r.get().status()));
-                    } else {
-                        done.complete(null);
-                    }
-                } catch (IOException | RuntimeException e) {
-                    done.completeExceptionally(e);
-                } finally {
-                    mb.forget(s);
-                }
-            };
-            try {
-                Optional<Mailbox.Reply> r = mb.await(c, s, waitMs);
-                if (r.isPresent()) {
-                    mb.forget(s);
-                    if (r.get().status() != 0) {
-                        done.completeExceptionally(new IOException(what + " refused: status " + r.get().status()));
-                    } else {
-                        done.complete(null);
-                    }
-                    return done;
-                }
-            } catch (IOException | RuntimeException e) {
-                mb.forget(s);
-                return CompletableFuture.failedFuture(e);
-            }
-            CONFIRMER.execute(rest); // the rest of the wait, off the caller's thread
-            return done;
+            return confirmer.rebind(mb, inst, port, segment, waitMs, CALL_TIMEOUT_MS);
         }
 
         @Override

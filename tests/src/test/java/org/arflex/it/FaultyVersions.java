@@ -1,0 +1,41 @@
+package org.arflex.it;
+
+import java.io.IOException;
+import java.math.BigDecimal;
+import java.nio.charset.StandardCharsets;
+import java.nio.file.Files;
+import java.nio.file.Path;
+import java.nio.file.attribute.PosixFilePermissions;
+
+/**
+ * Deliberately faulty builds of a component for the update tests (UpdateSetIT, ShadowRunIT,
+ * ReconfigBench): the bundle's real executable, written beside a script that runs it with its
+ * arguments and kills it by SIGSEGV a fixed time after its spawn. The script takes the place of
+ * the executable in a copy of the bundle, which is then pinned and spawned like any other build.
+ */
+final class FaultyVersions {
+
+    private FaultyVersions() {
+    }
+
+    /**
+     * Writes the executable {@code exeEntry} of {@code bundle} into {@code dir} (read and execute
+     * for the owner only) and returns a {@code /bin/sh} script that execs it with the script's
+     * arguments, killed by SIGSEGV {@code afterMs} ms after its spawn; {@code who} (the test) is
+     * named in the script's comment.
+     */
+    static byte[] crashingAfterMs(Path dir, Path bundle, String exeEntry, long afterMs, String who)
+            throws IOException {
+        String file = exeEntry.substring(exeEntry.lastIndexOf('/') + 1);
+        Path real = dir.resolve(file);
+        Files.write(real, UpdateSetIT.entry(bundle, exeEntry));
+        Files.setPosixFilePermissions(real, PosixFilePermissions.fromString("r-x------"));
+        String seconds = BigDecimal.valueOf(afterMs, 3).stripTrailingZeros().toPlainString();
+        String script = "#!/bin/sh\n"
+                + "# " + who + "'s deliberately faulty " + file + ": the real one, killed by SIGSEGV " + afterMs
+                + " ms after its spawn\n"
+                + "( sleep " + seconds + "; kill -SEGV $$ ) </dev/null >/dev/null 2>&1 &\n"
+                + "exec " + real + " \"$@\"\n";
+        return script.getBytes(StandardCharsets.UTF_8);
+    }
+}
