@@ -458,10 +458,14 @@ int Step(struct arflex_component* c, uint64_t release_ns, bool force_stop) {
   // far from it). The trajectory comes to the arm: idle, the output moves there and the next
   // motion starts there; in a motion, the program starts over from its first motion at the arm
   // (as for a robot that appears). Not while a protective stop or safe mode holds on purpose:
-  // those resume where they stopped.
+  // those resume where they stopped. Once the stop's causes are gone and only the fresh
+  // command is awaited, the rule holds again: a robot that takes only a reference at rest near
+  // the arm after a stop (sim-robot) and an arm pushed or stopped further away than that would
+  // otherwise wait for each other for ever. Moving the held output to an arm at rest starts no
+  // motion (the rate stays 0 until the command).
   bool at_rest = arm;
   for (int j = 0; at_rest && j < 6; ++j) at_rest = std::fabs(js.qd[j]) < kRestSpeed;
-  if (!arflex_input_bound(g.in_state) || stopped_on_purpose) {
+  if (!arflex_input_bound(g.in_state) || stop_cause) {
     g.away_since = 0;
   } else if (arm) {
     if ((qm - g.player.q_out()).cwiseAbs().maxCoeff() <= kAwayTol || !at_rest) {

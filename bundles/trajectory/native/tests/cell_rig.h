@@ -130,6 +130,7 @@ void WriteRobot(struct arflex_host* script, const Model& m, const Q& q, const Q&
 void CaseTrajectory();      // test_cell_trajectory.cc
 void CaseProgramSwitch();   // test_cell_trajectory.cc
 void CaseLateRobot();       // test_cell_trajectory.cc
+void CaseStopAway();        // test_cell_stop_away.cc
 void CaseStateTransfer();   // test_cell_state_transfer.cc
 void CaseForceGuard();      // test_cell_force_guard.cc
 void CaseTeachReplay();     // test_cell_teach.cc

@@ -1,7 +1,7 @@
 // test_cell - CTest cell.*: the cell's RT halves as processes under the rt-core host API,
 // wired as the DRCR would wire them; the test itself plays the robot and the sensors through
 // "script" instances whose output segments it writes.
-//   test_cell <trajectory|program_switch|late_robot|invalid_input|bad_program|force_guard|teach_replay|tools> <bin dir> <bundles dir>
+//   test_cell <trajectory|program_switch|late_robot|stop_away|invalid_input|bad_program|force_guard|teach_replay|tools> <bin dir> <bundles dir>
 // Each component (trajectory, force-guard, teach, tool-gripper, tool-spindle) is created from
 // its bundle's contract, <bundles dir>/<name>/src/main/resources/OSGI-INF/arflex/<name>.xml
 // (arflex_host_load_contract, docs/DECISIONS.md D32/D34): its ports, parameters with their
@@ -26,7 +26,7 @@ using namespace celltest;
 
 int main(int argc, char** argv) {
   if (argc != 4) {
-    fprintf(stderr, "usage: %s <trajectory|program_switch|late_robot|invalid_input|bad_program|force_guard|teach_replay|tools> <bin dir> <bundles dir>\n", argv[0]);
+    fprintf(stderr, "usage: %s <trajectory|program_switch|late_robot|stop_away|invalid_input|bad_program|force_guard|teach_replay|tools> <bin dir> <bundles dir>\n", argv[0]);
     return 2;
   }
   bindir = argv[2];
@@ -41,6 +41,7 @@ int main(int argc, char** argv) {
   else if (c == "program_switch") CaseProgramSwitch();
   else if (c == "state_transfer") CaseStateTransfer();
   else if (c == "late_robot") CaseLateRobot();
+  else if (c == "stop_away") CaseStopAway();
   else if (c == "invalid_input") CaseInvalidInput();
   else {
     fprintf(stderr, "unknown case '%s'\n", argv[1]);
