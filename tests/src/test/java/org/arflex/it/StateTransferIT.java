@@ -217,8 +217,8 @@ class StateTransferIT {
                             + "difference %.3g rad%n", n.get(0).seq(), o.get(mark - 1).seq(), same, sameDiff);
                     System.out.printf(Locale.ROOT, "StateTransferIT: the step of tcp-correction's input at the switch "
                             + "(the offset it took up, from its state block): %.3f mrad (%.3f before the apply; bound, "
-                            + "one cycle of the programmed motion: %.3f); between the two halves over the whole window: "
-                            + "%.3f mrad per source cycle%n", offset * 1e3, offsetBefore * 1e3, ONE_CYCLE * 1e3,
+                            + "two cycles of the programmed motion: %.3f); between the two halves over the whole window: "
+                            + "%.3f mrad per source cycle%n", offset * 1e3, offsetBefore * 1e3, 2 * ONE_CYCLE * 1e3,
                             crossAll * 1e3);
                     System.out.printf(Locale.ROOT, "StateTransferIT: trajectory's own output across the two halves at the switch: "
                             + "largest step %.3f mrad per source cycle (bound, one cycle of the programmed motion: "
@@ -230,7 +230,15 @@ class StateTransferIT {
                             (first.tNs() - prior.tNs()) / 1e6, n.size(), robotAfter * 1e3, robotBefore * 1e3,
                             ChangeSetIT.JUMP_BOUND * 1e3, worst.forceNorm(), ChangeSetIT.delta(robot0, robot1,
                             "safeCycles"), tookMs);
-                    assertTrue(offset <= ONE_CYCLE * 1.02, "tcp-correction's reference stepped " + offset
+                    // the switch's discontinuity: trajectory's output across its two halves, per source
+                    // cycle (a release either half skips does not count as a step)
+                    assertTrue(cross <= ONE_CYCLE * 1.02, "trajectory's output stepped " + cross
+                            + " rad per source cycle across the two halves at the switch");
+                    // what tcp-correction took up: its last value of the old half and its first of the
+                    // new one, read at two instants; when the old half had skipped a release just
+                    // before (under load: 0.26-0.31 mrad in a third of the runs with builds beside
+                    // them), those are two source cycles apart, not one
+                    assertTrue(offset <= 2 * ONE_CYCLE * 1.02, "tcp-correction's reference stepped " + offset
                             + " rad at the switch");
                     assertTrue(same > 500, "values under the same seq: " + same);
                     assertTrue(sameDiff < ONE_CYCLE / 2, "the two halves differ by " + sameDiff + " rad under the same seq");
