@@ -98,6 +98,15 @@ bool Leaked() {
 
 uint64_t Now() { return arflex_sys_now_ns(); }
 
+void WriteJointState(struct arflex_port* out, const Q& q, uint64_t* seq) {
+  struct arflex_joint_state js;
+  memset(&js, 0, sizeof(js));
+  js.t_ns = (int64_t)Now();
+  js.seq = ++*seq;
+  for (int j = 0; j < 6; ++j) js.q[j] = q[j];
+  arflex_state_write(out, &js, sizeof(js));
+}
+
 int SetI(struct arflex_host* h, const char* n, int64_t v) {
   return arflex_host_set_param(h, n, (uint64_t)v, nullptr, kCall);
 }

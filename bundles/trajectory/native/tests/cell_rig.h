@@ -110,6 +110,9 @@ struct Reader {
 };
 
 uint64_t Now();
+// Writes an arm at rest at q (qd, tau 0) to a script's joint_state output, stamped now, with
+// the next sequence number of *seq.
+void WriteJointState(struct arflex_port* out, const Q& q, uint64_t* seq);
 int SetI(struct arflex_host* h, const char* n, int64_t v);
 std::string MakeDataDir();
 void RemoveDir(const std::string& d);

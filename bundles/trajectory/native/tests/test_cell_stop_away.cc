@@ -27,14 +27,7 @@ void CaseStopAway() {
   struct arflex_port* js_out = arflex_host_output(&script, "joint_state");
   struct arflex_port* sf_out = arflex_host_output(&script, "safety");
   uint64_t js_seq = 0, sf_seq = 0;
-  auto write_js = [&](const Q& q) {
-    struct arflex_joint_state js;
-    memset(&js, 0, sizeof(js));
-    js.t_ns = (int64_t)Now();
-    js.seq = ++js_seq;
-    for (int j = 0; j < 6; ++j) js.q[j] = q[j];
-    arflex_state_write(js_out, &js, sizeof(js));
-  };
+  auto write_js = [&](const Q& q) { WriteJointState(js_out, q, &js_seq); };
   auto write_safety = [&](bool stop) {
     struct arflex_safety_state s;
     memset(&s, 0, sizeof(s));

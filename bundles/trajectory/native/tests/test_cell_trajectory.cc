@@ -170,14 +170,7 @@ void CaseLateRobot() {
   const double vmax[6] = {123 * deg, 115 * deg, 112 * deg, 179 * deg, 172 * deg, 219 * deg};
   struct arflex_port* js_out = arflex_host_output(&script, "joint_state");
   uint64_t js_seq = 0;
-  auto write_js = [&](const Q& q) {
-    struct arflex_joint_state js;
-    memset(&js, 0, sizeof(js));
-    js.t_ns = (int64_t)Now();
-    js.seq = ++js_seq;
-    for (int j = 0; j < 6; ++j) js.q[j] = q[j];
-    arflex_state_write(js_out, &js, sizeof(js));
-  };
+  auto write_js = [&](const Q& q) { WriteJointState(js_out, q, &js_seq); };
   Q robot;
   robot << -0.2, 0.4, 0.3, 0.1, 0.8, -0.1;  // where the late robot's arm is
   Q q = Q::Zero(), last = Q::Zero();
