@@ -68,6 +68,8 @@ class CellLaunchTest {
     @Test
     void aHalfSlowToGetReadyHoldsNobodyAndStartsWithTheWiringAndParametersOfTheMomentItIsReady() throws Exception {
         rig.install("fast", PORTS_B);
+        // fast's launch thread reports its READY through the actor: not always before install returns
+        rig.stepUntil("fast ACTIVE", () -> rig.state("fast") == State.ACTIVE);
         rig.install("slow", PORTS_A);
         // slow is being launched: the actor is free, slow is not ACTIVE yet and says why
         assertEquals(State.ACTIVE, rig.state("fast"));
