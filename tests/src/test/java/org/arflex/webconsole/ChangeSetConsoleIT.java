@@ -22,7 +22,6 @@ import java.util.List;
 import java.util.Map;
 import java.util.regex.Matcher;
 import java.util.regex.Pattern;
-import java.util.stream.Stream;
 import org.junit.jupiter.api.AfterAll;
 import org.junit.jupiter.api.BeforeAll;
 import org.junit.jupiter.api.MethodOrderer;
@@ -83,20 +82,7 @@ class ChangeSetConsoleIT {
         if (rt != null) {
             rt.close();
         }
-        RuntimeUnderTest.awaitCondition("child processes to end", Duration.ofSeconds(20),
-                () -> ProcessHandle.current().descendants().noneMatch(ProcessHandle::isAlive));
-        if (runtimeId != null) {
-            String prefix = "arflex." + runtimeId + ".";
-            for (String dir : List.of("/dev/shm", "/dev/mqueue")) {
-                Path d = Path.of(dir);
-                if (Files.isDirectory(d)) {
-                    try (Stream<Path> s = Files.list(d)) {
-                        List<Path> left = s.filter(p -> p.getFileName().toString().startsWith(prefix)).toList();
-                        assertTrue(left.isEmpty(), "left over in " + dir + ": " + left);
-                    }
-                }
-            }
-        }
+        RuntimeUnderTest.assertNothingLeft(runtimeId);
     }
 
     // ---- helpers

@@ -223,6 +223,28 @@ final class RuntimeUnderTest implements AutoCloseable {
         }
     }
 
+    /**
+     * Nothing leaks once a runtime is closed: no child process of this JVM (waited for, 20 s),
+     * no /dev/shm or /dev/mqueue object of runtime {@code runtimeId} (null: its id was never read).
+     */
+    static void assertNothingLeft(String runtimeId) throws IOException {
+        awaitCondition("child processes to end", Duration.ofSeconds(20),
+                () -> ProcessHandle.current().descendants().noneMatch(ProcessHandle::isAlive));
+        if (runtimeId == null) {
+            return;
+        }
+        String prefix = "arflex." + runtimeId + ".";
+        for (String dir : List.of("/dev/shm", "/dev/mqueue")) {
+            Path d = Path.of(dir);
+            if (Files.isDirectory(d)) {
+                try (Stream<Path> s = Files.list(d)) {
+                    List<Path> left = s.filter(p -> p.getFileName().toString().startsWith(prefix)).toList();
+                    org.junit.jupiter.api.Assertions.assertTrue(left.isEmpty(), "left over in " + dir + ": " + left);
+                }
+            }
+        }
+    }
+
     /** Stops the framework through Gogo; kills what is left after the deadline. */
     @Override
     public void close() throws IOException {

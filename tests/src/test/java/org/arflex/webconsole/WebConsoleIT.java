@@ -92,20 +92,7 @@ class WebConsoleIT {
             }
         }
         // Nothing leaks: no child process, no shared memory or queue of this runtime.
-        RuntimeUnderTest.awaitCondition("child processes to end", Duration.ofSeconds(20),
-                () -> ProcessHandle.current().descendants().noneMatch(ProcessHandle::isAlive));
-        if (runtimeId != null) {
-            String prefix = "arflex." + runtimeId + ".";
-            for (String dir : List.of("/dev/shm", "/dev/mqueue")) {
-                Path d = Path.of(dir);
-                if (Files.isDirectory(d)) {
-                    try (Stream<Path> s = Files.list(d)) {
-                        List<Path> left = s.filter(p -> p.getFileName().toString().startsWith(prefix)).toList();
-                        assertTrue(left.isEmpty(), "left over in " + dir + ": " + left);
-                    }
-                }
-            }
-        }
+        RuntimeUnderTest.assertNothingLeft(runtimeId);
     }
 
     /** Logs the browser in: the Web Console uses HTTP Basic authentication. */
