@@ -312,7 +312,7 @@ public final class DeploymentSets {
                         e.parameter()), Services.CALL_MS));
             }
         }
-        return new DeploymentUndo.Done(List.copyOf(installed), List.copyOf(newComponents), updated, uninstalled, old);
+        return new DeploymentUndo.Done(List.copyOf(installed), List.copyOf(newComponents), uninstalled, updated, old);
     }
 
     /** Reads and gates one jar; an update's through {@link #updates}, which also reads its contract. */
