@@ -272,7 +272,7 @@ public final class DeploymentSets {
             if (!r.applied) {
                 return undone(url, text, installed, r.refusal == null ? "not applied" : r.refusal);
             }
-            List<String> back = DeploymentUndo.rolledBack(r.text, done.updated());
+            List<String> back = DeploymentUndo.notHeld(r.text, done.updated());
             if (!back.isEmpty()) {
                 String why = undo.takeBack(url, text, done, back);
                 ChangeSetDTO dto = refused(url, text, why);

@@ -11,7 +11,8 @@ import org.osgi.framework.BundleException;
 
 /**
  * Takes a deployment set back when its change set did not hold (D50): refused, torn down,
- * rejected in a shadow run, or applied and then one of its updates rolled back after the switch.
+ * rejected in a shadow run, or applied and then one of its updates rolled back after the switch
+ * (or its new version did not start at the switch).
  *
  * <p>Not applied: nothing of it runs, the bundles the set installed in Felix are uninstalled
  * again. Applied and rolled back: the set's own changes are taken back by one more change set
@@ -35,12 +36,21 @@ final class DeploymentUndo {
         this.log = log;
     }
 
-    /** The updates of {@code updated} an applied set's text says were rolled back after their switch. */
-    static List<String> rolledBack(String text, List<String> updated) {
+    /**
+     * The updates of {@code updated} that an applied set's text says did not hold, each with how
+     * ({@code update c rolled back after the switch}, {@code update c did not start at the
+     * switch}: the verdicts of UpdateWindow); empty when every one was committed or has no verdict.
+     */
+    static List<String> notHeld(String text, List<String> updated) {
         List<String> out = new ArrayList<>();
         for (String c : updated) {
-            if (text != null && text.contains("update " + c + ": rolled back after ")) {
-                out.add(c);
+            if (text == null) {
+                continue;
+            }
+            if (text.contains("update " + c + ": rolled back after ")) {
+                out.add("update " + c + " rolled back after the switch");
+            } else if (text.contains("update " + c + ": the new version did not start")) {
+                out.add("update " + c + " did not start at the switch");
             }
         }
         return out;
@@ -60,11 +70,12 @@ final class DeploymentUndo {
     }
 
     /**
-     * After an applied set whose updates {@code back} were rolled back: the undo change set, then
-     * the bundles. Appends what happened to {@code text}; returns why the set is not kept.
+     * After an applied set whose updates did not hold ({@code back}, as {@link #notHeld} says): the
+     * undo change set, then the bundles. Appends what happened to {@code text}; returns why the
+     * set is not kept.
      */
     String takeBack(String url, StringBuilder text, Done done, List<String> back) {
-        String why = "update " + String.join(", update ", back) + " rolled back after the switch";
+        String why = String.join(", ", back);
         List<String> undo = actions(done);
         if (undo.isEmpty()) {
             return why + "; the set had nothing else to take back";

@@ -80,13 +80,17 @@ class DeploymentUndoTest {
     }
 
     @Test
-    void onlyARollbackAfterTheSwitchOfTheSetsOwnUpdateCountsAsOne() {
-        assertEquals(List.of("tcp-correction"), DeploymentUndo.rolledBack("applied: ...\n" + ROLLED_BACK + "\n",
-                List.of("tcp-correction", "vision")));
-        assertEquals(List.of(), DeploymentUndo.rolledBack("update tcp-correction: committed: the new version ran 300 "
+    void onlyARollbackOrANewVersionThatDidNotStartOfTheSetsOwnUpdatesCount() {
+        assertEquals(List.of("update tcp-correction rolled back after the switch"), DeploymentUndo.notHeld(
+                "applied: ...\n" + ROLLED_BACK + "\n", List.of("tcp-correction", "vision")));
+        assertEquals(List.of("update tcp-correction did not start at the switch"), DeploymentUndo.notHeld(
+                "update tcp-correction: the new version did not start\n", List.of("tcp-correction")));
+        assertEquals(List.of(), DeploymentUndo.notHeld("update tcp-correction: committed: the new version ran 300 "
                 + "cycles (0 overruns or deadline misses, the old one 0)\n", List.of("tcp-correction")));
-        assertEquals(List.of(), DeploymentUndo.rolledBack(ROLLED_BACK, List.of("tcp")), "another component's name");
-        assertEquals(List.of(), DeploymentUndo.rolledBack(null, List.of("tcp-correction")));
+        assertEquals(List.of(), DeploymentUndo.notHeld("warning: no verdict of the rollback window yet: timeout\n",
+                List.of("tcp-correction")), "no verdict: nothing is taken back on a guess");
+        assertEquals(List.of(), DeploymentUndo.notHeld(ROLLED_BACK, List.of("tcp")), "another component's name");
+        assertEquals(List.of(), DeploymentUndo.notHeld(null, List.of("tcp-correction")));
     }
 
     @Test
@@ -94,7 +98,8 @@ class DeploymentUndoTest {
         DeploymentUndo undo = new DeploymentUndo(service(a -> outcome(true, null, "change set: ...\napplied: ...\n")),
                 events::add);
         StringBuilder text = new StringBuilder();
-        String why = undo.takeBack("file:/srv/sets/s.xml", text, done(false), List.of("tcp-correction"));
+        String why = undo.takeBack("file:/srv/sets/s.xml", text, done(false),
+                List.of("update tcp-correction rolled back after the switch"));
         assertEquals(List.of(List.of("uninstall tool-gripper", "install teach", "set sim-robot speed 0.8")), applied);
         assertEquals(List.of("apply uninstall tool-gripper; install teach; set sim-robot speed 0.8", "uninstall bundle 34"),
                 events, "the components out of the cell before their bundle leaves Felix");
@@ -109,7 +114,8 @@ class DeploymentUndoTest {
         DeploymentUndo undo = new DeploymentUndo(service(a -> outcome(false, "the set would stop 'trajectory' (input "
                 + "'tool' of 'trajectory': no provider)", "refused: ...\n")), events::add);
         StringBuilder text = new StringBuilder();
-        String why = undo.takeBack("file:/srv/sets/s.xml", text, done(false), List.of("tcp-correction"));
+        String why = undo.takeBack("file:/srv/sets/s.xml", text, done(false),
+                List.of("update tcp-correction rolled back after the switch"));
         assertEquals(1, applied.size());
         assertTrue(events.stream().noneMatch(e -> e.startsWith("uninstall bundle")), events::toString);
         assertEquals("update tcp-correction rolled back after the switch; taking it back was refused (the set would stop "
@@ -126,7 +132,7 @@ class DeploymentUndoTest {
             throw new AssertionError("no change set expected");
         }), events::add);
         String why = undo.takeBack("u", new StringBuilder(), new DeploymentUndo.Done(List.of(), List.of(), List.of(),
-                List.of("tcp-correction"), Map.of()), List.of("tcp-correction"));
+                List.of("tcp-correction"), Map.of()), List.of("update tcp-correction rolled back after the switch"));
         assertEquals("update tcp-correction rolled back after the switch; the set had nothing else to take back", why);
         assertEquals(List.of(), applied);
     }
