@@ -33,6 +33,12 @@ import org.junit.jupiter.api.Test;
  * runs 1.0.1 (committed after its window), in one change set. Throughout: the guard never leaves
  * NORMAL, sim-robot runs no safe cycle, nothing waits for a reset or a fresh command, sim-robot,
  * the guard and trajectory keep their pids.
+ *
+ * <p>D50: a gripper signed by an unknown key is refused naming the jar; a set whose faulty update
+ * is rejected in its shadow run leaves no bundle; a set whose faulty update is rolled back after
+ * its switch is taken back whole (its gripper, signed by a trusted key, uninstalled from the cell
+ * and from Felix, the guard's limit it wrote written back); a set of changes only uninstalls the
+ * gripper and writes the guard's limit, a value out of range refused naming its line.
  */
 class DeploymentSetIT {
 
@@ -272,7 +278,21 @@ class DeploymentSetIT {
                 assertTrue(out.contains("\nuninstalled again: bundle "), out);
                 assertTrue(out.contains("tool-gripper"), out);
                 nothingInstalled(rt, tcpPid);
-                w.unharmed("after three refused sets");
+
+                // D50: rejected in its shadow run (D42): the faulty version crashes while it shadows the
+                // running one; nothing was switched, and the gripper's bundle installed for the set goes again
+                Path faulty = UpdateSetIT.version(dir, "1.0.2-faulty", FaultyVersions.crashingAfterMs(dir,
+                        CellRig.TCP_CORRECTION, UpdateSetIT.EXE, 500, "DeploymentSetIT"));
+                Path shadowed = Files.writeString(dir.resolve("shadowed.xml"), "<deployment xmlns=\"urn:arflex:deployment:1\">\n"
+                        + "  <install jar=\"tool-gripper.jar\" sha256=\"" + gripperPin + "\"/>\n"
+                        + "  <update component=\"tcp-correction\" jar=\"" + faulty.getFileName() + "\" sha256=\""
+                        + Jars.sha256(faulty) + "\" shadow=\"5000\" window=\"300\"/>\n</deployment>\n");
+                out = rt.cmd("arflex:deploy set " + shadowed.toUri());
+                System.out.println("DeploymentSetIT: a set rejected in shadow:\n" + out);
+                assertTrue(out.startsWith("error: ") && out.contains("update tcp-correction: rejected in shadow after "), out);
+                assertTrue(out.contains("\nuninstalled again: bundle ") && out.contains(at(shadowed, "tool-gripper.jar")), out);
+                nothingInstalled(rt, tcpPid);
+                w.unharmed("after five refused sets");
             }
         }
     }
@@ -320,6 +340,30 @@ class DeploymentSetIT {
             String again = rt.cmd("arflex:deploy set " + set.toUri());
             assertTrue(again.startsWith("error: ") && again.contains("already installed as bundle"), again);
             rt.awaitState("ACTIVE", T, "tool-gripper", "tcp-correction");
+
+            // D50: a set of changes only, the gripper uninstalled and the guard's limit written; first
+            // with a value out of range: refused naming its line, nothing changed
+            String head = "<deployment xmlns=\"urn:arflex:deployment:1\" name=\"changes\">\n"
+                    + "  <uninstall component=\"tool-gripper\"/>\n";
+            Path outOfRange = Files.writeString(dir.resolve("changes-bad.xml"), head
+                    + "  <set component=\"force-guard\" parameter=\"force_limit_n\" value=\"0.5\"/>\n</deployment>\n");
+            String refused = rt.cmd("arflex:deploy set " + outOfRange.toUri());
+            assertTrue(refused.startsWith("error: ") && refused.contains("refused: line 3, set force-guard force_limit_n 0.5: "
+                    + "force-guard.force_limit_n: 0.5 is out of range [1.0, 10000.0] N; nothing installed"), refused);
+            rt.awaitState("ACTIVE", T, "tool-gripper");
+            long trajPid = rt.pid("trajectory");
+            Path changes = Files.writeString(dir.resolve("changes.xml"), head
+                    + "  <set component=\"force-guard\" parameter=\"force_limit_n\" value=\"145\"/>\n</deployment>\n");
+            String applied = rt.cmd("arflex:deploy set " + changes.toUri());
+            System.out.println("DeploymentSetIT: a set of changes only:\n" + applied);
+            assertFalse(applied.startsWith("error: "), applied);
+            assertTrue(applied.contains("STOP     tool-gripper") && applied.contains("REBIND   trajectory"), applied);
+            rt.awaitState("INSTALLED", T, "tool-gripper");
+            assertTrue(rt.cmd("arflex:get force-guard force_limit_n").strip().startsWith("145"),
+                    rt.cmd("arflex:get force-guard force_limit_n"));
+            assertFalse(rt.cmd("arflex:bindings").contains("tool-gripper"), rt.cmd("arflex:bindings"));
+            assertEquals(trajPid, rt.pid("trajectory"));
+            rt.awaitState("ACTIVE", T, "tcp-correction", "trajectory", "sim-robot", "force-guard");
         }
     }
 
