@@ -152,7 +152,7 @@ class DeploymentSetIT {
                 .noneMatch(p -> p.contains("--instance tool-gripper ") || p.contains("--instance 1-tcp-correction "))
                 && objects(rt, "tool-gripper").isEmpty() && objects(rt, "1-tcp-correction").isEmpty());
         assertEquals(tcpPid, rt.pid("tcp-correction"), "the running tcp-correction untouched");
-        assertTrue(rt.cmd("arflex:info tcp-correction").startsWith("tcp-correction 1.0.0 "), rt.cmd("arflex:info tcp-correction"));
+        assertTrue(rt.cmd("arflex:info tcp-correction").startsWith("tcp-correction 1.1.0 "), rt.cmd("arflex:info tcp-correction"));
     }
 
     /** The arm's record over a span: the guard's modes, sim-robot's stats before and after. */
