@@ -18,8 +18,8 @@ void arflex_hc_on_state(struct loader *L, const XML_Char **atts)
 		return;
 	}
 	for (unsigned i = 0; i < L->ntypes; i++) {
-		if (strcmp(L->types[i].name, type))
-			continue;
+		if (!L->types[i].name || strcmp(L->types[i].name, type))
+			continue; /* a table entry without a name matches nothing (as for ports) */
 		if (!(L->types[i].methods & 1u)) {
 			arflex_hc_fail(L, "12.1", "state/@type",
 				       "port type %s does not allow the state method", type);
