@@ -273,7 +273,7 @@ public final class Activator implements BundleActivator {
                     public void forget(java.nio.file.Path exe) {
                         executables.forget(exe);
                     }
-                }, gateHook::refusal, prepares, gate::check, log);
+                }, gateHook::refusal, prepares, log);
         changeSets.executables(extender::executable);
         changeSets.bundles(new org.arflex.drcr.impl.services.UpdatedBundles(ctx, cell,
                 new org.arflex.drcr.impl.services.UpdatedBundles.Carrier() {

@@ -72,16 +72,13 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
     }
 
     /**
-     * @param prepare     the thread that prepares installed bundles for their start (extracts their
-     *                    executables once the gate admits them; D54)
-     * @param lookAhead   the gate's verdict for that preparation: neither logged nor kept (a bundle
-     *                    is judged for its start, when Felix resolves it, as before)
+     * @param prepare the thread that prepares installed bundles for their start (judged by the
+     *                code gate, their executables extracted once it admits them; D54)
      */
     public ContractExtender(Cell cell, ContractReader reader, BundleContext own, Extractor extractor,
-                            Admission admission, java.util.concurrent.Executor prepare, Admission lookAhead,
-                            Consumer<String> log) {
+                            Admission admission, java.util.concurrent.Executor prepare, Consumer<String> log) {
         this.admission = admission;
-        this.preparation = new StartPreparation(prepare, lookAhead, this::extract, log);
+        this.preparation = new StartPreparation(prepare, admission, this::extract, log);
         this.cell = cell;
         this.reader = reader;
         this.own = own;

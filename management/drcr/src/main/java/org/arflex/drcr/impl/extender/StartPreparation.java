@@ -15,9 +15,10 @@ import org.osgi.framework.Bundle;
  * (with their SHA-256 recorded). The start that follows takes the extracted file instead of
  * copying it out of the jar (2-8 ms of install-to-first-cycle, measured under load).
  *
- * <p>Nothing is trusted more than before: the gate's look ahead is neither logged nor kept (a
- * bundle judged while its install is under way may not be readable yet); the start asks the gate
- * again, as it did; the file taken is hashed against its record before it is spawned, as every
+ * <p>The gate's verdict is the one its start would get (the resolver hook's, judged once per
+ * revision, D54): the hash of the jar is off the start's way too. A verdict on content that could
+ * not be read yet, or read while the revision changed, is not kept. Nothing is trusted more than
+ * before: the start asks the gate again; the file taken is hashed against its record before it is spawned, as every
  * spawn; and only the first start after an install takes a prepared file (an updated bundle is
  * started by Felix at once, and later starts extract afresh, as they did). A preparation of a
  * revision that is gone (the bundle was updated or uninstalled meanwhile) is dropped and extracts

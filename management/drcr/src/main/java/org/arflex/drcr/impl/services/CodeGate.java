@@ -102,18 +102,6 @@ public final class CodeGate {
         Decision d = judge(b);
         log.accept("arflex: code gate: bundle " + b.getBundleId() + " " + (d.admitted() ? "admitted: " : "refused: ")
                 + d.reason());
-        return refusalText(b, d);
-    }
-
-    /**
-     * As {@link #refusal}, not logged: a look ahead (D54, the preparation of an installed bundle
-     * for its start), whose refusal refuses nothing (the start asks again, and that is logged).
-     */
-    public String check(Bundle b) {
-        return refusalText(b, judge(b));
-    }
-
-    private static String refusalText(Bundle b, Decision d) {
         return d.admitted() ? null : "bundle " + b.getBundleId() + " (" + b.getSymbolicName() + ", location "
                 + b.getLocation() + ") " + d.reason();
     }

@@ -43,7 +43,12 @@ public final class CodeGateHook implements ResolverHookFactory {
         return r == null ? gate.refusal(b) : refusal(r);
     }
 
-    /** Null when the revision may resolve, else why not (judged once per revision). */
+    /**
+     * Null when the revision may resolve, else why not (judged once per revision). The content
+     * is read through the bundle, so a verdict is kept only when the bundle's revision was the
+     * same before and after it was read (the extender's look ahead, D54, runs beside Felix's
+     * {@code update}) and the content could be read.
+     */
     String refusal(BundleRevision r) {
         Bundle b = r.getBundle();
         if (b == null || b.getBundleId() == 0) {
@@ -52,11 +57,19 @@ public final class CodeGateHook implements ResolverHookFactory {
         String v = verdicts.get(r);
         if (v == null) {
             v = judge(b);
-            if (!v.contains(UNREADABLE)) {
+            if (!v.contains(UNREADABLE) && current(b) == r) {
                 verdicts.put(r, v);
             }
         }
         return v.isEmpty() ? null : v;
+    }
+
+    private static BundleRevision current(Bundle b) {
+        try {
+            return b.adapt(BundleRevision.class);
+        } catch (RuntimeException e) {
+            return null;
+        }
     }
 
     /**

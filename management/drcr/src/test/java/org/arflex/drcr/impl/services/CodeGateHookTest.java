@@ -24,7 +24,15 @@ class CodeGateHookTest {
 
     private final List<String> log = new ArrayList<>();
 
-    private static BundleRevision revision(Bundle b) {
+    private static Object call(java.lang.reflect.Method m, Object target, Object[] args) throws Throwable {
+        try {
+            return m.invoke(target, args);
+        } catch (java.lang.reflect.InvocationTargetException e) {
+            throw e.getCause();
+        }
+    }
+
+    private static BundleRevision revisionOnly(Bundle b) {
         return (BundleRevision) Proxy.newProxyInstance(BundleRevision.class.getClassLoader(),
                 new Class<?>[] {BundleRevision.class}, (proxy, m, args) -> switch (m.getName()) {
                     case "getBundle" -> b;
@@ -32,6 +40,22 @@ class CodeGateHookTest {
                     case "equals" -> proxy == args[0];
                     default -> throw new UnsupportedOperationException(m.getName());
                 });
+    }
+
+    /** The revision of {@code b}, and {@code b} as its bundle: it answers adapt(BundleRevision) with it. */
+    private static BundleRevision revision(Bundle b) {
+        BundleRevision[] r = new BundleRevision[1];
+        Bundle withRevision = (Bundle) Proxy.newProxyInstance(Bundle.class.getClassLoader(), new Class<?>[] {Bundle.class},
+                (proxy, m, args) -> m.getName().equals("adapt") && args[0] == BundleRevision.class ? r[0]
+                        : call(m, b, args));
+        r[0] = (BundleRevision) Proxy.newProxyInstance(BundleRevision.class.getClassLoader(),
+                new Class<?>[] {BundleRevision.class}, (proxy, m, args) -> switch (m.getName()) {
+                    case "getBundle" -> withRevision;
+                    case "hashCode" -> System.identityHashCode(proxy);
+                    case "equals" -> proxy == args[0];
+                    default -> throw new UnsupportedOperationException(m.getName());
+                });
+        return r[0];
     }
 
     @Test
@@ -79,11 +103,46 @@ class CodeGateHookTest {
                     if (m.getName().equals("getEntryPaths") && reads[0]++ == 0) {
                         throw new IllegalStateException("No bundle associated with resource");
                     }
-                    return m.invoke(readable, args);
+                    return call(m, readable, args);
                 });
         BundleRevision r = revision(settling);
         assertNull(hook.refusal(r), String.join("\n", log));
         assertTrue(log.stream().anyMatch(l -> l.contains("refused") && l.contains("(unreadable: No bundle associated")),
                 "the first verdict names why it refused: " + log);
+    }
+
+    /**
+     * The extender's look ahead (D54) judges a bundle beside Felix's update: a verdict read
+     * while the revision changed is not kept for the revision asked about.
+     */
+    @Test
+    void aVerdictReadWhileTheRevisionChangedIsNotKept(@TempDir Path dir) throws Exception {
+        Path cell = Files.createDirectories(dir.resolve("cell"));
+        CodeGate gate = new CodeGate(List.of(cell), null, log::add);
+        CodeGateHook hook = new CodeGateHook(gate);
+        byte[] jar = CodeGateTest.jar("good", false);
+        gate.verified(jar, "a console upload, sha256 pinned");
+        Bundle content = SignedCodeGateTest.installed(dir.resolve("felix-cache/upload.jar").toUri().toString(), jar);
+        BundleRevision[] now = new BundleRevision[1];
+        BundleRevision[] first = new BundleRevision[1];
+        Bundle updating = (Bundle) Proxy.newProxyInstance(Bundle.class.getClassLoader(), new Class<?>[] {Bundle.class},
+                (proxy, m, args) -> {
+                    if (m.getName().equals("adapt")) {
+                        return now[0];
+                    }
+                    if (m.getName().equals("getEntryPaths") && args[0].equals("/") && now[0] == first[0]) {
+                        now[0] = revisionOnly(content); // Felix's update installs a new revision meanwhile
+                    }
+                    return call(m, content, args);
+                });
+        BundleRevision asked = revisionOnly(updating);
+        first[0] = asked;
+        now[0] = asked;
+        assertNull(hook.refusal(updating));
+        long judged = log.stream().filter(l -> l.contains("code gate: bundle")).count();
+        now[0] = asked;
+        assertNull(hook.refusal(asked));
+        assertEquals(judged + 1, log.stream().filter(l -> l.contains("code gate: bundle")).count(),
+                "judged again: the first verdict was read across two revisions");
     }
 }
