@@ -24,6 +24,8 @@ final class ChangeSetExecutor {
     private final SetTools tools;
     private final SetAdmission admission;
     private final SwitchTurn switchTurn;
+    /** Where an apply says how far it is (D53). */
+    private final ChangeSetProgress progress;
     /** The set being prepared, if any: one at a time (actor thread). */
     private SetRun current;
     /** Updates in their rollback window, by component name (actor thread; D38). */
@@ -38,8 +40,9 @@ final class ChangeSetExecutor {
     static final long OVERRUN_ALLOWANCE = 2;
 
     ChangeSetExecutor(Cell cell, Stops stops, Segments segments, Starter starter, PlanExecutor plans,
-                      Failures failures, Consumer<String> log) {
+                      Failures failures, Consumer<String> log, ChangeSetProgress progress) {
         this.cell = cell;
+        this.progress = progress;
         this.segments = segments;
         this.log = log;
         this.tools = new SetTools(cell, stops, segments, starter, plans, failures, log);
@@ -71,19 +74,48 @@ final class ChangeSetExecutor {
      * is not applied.
      */
     void apply(ChangeSet set, Consumer<SetOutcome> done) {
+        apply(set, null, done);
+    }
+
+    /**
+     * As {@link #apply(ChangeSet, Consumer)}, publishing its phases through {@code shown} (D53);
+     * null: through an apply of its own, which this executor also ends with the outcome.
+     */
+    void apply(ChangeSet set, ChangeSetProgress.Apply shown, Consumer<SetOutcome> done) {
         cell.actor().checkThread();
+        ChangeSetProgress.Apply p = shown;
+        Consumer<SetOutcome> then = done;
+        if (p == null) {
+            ChangeSetProgress.Apply own = progress.begin(set.steps().stream().map(ChangeSet.Step::text).toList());
+            p = own;
+            then = o -> {
+                done.accept(o);
+                ends(own, o);
+            };
+        }
         SetAdmission.Checked c = admission.check(set, busy());
         if (c.refusal() != null) {
             log.accept("arflex: change set refused: " + set.describe() + ": " + c.refusal());
-            done.accept(new SetOutcome(false, c.refusal(), c.plan(), 0, 0));
+            then.accept(new SetOutcome(false, c.refusal(), c.plan(), 0, 0));
             return;
         }
-        SetRun run = new SetRun(tools, switchTurn, set, c, done, cell.config().monotonicNs().getAsLong(),
+        p.claim();
+        SetRun run = new SetRun(tools, switchTurn, p, set, c, then, cell.config().monotonicNs().getAsLong(),
                 () -> current = null);
         current = run;
         log.accept("arflex: change set: " + set.describe() + ": preparing " + c.plan().startOrder()
                 + " while the cell runs\n" + c.plan().toText());
         run.prepare();
+    }
+
+    /** The outcome of an apply this executor began itself, once its windows are over. */
+    private static void ends(ChangeSetProgress.Apply own, SetOutcome o) {
+        if (!o.applied() || o.verdict() == null) {
+            own.done(ChangeSetProgress.outcomeOf(o.applied(), o.refusal(), null, false), o.refusal());
+        } else {
+            o.verdict().whenComplete((v, e) -> own.done(ChangeSetProgress.outcomeOf(true, null, v, e != null),
+                    e != null ? "no verdict of the rollback window: " + e : v));
+        }
     }
 
     /**

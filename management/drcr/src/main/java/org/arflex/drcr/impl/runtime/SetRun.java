@@ -23,6 +23,8 @@ final class SetRun {
     final Consumer<SetOutcome> done;
     final long t0;
     final SetTools tools;
+    /** Where this apply says how far it is (D53). */
+    final ChangeSetProgress.Apply progress;
     private final SwitchTurn switchTurn;
     /** Called once the run no longer holds the executor (switched or torn down). */
     private final Runnable release;
@@ -50,10 +52,11 @@ final class SetRun {
     private final Starter starter;
     private final Consumer<String> log;
 
-    SetRun(SetTools tools, SwitchTurn switchTurn, ChangeSet set, SetAdmission.Checked checked, Consumer<SetOutcome> done, long t0,
+    SetRun(SetTools tools, SwitchTurn switchTurn, ChangeSetProgress.Apply progress, ChangeSet set, SetAdmission.Checked checked, Consumer<SetOutcome> done, long t0,
            Runnable release) {
         this.tools = tools;
         this.switchTurn = switchTurn;
+        this.progress = progress;
         this.set = set;
         this.checked = checked;
         this.done = done;
@@ -68,6 +71,7 @@ final class SetRun {
 
     void prepare() {
         Plan plan = checked.plan();
+        progress.phase(ChangeSetProgress.PREPARING, "preparing " + set.describe() + " while the cell runs");
         for (ChangeSet.Step s : set.steps()) {
             Instance inst = cell.find(s.component());
             if (s instanceof ChangeSet.Install i) {
@@ -124,6 +128,7 @@ final class SetRun {
             }
         }
         outstanding = starting.size();
+        preparing();
         if (outstanding == 0) {
             prepared();
             return;
@@ -158,6 +163,7 @@ final class SetRun {
         log.accept("arflex: change set: " + inst.name + " READY (pid " + half.pid() + ", spawn to READY "
                 + tookNs / 1000 + " us), not started yet");
         half.exit().thenAccept(ex -> cell.actor().submit(() -> exitedEarly(inst, half, ex)));
+        preparing();
         if (outstanding == 0) {
             prepared();
         }
@@ -168,7 +174,7 @@ final class SetRun {
         for (ChangeSet.Step s : set.steps()) {
             if (s instanceof ChangeSet.Update u && u.shadow() > 0) {
                 Instance next = nexts.get(u.component());
-                shadows.put(next, new ShadowRun(cell, segments, log, shadowOutcome, u, cell.find(u.component()),
+                shadows.put(next, new ShadowRun(cell, segments, log, progress, shadowOutcome, u, cell.find(u.component()),
                         oldHalves.get(u.component()), next, prepared.get(next)));
             }
         }
@@ -176,6 +182,8 @@ final class SetRun {
             switchTurn.switchOver(this);
             return;
         }
+        progress.phase(ChangeSetProgress.SHADOW, "shadow runs of " + shadows.keySet().stream().map(i -> i.name).toList()
+                + " starting");
         for (ShadowRun r : List.copyOf(shadows.values())) {
             if (!over) {
                 r.begin(checked.plan().wiringOf(r.next.name));
@@ -260,6 +268,29 @@ final class SetRun {
                 segments.close(inst);
             }
         }
+    }
+
+    /** Says which halves are READY and which are awaited, by the action that starts them (D53). */
+    private void preparing() {
+        List<String> waiting = new ArrayList<>();
+        for (Instance inst : starting) {
+            if (!prepared.containsKey(inst)) {
+                waiting.add(action(inst));
+            }
+        }
+        progress.phase(ChangeSetProgress.PREPARING, String.format(java.util.Locale.ROOT,
+                "%d of %d new RT halves READY%s", prepared.size(), starting.size(),
+                waiting.isEmpty() ? "" : "; awaiting " + String.join(", ", waiting)));
+    }
+
+    /** The action of the set that starts {@code inst}: named in the set, or a start the plan adds. */
+    private String action(Instance inst) {
+        for (ChangeSet.Step s : set.steps()) {
+            if (!(s instanceof ChangeSet.Set) && s.component().equals(inst.name)) {
+                return s instanceof ChangeSet.Update ? "update " + inst.name : s.text();
+            }
+        }
+        return "start " + inst.name;
     }
 
     /** Called by the switch turn: the run no longer holds the executor. */

@@ -47,6 +47,7 @@ final class SwitchTurn {
 
     /** The switch, in this one actor turn. */
     void switchOver(SetRun run) {
+        run.progress.phase(ChangeSetProgress.SWITCHING, "switching " + run.set.describe() + " in one actor turn");
         long ts = cell.config().monotonicNs().getAsLong();
         Plan shown = run.checked.plan();
         for (Instance inst : run.starting) {
@@ -173,7 +174,7 @@ final class SwitchTurn {
         for (ChangeSet.Step s : run.set.steps()) {
             if (s instanceof ChangeSet.Update u) {
                 Instance next = run.nexts.get(u.component());
-                UpdateWindow w = new UpdateWindow(owner, cell, stops, segments, log, warm, run.set, u, olds.get(u.component()), run.oldHalves.get(u.component()), next);
+                UpdateWindow w = new UpdateWindow(owner, cell, stops, segments, log, run.progress, warm, run.set, u, olds.get(u.component()), run.oldHalves.get(u.component()), next);
                 verdicts.add(w.verdict);
                 w.begin();
             }
