@@ -169,7 +169,8 @@
     live.replaceChildren(el('div', {id: 'arflex-cs-live-box', 'data-phase': p.phase, 'data-running': String(p.running),
       'data-outcome': p.outcome || '', class: 'arflex-msg' + (p.running ? '' : ok ? ' arflex-msg-ok' : ' arflex-msg-error')},
       el('strong', {}, p.running ? 'Applying now: ' : 'Last set applied in this runtime: '), (p.actions || []).join('; '),
-      ' (' + (p.forMs / 1000).toFixed(1) + ' s since it began)',
+      p.running ? ' (' + (p.forMs / 1000).toFixed(1) + ' s since it began)'
+        : ' (took ' + ((p.phaseMillis - p.startedMillis) / 1000).toFixed(1) + ' s, finished ' + when(p.phaseMillis) + ')',
       el('ol', {id: 'arflex-cs-live-phases'}, phases.map((ph, i) => el('li', {'data-phase': ph},
         i === phases.length - 1 && p.running ? el('strong', {}, PHASE_TEXT[ph] || ph) : (PHASE_TEXT[ph] || ph)))),
       el('div', {id: 'arflex-cs-live-step'}, p.running ? p.step
