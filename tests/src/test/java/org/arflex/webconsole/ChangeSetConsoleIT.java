@@ -536,5 +536,12 @@ class ChangeSetConsoleIT {
         assertTrue(String.valueOf(last.get("why")).contains("update sample-scaler: passed its shadow run of"), String.valueOf(p));
         RuntimeUnderTest.awaitCondition("the new version running", WAIT,
                 () -> pid("sample-scaler") != scalerPid && "ACTIVE".equals(state("sample-scaler")));
+        // the shell says the same: arflex:change progress, its output in the runtime's log
+        rt.gogo("arflex:change progress");
+        RuntimeUnderTest.awaitCondition("arflex:change progress answered", WAIT,
+                () -> rt.tail().contains("outcome: committed: update sample-scaler: passed its shadow run of 3"));
+        assertTrue(rt.tail().contains("(phases checking > preparing > shadow > switching > window > bundles > done)\n"
+                + "outcome: committed: update sample-scaler: passed its shadow run of 3"),
+                rt.tail());
     }
 }

@@ -307,7 +307,8 @@ public final class ChangeSets implements ChangeSetService {
             return refused(actions, "interrupted");
         }
         ChangeSetDTO d = dto(actions, r);
-        if (r.applied() && parsed.stream().anyMatch(a -> a[0].equals("install") || a[0].equals("uninstall"))) {
+        if (r.applied() && r.verdict() == null // a set with updates is in their windows now: said after them
+                && parsed.stream().anyMatch(a -> a[0].equals("install") || a[0].equals("uninstall"))) {
             p.phase(ChangeSetProgress.BUNDLES, "starting and stopping the bundles of installed and uninstalled components");
         }
         if (r.applied()) {

@@ -15,9 +15,15 @@ final class ChangeSetProgressText {
         }
         StringBuilder sb = new StringBuilder();
         sb.append("change set: ").append(String.join("; ", p.actions)).append('\n');
-        sb.append(String.format(Locale.ROOT, "%s: %s for %.1f s (began %.1f s ago; phases %s)%n",
-                p.running ? "applying" : "finished", p.phase, Math.max(0, nowMillis - p.phaseMillis) / 1e3,
-                Math.max(0, nowMillis - p.startedMillis) / 1e3, String.join(" > ", p.phases)));
+        if (p.running) {
+            sb.append(String.format(Locale.ROOT, "applying: %s for %.1f s (began %.1f s ago; phases %s)%n", p.phase,
+                    Math.max(0, nowMillis - p.phaseMillis) / 1e3, Math.max(0, nowMillis - p.startedMillis) / 1e3,
+                    String.join(" > ", p.phases)));
+        } else {
+            sb.append(String.format(Locale.ROOT, "finished %.1f s ago, after %.1f s (phases %s)%n",
+                    Math.max(0, nowMillis - p.phaseMillis) / 1e3, Math.max(0, p.phaseMillis - p.startedMillis) / 1e3,
+                    String.join(" > ", p.phases)));
+        }
         if (p.running) {
             sb.append("now: ").append(p.step).append('\n');
             if (p.cycles > 0) {

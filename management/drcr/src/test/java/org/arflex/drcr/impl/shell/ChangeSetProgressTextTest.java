@@ -45,9 +45,9 @@ class ChangeSetProgressTextTest {
         p.outcome = "rejected-in-shadow";
         p.why = "update stage: rejected in shadow after 40 cycles: it exited";
         assertEquals("change set: update stage file:/x.jar; set user gain 2\n"
-                + "finished: done for 0.0 s (began 2.0 s ago; phases checking > preparing > shadow > done)\n"
+                + "finished 0.5 s ago, after 2.0 s (phases checking > preparing > shadow > done)\n"
                 + "outcome: rejected-in-shadow: update stage: rejected in shadow after 40 cycles: it exited",
-                ChangeSetProgressText.of(p, 12_000));
+                ChangeSetProgressText.of(p, 12_500));
     }
 
     @Test
