@@ -185,13 +185,17 @@
   async function pollLive() {
     if (livePolling) return;
     livePolling = true;
+    let sawRunning = false;
     try {
       for (;;) {
         const r = await get('changeset-progress');
         renderLive(r);
         if (!r.progress || !r.progress.running) break;
+        sawRunning = true;
         await new Promise(done => setTimeout(done, 250));
       }
+      // the apply is over: the outcome and the history below follow without waiting for the next second
+      if (sawRunning) setTimeout(refresh, 200);
     } catch (e) {
       live.replaceChildren(el('div', {class: 'arflex-msg arflex-msg-error'}, 'Cannot read the progress: ' + e.message));
     } finally { livePolling = false; }
