@@ -2,7 +2,9 @@
  * the whole set (what starts, stops, restarts, rebinds or holds and why, the admission per CPU,
  * what is refused and why) and changes nothing; Apply the plan shown applies exactly that plan,
  * or is refused when the cell changed since; then the outcome (committed, refused, rejected in
- * shadow, rolled back, torn down) and the history of the sets applied in this runtime.
+ * shadow, rolled back, torn down) and the history of the sets applied in this runtime. While a
+ * set is applied, its live progress (D53) from the DRCR: the phases gone through, what it does
+ * now, an update's shadow or window cycles and the worst deviation so far, then the outcome.
  * Everything goes into the DOM through textContent and attribute setters only. */
 'use strict';
 (() => {
@@ -11,6 +13,7 @@
   const planBox = el('div', {id: 'arflex-cs-plan'});
   const progress = el('div', {id: 'arflex-cs-progress'});
   const historyBox = el('div', {id: 'arflex-cs-history'});
+  const live = el('div', {id: 'arflex-cs-live'});
   const actions = el('textarea', {id: 'arflex-cs-actions', rows: 6, cols: 90, spellcheck: 'false',
     placeholder: 'install teach\nuninstall trajectory\nset tcp-correction enable true\n'
       + 'update tcp-correction file:/…/tcp-correction-1.0.1.jar <sha256> shadow 200 tolerance corrected.q 0.000001'});
@@ -25,6 +28,12 @@
     'rejected-in-shadow': 'rejected in its shadow run, nothing changed', 'rolled-back': 'rolled back after the switch',
     'torn-down': 'torn down during its preparation, nothing changed', 'unknown': 'unknown'
   };
+  const PHASE_TEXT = {
+    'checking': 'checking the set', 'preparing': 'preparing the new RT halves', 'shadow': 'shadow run',
+    'switching': 'switching', 'window': 'rollback window', 'bundles': 'bundles', 'done': 'outcome'
+  };
+  // the live progress: polled every 250 ms while the DRCR applies a set, once a second otherwise
+  let livePolling = false;
   const when = ms => ms ? new Date(ms).toISOString().replace('T', ' ').replace(/\.\d+Z$/, ' UTC') : '';
 
   function table(id, head, rows, empty) {
@@ -74,6 +83,7 @@
           'application/x-www-form-urlencoded');
         message(status, 'Applying the set…', 'info');
         applyingShown = true;
+        pollLive();
         planBox.replaceChildren();
         shown = null;
       } catch (e) {
@@ -150,7 +160,49 @@
         rows, 'No set applied yet.'));
   }
 
+  /** The DRCR's progress of the set being applied (or of the last one): phases, step, cycles, outcome. */
+  function renderLive(r) {
+    const p = r.progress;
+    if (!p) { live.replaceChildren(); return; }
+    const phases = p.phases || [];
+    const ok = p.outcome === 'committed';
+    live.replaceChildren(el('div', {id: 'arflex-cs-live-box', 'data-phase': p.phase, 'data-running': String(p.running),
+      'data-outcome': p.outcome || '', class: 'arflex-msg' + (p.running ? '' : ok ? ' arflex-msg-ok' : ' arflex-msg-error')},
+      el('strong', {}, p.running ? 'Applying now: ' : 'Last set applied in this runtime: '), (p.actions || []).join('; '),
+      p.running ? ' (' + (p.forMs / 1000).toFixed(1) + ' s since it began)'
+        : ' (took ' + ((p.phaseMillis - p.startedMillis) / 1000).toFixed(1) + ' s, finished ' + when(p.phaseMillis) + ')',
+      el('ol', {id: 'arflex-cs-live-phases'}, phases.map((ph, i) => el('li', {'data-phase': ph},
+        i === phases.length - 1 && p.running ? el('strong', {}, PHASE_TEXT[ph] || ph) : (PHASE_TEXT[ph] || ph)))),
+      el('div', {id: 'arflex-cs-live-step'}, p.running ? p.step
+        : (OUTCOME_TEXT[p.outcome] || p.outcome) + (p.why ? ': ' + p.why : '')),
+      p.running && p.cycles > 0 ? el('div', {id: 'arflex-cs-live-cycles', 'data-cycle': p.cycle, 'data-cycles': p.cycles},
+        el('progress', {max: p.cycles, value: Math.min(p.cycle, p.cycles)}),
+        ' cycle ' + p.cycle + ' of ' + p.cycles + (p.component ? ' (' + p.component + ')' : '')) : '',
+      p.running && p.worstField ? el('div', {id: 'arflex-cs-live-worst'}, 'Worst deviation so far: ' + p.worstField + ' '
+        + Number(p.worstDeviation).toPrecision(3) + ' from the running version\'s (tolerance ' + p.tolerance + ')') : ''));
+  }
+
+  async function pollLive() {
+    if (livePolling) return;
+    livePolling = true;
+    let sawRunning = false;
+    try {
+      for (;;) {
+        const r = await get('changeset-progress');
+        renderLive(r);
+        if (!r.progress || !r.progress.running) break;
+        sawRunning = true;
+        await new Promise(done => setTimeout(done, 250));
+      }
+      // the apply is over: the outcome and the history below follow without waiting for the next second
+      if (sawRunning) setTimeout(refresh, 200);
+    } catch (e) {
+      live.replaceChildren(el('div', {class: 'arflex-msg arflex-msg-error'}, 'Cannot read the progress: ' + e.message));
+    } finally { livePolling = false; }
+  }
+
   async function refresh() {
+    pollLive();
     try { render(await get('changesets')); } catch (e) { message(status, 'Cannot read the change sets: ' + e.message, 'error'); }
   }
 
@@ -159,7 +211,7 @@
       el('small', {}, 'install <component> · uninstall <component> · set <component> <parameter> <value> · '
         + 'update <component> <jar URL> [<sha256>] [window N] [shadow K] [envelope <port>.<field> <min> <max>] '
         + '[tolerance <port>.<field> <max>]'), el('br'), planBtn),
-    planBox, progress, historyBox);
+    planBox, live, progress, historyBox);
   refresh();
   setInterval(refresh, 1000);
 })();

@@ -39,7 +39,10 @@ import org.junit.jupiter.api.TestMethodOrder;
  * then the set is applied, its outcome is "committed" with the plan shown, the scaler runs
  * beside the unchanged counter; a second set uninstalls the scaler and sets the counter's
  * amplitude; the history lists both newest first; the audit log has the applies, their
- * outcomes and the refusals.
+ * outcomes and the refusals. Then the page in Chromium; last, an update of the scaler with a
+ * shadow run and a rollback window applied from the page, whose live progress (D53) the page
+ * shows going through the shadow run (its cycles) and the window to the outcome, and whose
+ * progress endpoint answers no one without the console's credentials, however its path is spelt.
  */
 @TestMethodOrder(MethodOrderer.OrderAnnotation.class)
 class ChangeSetConsoleIT {
@@ -423,5 +426,160 @@ class ChangeSetConsoleIT {
         assertTrue(why.startsWith("jar " + scaler.toUri() + " (line 2, install): ") && why.contains("pinned " + zeros)
                 && why.endsWith("; nothing installed"), why);
         assertEquals(scalerState, state("sample-scaler"), "nothing of the refused sets changed the cell");
+    }
+
+    /** A copy of the sample-scaler bundle whose contract says {@code version}: the same executable. */
+    private static Path scalerVersion(Path dir, String version) throws IOException {
+        Path in = org.arflex.it.Components.jar("sample-scaler");
+        Path out = dir.resolve("sample-scaler-" + version + ".jar");
+        String entry = "OSGI-INF/arflex/sample-scaler.xml";
+        boolean found = false;
+        try (java.util.zip.ZipFile z = new java.util.zip.ZipFile(in.toFile());
+                java.util.zip.ZipOutputStream zo = new java.util.zip.ZipOutputStream(Files.newOutputStream(out))) {
+            for (java.util.zip.ZipEntry e : java.util.Collections.list(z.entries())) {
+                byte[] b = z.getInputStream(e).readAllBytes();
+                if (e.getName().equals(entry)) {
+                    String xml = new String(b, StandardCharsets.UTF_8);
+                    String now = xml.replaceFirst("name=\"sample-scaler\" version=\"[^\"]+\"",
+                            "name=\"sample-scaler\" version=\"" + version + "\"");
+                    assertFalse(now.equals(xml), "the contract's version was not rewritten");
+                    b = now.getBytes(StandardCharsets.UTF_8);
+                    found = true;
+                }
+                zo.putNextEntry(new java.util.zip.ZipEntry(e.getName()));
+                zo.write(b);
+                zo.closeEntry();
+            }
+        }
+        assertTrue(found, entry + " in " + in);
+        return out;
+    }
+
+    private static String sha256(Path f) throws IOException {
+        try {
+            return java.util.HexFormat.of().formatHex(java.security.MessageDigest.getInstance("SHA-256")
+                    .digest(Files.readAllBytes(f)));
+        } catch (java.security.NoSuchAlgorithmException e) {
+            throw new IllegalStateException(e);
+        }
+    }
+
+    @Test
+    @Order(9)
+    void theProgressEndpointAnswersOnlyTheConsolesUser() {
+        String rest = "/arflex-changesets/api/changeset-progress";
+        List<String> answered = new ArrayList<>();
+        int tries = 0;
+        String wrong = "Basic " + java.util.Base64.getEncoder().encodeToString("arflex:admin".getBytes(StandardCharsets.UTF_8));
+        for (String prefix : PREFIXES) {
+            for (String auth : new String[] {null, wrong}) {
+                HttpRequest.Builder b = HttpRequest.newBuilder(URI.create(rt.base() + prefix + rest)).GET()
+                        .header("Origin", EVIL);
+                if (auth != null) {
+                    b.header("Authorization", auth);
+                }
+                HttpResponse<String> r = send(b, false);
+                tries++;
+                int st = r == null ? -1 : r.statusCode();
+                if ((st >= 200 && st < 300) || (r != null && r.body().contains("\"progress\""))) {
+                    answered.add(prefix + (auth == null ? " no credentials" : " wrong credentials") + " -> " + st);
+                }
+                if (prefix.equals("/system/console")) {
+                    assertEquals(401, st, prefix + ": " + (r == null ? "" : r.body()));
+                }
+            }
+        }
+        System.out.println("ChangeSetConsoleIT: " + tries + " reads of the progress without the console's credentials, "
+                + answered.size() + " answered");
+        assertTrue(answered.isEmpty(), "answered: " + answered);
+        // the console's user reads it: JSON, not sniffed, not shared with another origin
+        HttpResponse<String> ok = send(HttpRequest.newBuilder(URI.create(rt.base() + PAGE + "/api/changeset-progress"))
+                .GET().header("Origin", EVIL), true);
+        assertEquals(200, ok.statusCode(), ok.body());
+        assertEquals("nosniff", ok.headers().firstValue("X-Content-Type-Options").orElse(null));
+        assertTrue(ok.headers().firstValue("Access-Control-Allow-Origin").isEmpty(), ok.headers().toString());
+        Map<String, Object> p = Json.object(ok.body());
+        assertEquals(true, p.get("drcr"));
+        @SuppressWarnings("unchecked")
+        Map<String, Object> last = (Map<String, Object>) p.get("progress");
+        assertNotNull(last, "the sets applied above: " + ok.body());
+        assertEquals(false, last.get("running"));
+        assertEquals("committed", last.get("outcome"), ok.body());
+        // a write to it is no endpoint, and is refused before one is looked for
+        HttpResponse<String> post = post("/system/console", rest, Map.of(), "Origin", rt.base(), token);
+        assertTrue(post.statusCode() >= 400, post.statusCode() + " " + post.body());
+    }
+
+    @Test
+    @Order(10)
+    void thePageShowsAnUpdatesShadowRunAndWindowLiveToItsOutcome() throws IOException {
+        Browser.requireInstalled();
+        assertEquals("ACTIVE", state("sample-scaler"), "the scaler the page installed runs");
+        long scalerPid = pid("sample-scaler");
+        Path work = Path.of(System.getProperty("arflex.it.work", "target/it")).resolve("changeset-console").toAbsolutePath();
+        Path jar = scalerVersion(Files.createDirectories(work.resolve("versions")), "1.0.1-live");
+        // 10 ms cycles: 300 shadow cycles take 3 s, the window 200 cycles 2 s
+        String set = "update sample-scaler " + jar.toUri() + " " + sha256(jar)
+                + " shadow 300 tolerance y.value 0.000001 window 200";
+        Path shots = Path.of(System.getProperty("arflex.screenshots", "target/screenshots"));
+        try (Browser b = Browser.start(work.resolve("chromedriver-progress.log"))) {
+            b.cdp("Network.enable", Map.of());
+            b.cdp("Network.setExtraHTTPHeaders", Map.of("headers", Map.of("Authorization", rt.basicAuth())));
+            b.open(rt.base() + PAGE);
+            b.await("the page", WAIT, () -> textOf(b, "#arflex-cs-history-table"), b::url);
+            planInTheBrowser(b, set);
+            b.await("the plan admitted", WAIT, () -> {
+                String t = textOf(b, "#arflex-cs-admission");
+                return t != null && t.startsWith("Admitted") ? t : null;
+            }, b::source);
+            b.click(b.findAll("#arflex-cs-apply").get(0));
+            // live: the shadow run with its cycles counting and the worst deviation so far
+            String shadow = b.await("the shadow run shown live, its cycles counting", WAIT, () -> {
+                String phase = (String) b.js("const e = document.getElementById('arflex-cs-live-box');"
+                        + " return e && e.dataset.running === 'true' ? e.dataset.phase : null;");
+                String cycle = (String) b.js("const e = document.getElementById('arflex-cs-live-cycles');"
+                        + " return e ? e.dataset.cycle : null;");
+                return "shadow".equals(phase) && cycle != null && Long.parseLong(cycle) > 0
+                        ? textOf(b, "#arflex-cs-live-box") : null;
+            }, b::source);
+            b.screenshot(shots.resolve("changesets-progress-shadow.png"));
+            assertTrue(shadow.contains("Applying now: update sample-scaler"), shadow);
+            assertTrue(shadow.contains("of 300 (sample-scaler)"), shadow);
+            assertTrue(shadow.contains("update sample-scaler: shadow run of pid"), shadow);
+            assertEquals(scalerPid, pid("sample-scaler"), "nothing switched during the shadow run");
+            String window = b.await("the rollback window shown live", WAIT, () -> {
+                String phase = (String) b.js("const e = document.getElementById('arflex-cs-live-box');"
+                        + " return e ? e.dataset.phase + '/' + e.dataset.running : null;");
+                return "window/true".equals(phase) || (phase != null && phase.startsWith("done/"))
+                        ? phase + " " + textOf(b, "#arflex-cs-live-box") : null;
+            }, b::source);
+            System.out.println("ChangeSetConsoleIT: after the shadow run the page showed: " + window);
+            String done = b.await("the outcome shown live", WAIT, () -> {
+                String phase = (String) b.js("const e = document.getElementById('arflex-cs-live-box');"
+                        + " return e ? e.dataset.phase + '/' + e.dataset.outcome : null;");
+                return phase != null && phase.startsWith("done/") ? phase : null;
+            }, b::source);
+            b.screenshot(shots.resolve("changesets-progress-done.png"));
+            assertEquals("done/committed", done, textOf(b, "#arflex-cs-live-box"));
+            @SuppressWarnings("unchecked")
+            List<String> phases = (List<String>) b.js("return Array.from(document.querySelectorAll("
+                    + "'#arflex-cs-live-phases li')).map(e => e.dataset.phase);");
+            assertEquals(List.of("checking", "preparing", "shadow", "switching", "window", "bundles", "done"), phases);
+        }
+        // the endpoint says the same, and the new version runs
+        Map<String, Object> p = Json.object(rt.get(PAGE + "/api/changeset-progress", true).body());
+        @SuppressWarnings("unchecked")
+        Map<String, Object> last = (Map<String, Object>) p.get("progress");
+        assertEquals("committed", last.get("outcome"), String.valueOf(p));
+        assertTrue(String.valueOf(last.get("why")).contains("update sample-scaler: passed its shadow run of"), String.valueOf(p));
+        RuntimeUnderTest.awaitCondition("the new version running", WAIT,
+                () -> pid("sample-scaler") != scalerPid && "ACTIVE".equals(state("sample-scaler")));
+        // the shell says the same: arflex:change progress, its output in the runtime's log
+        rt.gogo("arflex:change progress");
+        RuntimeUnderTest.awaitCondition("arflex:change progress answered", WAIT,
+                () -> rt.tail().contains("outcome: committed: update sample-scaler: passed its shadow run of 3"));
+        assertTrue(rt.tail().contains("(phases checking > preparing > shadow > switching > window > bundles > done)\n"
+                + "outcome: committed: update sample-scaler: passed its shadow run of 3"),
+                rt.tail());
     }
 }

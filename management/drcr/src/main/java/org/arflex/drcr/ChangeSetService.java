@@ -2,6 +2,7 @@ package org.arflex.drcr;
 
 import java.util.List;
 import org.arflex.drcr.dto.ChangeSetDTO;
+import org.arflex.drcr.dto.ChangeSetProgressDTO;
 
 /**
  * Change sets (docs/DECISIONS.md D35): several actions planned, admitted and applied together,
@@ -47,4 +48,15 @@ public interface ChangeSetService {
      * (D46).
      */
     List<ChangeSetDTO> history();
+
+    /**
+     * Where the set being applied is (docs/DECISIONS.md D53): its phase (checking, preparing,
+     * shadow, switching, window, bundles), what it does in it, an update's shadow or window
+     * cycles so far and the compared field closest to its tolerance; once over, phase
+     * {@code done} with the outcome, until the next apply begins. Null when no set was applied
+     * in this runtime. A snapshot: reading it never waits for the apply.
+     *
+     * @since 0.8.0
+     */
+    ChangeSetProgressDTO progress();
 }

@@ -4,5 +4,5 @@
  * {@link org.arflex.drcr.ResourceManager} and the {@link org.arflex.drcr.UpdateService}.
  */
 @org.osgi.annotation.bundle.Export
-@org.osgi.annotation.versioning.Version("0.7.0")
+@org.osgi.annotation.versioning.Version("0.8.0")
 package org.arflex.drcr;

@@ -29,6 +29,10 @@ import org.arflex.drcr.dto.ChangeSetDTO;
  * last one this console applied (with whether the plan the DRCR applied was the one shown), and
  * the DRCR's history of the sets applied in this runtime, each with its outcome
  * ({@link ChangeSetOutcome}).</li>
+ * <li>{@code GET changeset-progress}: where the set being applied is (D53), as the DRCR says it
+ * ({@link ChangeSetService#progress}): its phase, what it does, an update's shadow or window
+ * cycles and the worst deviation so far, then the outcome; the page polls it while a set is
+ * applied. Read-only, authenticated like every page's GET.</li>
  * </ul>
  * Every outcome of an apply started here is written to the audit log once it is known.
  */
@@ -65,6 +69,7 @@ final class ChangeSetBackend {
     Routes routes() {
         return new Routes()
                 .get("changesets", call -> status())
+                .get("changeset-progress", call -> progress())
                 .post("changeset-plan", call -> plan(call.param("actions")))
                 .post("changeset-apply", call -> apply(call.param("actions"), call.param("plan"), call.user(),
                         call.remote()));
@@ -201,6 +206,41 @@ final class ChangeSetBackend {
         if (audit != null) {
             audit.outcome(r.user(), remote, r.actions(), view);
         }
+    }
+
+    /**
+     * Where the set being applied is, or how the last one ended (D53): {@code progress} null when
+     * no set was applied in this runtime; {@code drcr} false without the DRCR.
+     */
+    Map<String, Object> progress() {
+        Map<String, Object> m = new LinkedHashMap<>();
+        ChangeSetService s = service.get();
+        m.put("drcr", s != null);
+        org.arflex.drcr.dto.ChangeSetProgressDTO p = s == null ? null : s.progress();
+        if (p == null) {
+            m.put("progress", null);
+            return m;
+        }
+        Map<String, Object> v = new LinkedHashMap<>();
+        v.put("actions", p.actions == null ? List.of() : List.of(p.actions));
+        v.put("running", p.running);
+        v.put("phase", p.phase);
+        v.put("phases", p.phases == null ? List.of() : List.of(p.phases));
+        v.put("step", p.step);
+        v.put("component", p.component);
+        v.put("cycle", p.cycle);
+        v.put("cycles", p.cycles);
+        v.put("worstField", p.worstField);
+        v.put("worstDeviation", p.worstDeviation);
+        v.put("tolerance", p.tolerance);
+        v.put("startedMillis", p.startedMillis);
+        v.put("phaseMillis", p.phaseMillis);
+        v.put("forMs", Math.max(0, clock.getAsLong() - p.startedMillis));
+        v.put("outcome", p.outcome);
+        v.put("why", p.why);
+        v.put("seq", p.seq);
+        m.put("progress", v);
+        return m;
     }
 
     /** What is being applied, the last outcome here, and the DRCR's history. */

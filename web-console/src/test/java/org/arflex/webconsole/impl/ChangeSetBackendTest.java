@@ -53,6 +53,7 @@ class ChangeSetBackendTest {
     private boolean admitted = true;
     private String refusal;
     private ChangeSetDTO applyAnswer;
+    private org.arflex.drcr.dto.ChangeSetProgressDTO progressAnswer;
     private ChangeSetService service;
     private ChangeSetBackend backend;
 
@@ -84,6 +85,11 @@ class ChangeSetBackendTest {
             @Override
             public List<ChangeSetDTO> history() {
                 return applyAnswer == null ? List.of() : List.of(applyAnswer);
+            }
+
+            @Override
+            public org.arflex.drcr.dto.ChangeSetProgressDTO progress() {
+                return progressAnswer;
             }
         };
         backend = new ChangeSetBackend(() -> service, started::add,
@@ -291,5 +297,42 @@ class ChangeSetBackendTest {
         service = null;
         assertEquals(503, assertThrows(HttpError.class, () -> backend.plan("install teach")).status);
         assertEquals(false, backend.status().get("drcr"));
+        assertEquals(false, backend.progress().get("drcr"));
+        assertNull(backend.progress().get("progress"));
+    }
+
+    @Test
+    @SuppressWarnings("unchecked")
+    void theProgressOfAnApplyIsTheDrcrsSnapshotAsJson() {
+        assertNull(backend.progress().get("progress"), "no set applied in this runtime");
+        assertEquals(true, backend.progress().get("drcr"));
+        org.arflex.drcr.dto.ChangeSetProgressDTO p = new org.arflex.drcr.dto.ChangeSetProgressDTO();
+        p.actions = new String[] {"update stage file:/x.jar"};
+        p.running = true;
+        p.phase = "shadow";
+        p.phases = new String[] {"checking", "preparing", "shadow"};
+        p.step = "update stage: shadow run of pid 7, cycle 40 of 100";
+        p.component = "stage";
+        p.cycle = 40;
+        p.cycles = 100;
+        p.worstField = "y.value";
+        p.worstDeviation = 0.004;
+        p.tolerance = 0.01;
+        p.startedMillis = 1_700_000_000_000L - 2_500;
+        p.seq = 17;
+        progressAnswer = p;
+        Map<String, Object> v = (Map<String, Object>) backend.progress().get("progress");
+        assertEquals(List.of("update stage file:/x.jar"), v.get("actions"));
+        assertEquals(true, v.get("running"));
+        assertEquals("shadow", v.get("phase"));
+        assertEquals(List.of("checking", "preparing", "shadow"), v.get("phases"));
+        assertEquals(40L, v.get("cycle"));
+        assertEquals(100L, v.get("cycles"));
+        assertEquals("y.value", v.get("worstField"));
+        assertEquals(0.004, v.get("worstDeviation"));
+        assertEquals(2_500L, v.get("forMs"));
+        assertEquals(17L, v.get("seq"));
+        assertNull(v.get("outcome"));
+        assertTrue(started.isEmpty() && applied.isEmpty(), "reading the progress applies nothing");
     }
 }

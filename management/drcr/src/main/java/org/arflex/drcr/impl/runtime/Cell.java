@@ -66,6 +66,8 @@ public final class Cell {
     private final PlanExecutor plans;
     private final WcetMonitor wcet;
     private final ChangeSetExecutor changeSets;
+    /** The live progress of the change set being applied (D53); read from any thread. */
+    private final ChangeSetProgress changeSetProgress = new ChangeSetProgress(System::currentTimeMillis);
 
     /** A cell whose launches and stops run inline, on the caller (tests with a steppable actor). */
     public Cell(Config cfg, Actor actor, RtLauncher launcher, Planner planner, Consumer<String> log) {
@@ -93,7 +95,7 @@ public final class Cell {
                 planner, this::changed, this::resume);
         this.plans = new PlanExecutor(this, stops, segments, starter, log);
         this.wcet = new WcetMonitor(this, log);
-        this.changeSets = new ChangeSetExecutor(this, stops, segments, starter, plans, failures, log);
+        this.changeSets = new ChangeSetExecutor(this, stops, segments, starter, plans, failures, log, changeSetProgress);
     }
 
     // Callbacks into parts built after the part that calls them (a crash re-plans, a plan's
@@ -450,10 +452,20 @@ public final class Cell {
      * switched, refused or torn down; when not applied nothing of the cell changed.
      */
     public CompletableFuture<ChangeSetResult> applyChangeSet(ChangeSet set) {
+        return applyChangeSet(set, null);
+    }
+
+    /** As above, its phases published through {@code shown} (D53; null: an apply of its own). */
+    public CompletableFuture<ChangeSetResult> applyChangeSet(ChangeSet set, ChangeSetProgress.Apply shown) {
         actor.checkThread();
         CompletableFuture<ChangeSetResult> f = new CompletableFuture<>();
-        changeSets.apply(set, o -> f.complete(ChangeSetResult.of(set, o)));
+        changeSets.apply(set, shown, o -> f.complete(ChangeSetResult.of(set, o)));
         return f;
+    }
+
+    /** Where the change set being applied is, or how the last one ended (D53); any thread. */
+    public ChangeSetProgress changeSetProgress() {
+        return changeSetProgress;
     }
 
     /** {@code to} takes {@code from}'s place in the registry (actor thread): an update's switch or rollback (D38). */

@@ -21,7 +21,7 @@ public record ChangeSetResult(boolean applied, boolean admitted, String refusal,
         this(applied, admitted, refusal, text, prepareMs, switchUs, null);
     }
 
-    static ChangeSetResult of(ChangeSet set, ChangeSetExecutor.Outcome o) {
+    static ChangeSetResult of(ChangeSet set, SetOutcome o) {
         return new ChangeSetResult(o.applied(), o.refusal() == null, o.refusal(), o.text(set), o.prepareNs() / 1e6,
                 o.switchNs() / 1e3, o.verdict());
     }

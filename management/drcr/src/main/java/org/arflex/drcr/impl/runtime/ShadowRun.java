@@ -62,6 +62,8 @@ final class ShadowRun {
     private final Segments segments;
     private final Consumer<String> log;
     private final Outcome outcome;
+    /** Where the change set says how far it is (D53). */
+    private final ChangeSetProgress.Apply progress;
     private Actor.Cancellable timer;
     private boolean done;
     private long cycles0;
@@ -76,8 +78,9 @@ final class ShadowRun {
     private long compared;
     private final double[] largest;
 
-    ShadowRun(Cell cell, Segments segments, Consumer<String> log, Outcome outcome, ChangeSet.Update update,
-              Instance old, RtHalf oldHalf, Instance next, RtHalf nextHalf) {
+    ShadowRun(Cell cell, Segments segments, Consumer<String> log, ChangeSetProgress.Apply progress, Outcome outcome,
+              ChangeSet.Update update, Instance old, RtHalf oldHalf, Instance next, RtHalf nextHalf) {
+        this.progress = progress;
         this.cell = cell;
         this.segments = segments;
         this.log = log;
@@ -123,6 +126,30 @@ final class ShadowRun {
         newBad0 = ChangeSetExecutor.bad(n);
         oldBad0 = ChangeSetExecutor.bad(o);
         timer = cell.actor().schedule(this::look, ChangeSetExecutor.WATCH_MS);
+        publish(0, 0);
+    }
+
+    /**
+     * Says how far the run is (D53): its cycles, and the compared field closest to its
+     * tolerance so far (the largest difference relative to the tolerance).
+     */
+    private void publish(long cycles, long bad) {
+        int worst = -1;
+        for (int i = 0; i < largest.length; i++) {
+            double abs = update.tolerances().get(i).abs();
+            double r = abs > 0 ? largest[i] / abs : largest[i];
+            if (worst < 0 || r > (update.tolerances().get(worst).abs() > 0
+                    ? largest[worst] / update.tolerances().get(worst).abs() : largest[worst])) {
+                worst = i;
+            }
+        }
+        ChangeSet.Tolerance t = worst < 0 ? null : update.tolerances().get(worst);
+        progress.cycles(ChangeSetProgress.SHADOW, String.format(Locale.ROOT, "update %s: shadow run of pid %d, cycle %d "
+                + "of %d, %d values compared, %d overruns or deadline misses%s", next.name, nextHalf.pid(), cycles,
+                update.shadow(), compared, bad, t == null ? "" : String.format(Locale.ROOT,
+                        ", worst %s.%s %.3g from the running version's (tolerance %s)", t.port(), t.field(),
+                        largest[worst], t.abs())), next.name, cycles, update.shadow(),
+                t == null ? null : t.port() + "." + t.field(), t == null ? 0 : largest[worst], t == null ? 0 : t.abs());
     }
 
     /** The new half's cycles since its START; the last seen once it is gone. */
@@ -216,6 +243,7 @@ final class ShadowRun {
             }
             sb.append(')');
             cell.monitor().unwatch(nextHalf); // watched again as the component's half at the switch
+            publish(cycles, newBad);
             outcome.passed(this, sb.toString());
             return;
         }
@@ -223,6 +251,9 @@ final class ShadowRun {
             reject(String.format(Locale.ROOT, "it ran only %d of its %d shadow cycles in %d ms", cycles,
                     update.shadow(), limitMs));
             return;
+        }
+        if (cycles != before) {
+            publish(cycles, newBad);
         }
         timer = cell.actor().schedule(this::look, ChangeSetExecutor.WATCH_MS);
     }

@@ -31,23 +31,28 @@ final class UpdateWindow {
     long tEndNs;
     org.arflex.drcr.impl.lifecycle.Actor.Cancellable timer;
     boolean done;
+    /** The window's cycles last published (D53). */
+    private long lastPublished = -1;
 
     private final ChangeSetExecutor owner;
     private final Cell cell;
     private final Stops stops;
     private final Segments segments;
     private final Consumer<String> log;
+    /** Where the change set says how far it is (D53). */
+    private final ChangeSetProgress.Apply progress;
     /** The executor's open windows, by component name (actor thread). */
     private final Map<String, UpdateWindow> warm;
 
     UpdateWindow(ChangeSetExecutor owner, Cell cell, Stops stops, Segments segments, Consumer<String> log,
-                 Map<String, UpdateWindow> warm, ChangeSet set, ChangeSet.Update update, Instance old, RtHalf oldHalf,
+                 ChangeSetProgress.Apply progress, Map<String, UpdateWindow> warm, ChangeSet set, ChangeSet.Update update, Instance old, RtHalf oldHalf,
                  Instance next) {
         this.owner = owner;
         this.cell = cell;
         this.stops = stops;
         this.segments = segments;
         this.log = log;
+        this.progress = progress;
         this.warm = warm;
         this.set = set;
         this.update = update;
@@ -81,6 +86,9 @@ final class UpdateWindow {
         log.accept("arflex: " + next.name + ": update switched to pid " + nextHalf.pid() + " (" + next.objectId
                 + "); the old version (pid " + oldHalf.pid() + ", " + old.objectId + ") is kept warm for "
                 + update.window() + " cycles");
+        progress.cycles(ChangeSetProgress.WINDOW, "update " + next.name + ": switched to pid " + nextHalf.pid()
+                + ", rollback window of " + update.window() + " cycles, pid " + oldHalf.pid() + " kept warm", next.name,
+                0, update.window(), null, 0, 0);
         // the counters' baseline right after the switch turn, which it would only lengthen
         cell.actor().submit(this::baseline);
     }
@@ -131,6 +139,12 @@ final class UpdateWindow {
             end(String.format(java.util.Locale.ROOT, "committed: the new version ran %d cycles (%d overruns or "
                     + "deadline misses, the old one %d)", cycles, newBad, oldBad), cycles);
             return;
+        }
+        if (cycles != lastPublished) {
+            lastPublished = cycles;
+            progress.cycles(ChangeSetProgress.WINDOW, String.format(java.util.Locale.ROOT, "update %s: rollback "
+                    + "window, cycle %d of %d of pid %d (%d overruns or deadline misses, the old version %d)", next.name,
+                    cycles, update.window(), nextHalf.pid(), newBad, oldBad), next.name, cycles, update.window(), null, 0, 0);
         }
         timer = cell.actor().schedule(this::watch, ChangeSetExecutor.WATCH_MS);
     }
@@ -194,6 +208,9 @@ final class UpdateWindow {
         String v = "update " + next.name + ": " + why;
         log.accept("arflex: " + v);
         cell.changed();
+        if (update.window() > 0 && nextHalf != null) {
+            progress.phase(ChangeSetProgress.WINDOW, v);
+        }
         verdict.complete(v);
     }
 
@@ -251,6 +268,7 @@ final class UpdateWindow {
                 next.name, cycles, update.from(), why, oldHalf.pid(), old.objectId, boundBackNanos / 1e6);
         old.life.reason(null);
         cell.problem("change set " + set.describe() + ": " + v);
+        progress.phase(ChangeSetProgress.WINDOW, v);
         verdict.complete(v);
     }
 }

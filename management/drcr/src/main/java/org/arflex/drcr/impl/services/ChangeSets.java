@@ -14,8 +14,10 @@ import java.util.function.Consumer;
 import org.arflex.contract.Contract;
 import org.arflex.drcr.ChangeSetService;
 import org.arflex.drcr.dto.ChangeSetDTO;
+import org.arflex.drcr.dto.ChangeSetProgressDTO;
 import org.arflex.drcr.impl.runtime.Cell;
 import org.arflex.drcr.impl.runtime.ChangeSet;
+import org.arflex.drcr.impl.runtime.ChangeSetProgress;
 import org.arflex.drcr.impl.runtime.ChangeSetResult;
 import org.arflex.drcr.impl.runtime.Instance;
 import org.osgi.framework.Bundle;
@@ -222,7 +224,7 @@ public final class ChangeSets implements ChangeSetService {
 
     @Override
     public ChangeSetDTO apply(List<String> actions) {
-        return history.record(applyOnce(actions));
+        return history.record(applyShown(actions));
     }
 
     @Override
@@ -230,13 +232,39 @@ public final class ChangeSets implements ChangeSetService {
         return history.list();
     }
 
-    private ChangeSetDTO applyOnce(List<String> actions) {
+    @Override
+    public ChangeSetProgressDTO progress() {
+        return cell.changeSetProgress().snapshot();
+    }
+
+    /** The apply, its phases published (D53), ended with its outcome whichever way it returns. */
+    private ChangeSetDTO applyShown(List<String> actions) {
+        ChangeSetProgress.Apply p = cell.changeSetProgress().begin(actions);
+        String[] verdict = new String[1];
+        boolean[] missing = new boolean[1];
+        ChangeSetDTO d = null;
+        try {
+            d = applyOnce(actions, p, verdict, missing);
+            return d;
+        } finally {
+            if (d == null) {
+                p.done("refused", "the apply failed: see the runtime's log");
+            } else {
+                String outcome = ChangeSetProgress.outcomeOf(d.applied, d.refusal, verdict[0], missing[0]);
+                p.done(outcome, d.refusal != null ? d.refusal : verdict[0]);
+            }
+        }
+    }
+
+    private ChangeSetDTO applyOnce(List<String> actions, ChangeSetProgress.Apply p, String[] verdictOut,
+                                   boolean[] verdictMissing) {
         List<String[]> parsed;
         try {
             parsed = parse(actions);
         } catch (IllegalArgumentException e) {
             return refused(actions, e.getMessage());
         }
+        p.phase(ChangeSetProgress.CHECKING, "checking the bundles behind the actions");
         String bundles = bundleProblems(parsed);
         if (bundles != null) {
             return refused(actions, bundles);
@@ -251,6 +279,7 @@ public final class ChangeSets implements ChangeSetService {
         }
         // refused sets are refused before anything is extracted from a bundle or a jar
         java.util.Map<String, Version> read = new java.util.HashMap<>();
+        p.phase(ChangeSetProgress.CHECKING, "reading the new versions of updates, the dry run");
         ChangeSet dryRun;
         try {
             dryRun = build(parsed, false, read);
@@ -262,12 +291,13 @@ public final class ChangeSets implements ChangeSetService {
             return dto(actions, dry);
         }
         ChangeSet set;
+        p.phase(ChangeSetProgress.CHECKING, "extracting the executables of installs and updates");
         try {
             set = build(parsed, true, read);
         } catch (IllegalStateException e) {
             return refused(actions, e.getMessage());
         }
-        CompletableFuture<ChangeSetResult> f = cell.actor().call(() -> cell.applyChangeSet(set), Services.CALL_MS);
+        CompletableFuture<ChangeSetResult> f = cell.actor().call(() -> cell.applyChangeSet(set, p), Services.CALL_MS);
         ChangeSetResult r;
         try {
             r = f.get(APPLY_MS, TimeUnit.MILLISECONDS);
@@ -278,6 +308,10 @@ public final class ChangeSets implements ChangeSetService {
             return refused(actions, "interrupted");
         }
         ChangeSetDTO d = dto(actions, r);
+        if (r.applied() && r.verdict() == null // a set with updates is in their windows now: said after them
+                && parsed.stream().anyMatch(a -> a[0].equals("install") || a[0].equals("uninstall"))) {
+            p.phase(ChangeSetProgress.BUNDLES, "starting and stopping the bundles of installed and uninstalled components");
+        }
         if (r.applied()) {
             d.text += followBundles(parsed, bundleIds);
         }
@@ -285,8 +319,13 @@ public final class ChangeSets implements ChangeSetService {
             // an update's rollback window: the command says how it ended (committed or rolled back, why)
             try {
                 String verdict = r.verdict().get(APPLY_MS, TimeUnit.MILLISECONDS);
+                verdictOut[0] = verdict;
+                if (verdict.contains(": committed")) {
+                    p.phase(ChangeSetProgress.BUNDLES, "updating the bundles of committed updates");
+                }
                 d.text += verdict + "\n" + followUpdates(parsed, bundleIds, read, verdict);
             } catch (ExecutionException | TimeoutException e) {
+                verdictMissing[0] = true;
                 d.text += "warning: no verdict of the rollback window yet: " + e + "\n";
             } catch (InterruptedException e) {
                 Thread.currentThread().interrupt();

@@ -209,13 +209,17 @@ public final class Commands {
      * {@code install <component>} (its bundle installed, not started), {@code uninstall <component>},
      * {@code set <component> <parameter> <value>} and {@code update <component> <jar URL> [<sha256>]
      * [window <cycles>] [shadow <cycles>] [envelope ...] [tolerance ...]} (D38, D42), in any number, e.g.
-     * {@code change apply install teach uninstall trajectory}.
+     * {@code change apply install teach uninstall trajectory}. {@code change progress}: where the
+     * set being applied is, or how the last one ended (D53).
      */
     public String change(String... args) {
         return guard(() -> {
-            String usage = "usage: change plan|apply <action>... (actions: install <component>, uninstall <component>,"
+            String usage = "usage: change plan|apply <action>... | change progress (actions: install <component>, uninstall <component>,"
                     + " set <component> <parameter> <value>, update <component> <jar URL> [<sha256>] [window <cycles>]"
                     + " [shadow <cycles>] [envelope <port>.<field> <min> <max>]... [tolerance <port>.<field> <max difference>]...)";
+            if (changeSets != null && args.length == 1 && args[0].equals("progress")) {
+                return ChangeSetProgressText.of(changeSets.progress(), System.currentTimeMillis());
+            }
             if (changeSets == null || args.length < 2 || !(args[0].equals("plan") || args[0].equals("apply"))) {
                 return usage;
             }

@@ -39,6 +39,11 @@ class CommandsDeploySetTest {
         public List<ChangeSetDTO> history() {
             throw new AssertionError("not a change set");
         }
+
+        @Override
+        public org.arflex.drcr.dto.ChangeSetProgressDTO progress() {
+            throw new AssertionError("not a change set");
+        }
     };
 
     private final Commands cmd = new Commands(null, null, null, n -> Optional.empty(), new Commands.BundleUpdater() {

@@ -1,0 +1,192 @@
+package org.arflex.drcr.impl.runtime;
+
+import java.util.ArrayList;
+import java.util.List;
+import java.util.function.LongSupplier;
+import org.arflex.drcr.dto.ChangeSetProgressDTO;
+
+/**
+ * The live progress of the change set being applied (D53): its phase, what it does in it, an
+ * update's shadow or window cycles, then its outcome. Whoever applies a set publishes through
+ * its {@link Apply}; {@link #snapshot} reads the last snapshot without a lock (a volatile
+ * field holding a DTO that is never changed once published), so a reader never holds up the
+ * actor, and publishing is a few field writes under this object's lock, no I/O.
+ *
+ * <p>One set is shown: an apply begun while another is shown and still running is not shown
+ * (its publishing is ignored) unless the executor takes it ({@link Apply#claim}), which happens
+ * only to the one set it accepts; the executor applies one set at a time.
+ */
+public final class ChangeSetProgress {
+    /** The phases, in their order. */
+    public static final String CHECKING = "checking";
+    public static final String PREPARING = "preparing";
+    public static final String SHADOW = "shadow";
+    public static final String SWITCHING = "switching";
+    public static final String WINDOW = "window";
+    public static final String BUNDLES = "bundles";
+    public static final String DONE = "done";
+
+    private final LongSupplier clock;
+    private volatile ChangeSetProgressDTO shown;
+    /** The apply shown (guarded by this). */
+    private Apply owner;
+    private long seq;
+
+    public ChangeSetProgress(LongSupplier wallClockMillis) {
+        this.clock = wallClockMillis;
+    }
+
+    /** The last snapshot (a copy), or null when no set was applied in this runtime. */
+    public ChangeSetProgressDTO snapshot() {
+        ChangeSetProgressDTO d = shown;
+        return d == null ? null : copy(d);
+    }
+
+    /**
+     * An apply of {@code actions} begins: shown from now on in phase {@link #CHECKING}, unless
+     * another apply is shown and still running.
+     */
+    public synchronized Apply begin(List<String> actions) {
+        Apply a = new Apply(actions);
+        if (owner == null || !owner.running) {
+            a.take();
+        }
+        return a;
+    }
+
+    private static ChangeSetProgressDTO copy(ChangeSetProgressDTO d) {
+        ChangeSetProgressDTO c = new ChangeSetProgressDTO();
+        c.actions = d.actions.clone();
+        c.running = d.running;
+        c.phase = d.phase;
+        c.step = d.step;
+        c.component = d.component;
+        c.cycle = d.cycle;
+        c.cycles = d.cycles;
+        c.worstField = d.worstField;
+        c.worstDeviation = d.worstDeviation;
+        c.tolerance = d.tolerance;
+        c.phases = d.phases.clone();
+        c.startedMillis = d.startedMillis;
+        c.phaseMillis = d.phaseMillis;
+        c.outcome = d.outcome;
+        c.why = d.why;
+        c.seq = d.seq;
+        return c;
+    }
+
+    /**
+     * The outcome of an apply in the console's words (D46): {@code verdict}, the lines of the
+     * updates' windows (null when the set has no update, or none came: {@code verdictMissing}).
+     */
+    public static String outcomeOf(boolean applied, String refusal, String verdict, boolean verdictMissing) {
+        if (!applied) {
+            String r = refusal == null ? "" : refusal;
+            if (r.matches("(?s)update \\S+: rejected in shadow after \\d+ cycles.*")) {
+                return "rejected-in-shadow";
+            }
+            return r.startsWith("preparation failed") || r.contains("the cell changed while the set was prepared")
+                    ? "torn-down" : "refused";
+        }
+        if (verdict != null && verdict.lines().anyMatch(l -> l.matches("update \\S+: rolled back after \\d+ cycles.*"))) {
+            return "rolled-back";
+        }
+        return verdictMissing ? "applied" : "committed";
+    }
+
+    /** One apply's publisher. Every method may be called from any thread. */
+    public final class Apply {
+        private final String[] actions;
+        private final List<String> phases = new ArrayList<>();
+        private long startedMillis;
+        private long phaseMillis;
+        private String phase;
+        private boolean running = true;
+
+        private Apply(List<String> actions) {
+            this.actions = actions.toArray(String[]::new);
+        }
+
+        /** Shown from now on (the executor accepted this set): its phases start afresh. */
+        public void claim() {
+            synchronized (ChangeSetProgress.this) {
+                if (owner != this) {
+                    take();
+                }
+            }
+        }
+
+        private void take() {
+            owner = this;
+            startedMillis = clock.getAsLong();
+            phases.clear();
+            phase = null;
+            shown = next(CHECKING, "checking the actions", null, 0, 0);
+        }
+
+        /** Enters {@code phase} (or stays in it) doing {@code step}; an entered phase is listed once. */
+        public void phase(String phase, String step) {
+            cycles(phase, step, null, 0, 0, null, 0, 0);
+        }
+
+        /** In {@code phase}, {@code step}, about {@code component} at {@code cycle} of {@code cycles}. */
+        public void cycles(String phase, String step, String component, long cycle, long cycles, String worstField,
+                           double worstDeviation, double tolerance) {
+            synchronized (ChangeSetProgress.this) {
+                if (owner != this || !running) {
+                    return;
+                }
+                ChangeSetProgressDTO d = next(phase, step, component, cycle, cycles);
+                d.worstField = worstField;
+                d.worstDeviation = worstDeviation;
+                d.tolerance = tolerance;
+                shown = d;
+            }
+        }
+
+        /** The outcome: shown until the next apply begins. */
+        public void done(String outcome, String why) {
+            synchronized (ChangeSetProgress.this) {
+                if (owner != this || !running) {
+                    return;
+                }
+                ChangeSetProgressDTO d = next(DONE, outcome + (why == null ? "" : ": " + why), null, 0, 0);
+                d.running = false;
+                d.outcome = outcome;
+                d.why = why;
+                running = false;
+                shown = d;
+            }
+        }
+
+        /** True while this apply is shown and running. */
+        public boolean shown() {
+            synchronized (ChangeSetProgress.this) {
+                return owner == this && running;
+            }
+        }
+
+        /** The next snapshot (under the lock); the caller publishes it once complete. */
+        private ChangeSetProgressDTO next(String phase, String step, String component, long cycle, long cycles) {
+            long now = clock.getAsLong();
+            if (!phase.equals(this.phase)) {
+                this.phase = phase;
+                phaseMillis = now;
+                phases.add(phase);
+            }
+            ChangeSetProgressDTO d = new ChangeSetProgressDTO();
+            d.actions = actions;
+            d.running = true;
+            d.phase = phase;
+            d.step = step;
+            d.component = component;
+            d.cycle = cycle;
+            d.cycles = cycles;
+            d.phases = phases.toArray(String[]::new);
+            d.startedMillis = startedMillis;
+            d.phaseMillis = phaseMillis;
+            d.seq = ++seq;
+            return d;
+        }
+    }
+}

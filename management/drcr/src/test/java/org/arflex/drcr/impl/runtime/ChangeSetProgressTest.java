@@ -1,0 +1,276 @@
+package org.arflex.drcr.impl.runtime;
+
+import static org.junit.jupiter.api.Assertions.assertArrayEquals;
+import static org.junit.jupiter.api.Assertions.assertEquals;
+import static org.junit.jupiter.api.Assertions.assertFalse;
+import static org.junit.jupiter.api.Assertions.assertNull;
+import static org.junit.jupiter.api.Assertions.assertTrue;
+
+import java.nio.ByteBuffer;
+import java.nio.ByteOrder;
+import java.nio.file.Path;
+import java.util.ArrayList;
+import java.util.List;
+import java.util.concurrent.CompletableFuture;
+import java.util.concurrent.atomic.AtomicLong;
+import org.arflex.contract.Contract;
+import org.arflex.contract.ContractParser;
+import org.arflex.contract.PortTypes;
+import org.arflex.drcr.dto.ChangeSetProgressDTO;
+import org.arflex.drcr.impl.abi.ControlBlock;
+import org.arflex.drcr.impl.lifecycle.ManualActor;
+import org.arflex.drcr.impl.lifecycle.State;
+import org.junit.jupiter.api.AfterEach;
+import org.junit.jupiter.api.Test;
+
+/**
+ * The live progress of an apply (D53), read as the console and the shell read it, between the
+ * actor's steps: the phases an update with a shadow run and a rollback window goes through, its
+ * cycles and the worst deviation so far, then the outcome; a rejected one; and which apply is
+ * shown when two begin. The cell of {@link CellShadowRunTest}: {@code src} -> {@code stage} ->
+ * {@code user}, steppable actor, fake halves.
+ */
+class ChangeSetProgressTest {
+
+    private static final String IN_SRC = "<in name=\"x\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\">"
+            + "<bind filter=\"(role=src)\"/></in>";
+    private static final String OUT = "<out name=\"y\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\"/>";
+    private static final String IN_STAGE = "<in name=\"x\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\">"
+            + "<bind filter=\"(role=stage)\"/></in>";
+    private static final String OLD_Y = "/arflex.t.stage.out.y";
+    private static final String NEW_Y = "/arflex.t.1-stage.out.y";
+
+    private final FakeLauncher fake = new FakeLauncher();
+    private final SteppedCell rig = new SteppedCell(fake, fake, true);
+    private final ManualActor actor = rig.actor;
+    private final Cell cell = rig.cell;
+    /** Every distinct snapshot seen between steps, in order. */
+    private final List<ChangeSetProgressDTO> seen = new ArrayList<>();
+
+    @AfterEach
+    void nothingLeaks() {
+        rig.close();
+    }
+
+    private static Contract parse(String name, String role, String ports, String version) throws Exception {
+        String xml = CellChangeSetTest.contract(name, role, ports, "50us").replace("version=\"1.0.0\"",
+                "version=\"" + version + "\"");
+        return ContractParser.create(PortTypes.builtin()).parse(xml, "test.xml");
+    }
+
+    private void install(Contract c) {
+        assertTrue(actor.call(() -> cell.install(c, c.name().hashCode(), Path.of("/nonexistent/" + c.name())), 0),
+                rig.log::toString);
+        rig.stepUntil(c.name() + " ACTIVE", () -> rig.state(c.name()) == State.ACTIVE);
+    }
+
+    private void runningCell() throws Exception {
+        install(parse("src", "src", OUT, "1.0.0"));
+        install(parse("stage", "stage", IN_SRC + OUT, "1.0.0"));
+        install(parse("user", null, IN_STAGE, "1.0.0"));
+    }
+
+    private ChangeSet update(long shadow, long window) throws Exception {
+        return ChangeSet.builder().update("stage", parse("stage", "stage", IN_SRC + OUT, "1.1.0"),
+                Path.of("/nonexistent/stage-1.1"), "file:/x/stage-1.1.jar", window, List.of(), shadow,
+                List.of(new ChangeSet.Tolerance("y", "value", 0.01))).build();
+    }
+
+    private static ControlBlock.Stats cycles(long n) {
+        return new ControlBlock.Stats(n, 0, 0, 0, 0, 0, 0, 0, 0, 0);
+    }
+
+    private static byte[] sample(long seq, long tNs, double value) {
+        return ByteBuffer.allocate(24).order(ByteOrder.LITTLE_ENDIAN).putLong(seq).putLong(tNs).putDouble(value).array();
+    }
+
+    /** The snapshot now, as a reader off the actor gets it; recorded when it moved. */
+    private ChangeSetProgressDTO now() {
+        ChangeSetProgressDTO p = cell.changeSetProgress().snapshot();
+        if (p != null && (seen.isEmpty() || seen.get(seen.size() - 1).seq != p.seq)) {
+            assertTrue(seen.isEmpty() || seen.get(seen.size() - 1).seq < p.seq, "seq grows");
+            seen.add(p);
+        }
+        return p;
+    }
+
+    private void look() {
+        actor.advance(ChangeSetExecutor.WATCH_MS);
+        actor.runAll();
+        now();
+    }
+
+    private CompletableFuture<ChangeSetResult> applyIntoShadow(ChangeSet set) {
+        CompletableFuture<ChangeSetResult> f = actor.call(() -> cell.applyChangeSet(set), 0);
+        rig.stepUntil("the new half started in shadow", () -> {
+            now();
+            return fake.events.contains("1-stage START") || f.isDone();
+        });
+        now();
+        return f;
+    }
+
+    private List<String> phasesSeen() {
+        List<String> out = new ArrayList<>();
+        for (ChangeSetProgressDTO p : seen) {
+            if (out.isEmpty() || !out.get(out.size() - 1).equals(p.phase)) {
+                out.add(p.phase);
+            }
+        }
+        return out;
+    }
+
+    @Test
+    void anUpdateGoesThroughPreparingShadowSwitchingAndItsWindowToItsOutcome() throws Exception {
+        runningCell();
+        assertNull(cell.changeSetProgress().snapshot(), "no set applied yet");
+        CompletableFuture<ChangeSetResult> f = applyIntoShadow(update(100, 50));
+        ChangeSetProgressDTO p = now();
+        assertTrue(p.running);
+        assertEquals("shadow", p.phase, p.step);
+        assertArrayEquals(new String[] {"checking", "preparing", "shadow"}, p.phases);
+        assertArrayEquals(new String[] {"update stage file:/x/stage-1.1.jar"},
+                p.actions);
+        assertEquals(100, p.cycles);
+        assertEquals(0, p.cycle);
+        assertTrue(seen.stream().anyMatch(s -> "preparing".equals(s.phase) && s.step.equals("0 of 1 new RT halves READY; "
+                + "awaiting update stage")), () -> seen.stream().map(s -> s.phase + ": " + s.step).toList().toString());
+        // 40 of its 100 shadow cycles, one value compared 0.004 from the running version's
+        FakeLauncher.FakeHalf newHalf = fake.running.get("1-stage");
+        fake.values.put(OLD_Y, sample(500, 7_000, 1.000));
+        fake.values.put(NEW_Y, sample(3, 7_000, 1.004));
+        newHalf.stats = cycles(40);
+        look();
+        p = now();
+        assertEquals("shadow", p.phase);
+        assertEquals("stage", p.component);
+        assertEquals(40, p.cycle);
+        assertEquals(100, p.cycles);
+        assertEquals("y.value", p.worstField);
+        assertEquals(0.004, p.worstDeviation, 1e-9);
+        assertEquals(0.01, p.tolerance);
+        assertTrue(p.step.startsWith("update stage: shadow run of pid " + newHalf.pid + ", cycle 40 of 100, 1 values "
+                + "compared, 0 overruns or deadline misses, worst y.value 0.00400 from the running version's (tolerance "
+                + "0.01)"), p.step);
+        assertFalse(f.isDone());
+        // passed: switched, then its window of 50 cycles
+        newHalf.stats = cycles(100);
+        look();
+        rig.stepUntil("the switch", () -> {
+            now();
+            return f.isDone();
+        });
+        rig.stepUntil("the window's baseline", () -> "window".equals(now().phase) && now().cycles == 50);
+        newHalf.stats = cycles(130);
+        look();
+        p = now();
+        assertEquals("window", p.phase);
+        assertEquals(30, p.cycle);
+        assertEquals(50, p.cycles);
+        assertTrue(p.step.startsWith("update stage: rollback window, cycle 30 of 50 of pid " + newHalf.pid), p.step);
+        assertTrue(p.running);
+        newHalf.stats = cycles(160);
+        look();
+        rig.stepUntil("the verdict", () -> f.join().verdict().isDone() && !now().running);
+        p = now();
+        assertEquals("done", p.phase);
+        assertEquals("committed", p.outcome);
+        assertTrue(p.why.contains("update stage: committed: the new version ran 60 cycles"), p.why);
+        assertArrayEquals(new String[] {"checking", "preparing", "shadow", "switching", "window", "done"}, p.phases);
+        // every phase was seen live too, but the executor's checks and the switch (each within one actor
+        // turn, between two reads)
+        assertEquals(List.of("preparing", "shadow", "window", "done"), phasesSeen(), phasesSeen()::toString);
+        // what a reader got is a copy: changing it changes nothing shown
+        p.phase = "forged";
+        p.phases[0] = "forged";
+        assertEquals("done", now().phase);
+        assertEquals("checking", now().phases[0]);
+    }
+
+    @Test
+    void anUpdateRejectedInShadowEndsWithThatOutcomeAndNeverSwitches() throws Exception {
+        runningCell();
+        CompletableFuture<ChangeSetResult> f = applyIntoShadow(update(200, 1000));
+        FakeLauncher.FakeHalf newHalf = fake.running.get("1-stage");
+        newHalf.stats = cycles(20);
+        look();
+        assertEquals(20, now().cycle);
+        newHalf.crash(139, "killed by signal 11");
+        rig.stepUntil("the outcome", () -> {
+            now();
+            return f.isDone();
+        });
+        rig.stepUntil("progress done", () -> !now().running);
+        ChangeSetProgressDTO p = now();
+        assertEquals("rejected-in-shadow", p.outcome);
+        assertTrue(p.why.startsWith("update stage: rejected in shadow after 20 cycles: the new version (pid "
+                + newHalf.pid + ") exited: killed by signal 11"), p.why);
+        assertArrayEquals(new String[] {"checking", "preparing", "shadow", "done"}, p.phases);
+        assertFalse(phasesSeen().contains("switching"));
+        assertFalse(phasesSeen().contains("window"));
+    }
+
+    @Test
+    void aSetRefusedByTheCellEndsRefusedWithoutPreparing() throws Exception {
+        runningCell();
+        ChangeSet bad = ChangeSet.builder().install("nobody", Path.of("/x")).build();
+        CompletableFuture<ChangeSetResult> f = actor.call(() -> cell.applyChangeSet(bad), 0);
+        rig.stepUntil("the outcome", f::isDone);
+        ChangeSetProgressDTO p = now();
+        assertFalse(p.running);
+        assertEquals("refused", p.outcome);
+        assertTrue(p.why.contains("no component 'nobody' is known to the cell"), p.why);
+        assertArrayEquals(new String[] {"checking", "done"}, p.phases);
+    }
+
+    @Test
+    void theApplyShownIsTheFirstUntilTheExecutorTakesAnother() {
+        AtomicLong clock = new AtomicLong(1_000);
+        ChangeSetProgress progress = new ChangeSetProgress(clock::get);
+        ChangeSetProgress.Apply a = progress.begin(List.of("install a"));
+        clock.set(1_200);
+        a.phase(ChangeSetProgress.PREPARING, "preparing a");
+        ChangeSetProgress.Apply b = progress.begin(List.of("install b"));
+        b.phase(ChangeSetProgress.CHECKING, "checking b");
+        b.done("refused", "another change set is being applied");
+        ChangeSetProgressDTO p = progress.snapshot();
+        assertArrayEquals(new String[] {"install a"}, p.actions, "a second apply while one runs is not shown");
+        assertEquals("preparing a", p.step);
+        assertEquals(1_000, p.startedMillis);
+        assertEquals(1_200, p.phaseMillis);
+        // the executor accepted c (a's checking was not over yet): c is shown from now on, a no more
+        ChangeSetProgress.Apply c = progress.begin(List.of("install c"));
+        clock.set(1_500);
+        c.claim();
+        a.done("committed", null);
+        p = progress.snapshot();
+        assertArrayEquals(new String[] {"install c"}, p.actions);
+        assertArrayEquals(new String[] {"checking"}, p.phases);
+        assertEquals(1_500, p.startedMillis);
+        assertTrue(p.running);
+        c.done("torn-down", "preparation failed, nothing changed: x");
+        p = progress.snapshot();
+        assertFalse(p.running);
+        assertEquals("torn-down", p.outcome);
+        // once over, the next apply is shown from its beginning
+        ChangeSetProgress.Apply d = progress.begin(List.of("install d"));
+        assertArrayEquals(new String[] {"install d"}, progress.snapshot().actions);
+        assertTrue(d.shown());
+    }
+
+    @Test
+    void theOutcomeIsNamedAsTheConsoleNamesIt() {
+        assertEquals("rejected-in-shadow", ChangeSetProgress.outcomeOf(false,
+                "update s: rejected in shadow after 5 cycles: why; nothing changed", null, false));
+        assertEquals("torn-down", ChangeSetProgress.outcomeOf(false, "preparation failed, nothing changed: x", null, false));
+        assertEquals("torn-down", ChangeSetProgress.outcomeOf(false, "the cell changed while the set was prepared: x",
+                null, false));
+        assertEquals("refused", ChangeSetProgress.outcomeOf(false, "install x: no component", null, false));
+        assertEquals("committed", ChangeSetProgress.outcomeOf(true, null, null, false));
+        assertEquals("committed", ChangeSetProgress.outcomeOf(true, null, "update s: passed its shadow run of 3 cycles\n"
+                + "update s: committed: the new version ran 9 cycles", false));
+        assertEquals("rolled-back", ChangeSetProgress.outcomeOf(true, null, "update s: rolled back after 12 cycles of "
+                + "the new version (file:/x.jar): why; pid 4 runs it again", false));
+        assertEquals("applied", ChangeSetProgress.outcomeOf(true, null, null, true));
+    }
+}
