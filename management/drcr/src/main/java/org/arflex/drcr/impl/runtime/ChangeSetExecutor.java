@@ -151,7 +151,7 @@ final class ChangeSetExecutor {
                     problems.add(s.text() + ": " + why);
                 } else {
                     updates.add(n);
-                    b.replace(u.contract());
+                    b.replace(u.contract()).overlap(n, u.shadow(), u.window()); // both halves run meanwhile (D51)
                 }
             } else if (s instanceof ChangeSet.Uninstall) {
                 if (inst == null || !inst.planned) {
@@ -222,6 +222,7 @@ final class ChangeSetExecutor {
                 }
             }
         }
+        refused.addAll(plan.transientRefusals()); // the old and the new half side by side do not fit (D51)
         return new Checked(change, plan, refused.isEmpty() ? null : String.join("; ", refused));
     }
 
@@ -743,6 +744,9 @@ final class ChangeSetExecutor {
         }
         if (!shown.cpuAssignment().equals(now.cpuAssignment())) {
             return "cpus " + now.cpuAssignment();
+        }
+        if (!shown.transientRefusals().equals(now.transientRefusals())) {
+            return "while both halves run: " + now.transientRefusals();
         }
         return null;
     }
