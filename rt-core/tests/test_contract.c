@@ -228,6 +228,30 @@ static void loads_a_service(void **state)
 	assert_int_equal(unlink(path), 0);
 }
 
+/* A type table entry without a name (a harness's sentinel) matches no <state> type: the
+ * reader skipped it for ports but compared it for the state block, a NULL dereference. */
+static void a_state_block_passes_over_a_nameless_type_entry(void **state)
+{
+	static const struct arflex_host_type with_hole[] = {
+		{ .name = NULL },
+		ARFLEX_HOST_TYPE(SAMPLE),
+	};
+	char path[128];
+
+	(void)state;
+	snprintf(path, sizeof(path), "%s/stateful.xml", dir);
+	write_file(path,
+		   "<component xmlns='urn:arflex:contract:1' name='svc' version='0.1.0'>"
+		   "<implementation executable='svc' task='service'/>"
+		   "<resources memory='1MiB'/><criticality>0</criticality>"
+		   "<fault restart='temporary' safe='hold'/>"
+		   "<state type='arflex.Sample' typeVersion='1.0'/></component>");
+	assert_int_equal(arflex_host_load_contract(&c, path, with_hole, 2, err, sizeof(err)), 0);
+	assert_true(c.has_state);
+	assert_string_equal(c.state.name, "arflex.Sample");
+	assert_int_equal(unlink(path), 0);
+}
+
 /* The contract is all a harness needs to create an instance. */
 static void creates_an_instance_from_a_contract(void **state)
 {
@@ -556,6 +580,7 @@ int main(void)
 		cmocka_unit_test(loads_the_guide_contract),
 		cmocka_unit_test(loads_every_kind),
 		cmocka_unit_test(loads_a_service),
+		cmocka_unit_test(a_state_block_passes_over_a_nameless_type_entry),
 		cmocka_unit_test(creates_an_instance_from_a_contract),
 		cmocka_unit_test(each_bad_input_is_refused_by_file_and_line),
 		cmocka_unit_test(file_errors_are_refused),

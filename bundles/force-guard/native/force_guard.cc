@@ -12,12 +12,22 @@
 // writing PROTECTIVE_STOP. A rising edge 0 -> 1 of the mutable parameter `reset` clears it as
 // well. Runtime heartbeat loss (rt-core safe mode) also writes PROTECTIVE_STOP, with the
 // HEARTBEAT_LOST reason.
+//
+// State block (contract <state type="arflex.ForceGuardState">, docs/DECISIONS.md D52): every
+// cycle the latch (latched, its reason, the trips), the safety output's seq and the contact
+// monitor's filter are published; the next version adopts them at its START in a change set's
+// update. A latched stop survives the update: the new half sets RESET_REQUIRED on its own control
+// block and writes PROTECTIVE_STOP until the operator's reset. Fail closed: a block it cannot
+// read (another type or major version, a value outside its bounds) starts the new half latched
+// too (it cannot know whether the old one had stopped the cell), not refused: a refused START is
+// restarted without a state, i.e. unlatched.
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 
 #include "arflex/component.h"
+#include "arflex_types/force_guard_state.h"
 #include "arflex_types/joint_state.h"
 #include "arflex_types/safety_state.h"
 #include "arflex_types/wrench.h"
@@ -43,6 +53,7 @@ struct State {
   double force_norm = 0;
   uint64_t seq = 0;
   uint64_t trips = 0;
+  struct arflex_force_guard_state state{};  // the state block published every cycle (D52)
 } g;
 
 struct arflex_ctl* Ctl(struct arflex_component* c) {
@@ -67,6 +78,12 @@ int Configure(struct arflex_component* c, void*) {
   if ((r = arflex_component_input(c, "joint_state", ARFLEX_PORT_STATE, &js_t, &g.in_js)) < 0 ||
       (r = arflex_component_input(c, "wrench", ARFLEX_PORT_STATE, &w_t, &g.in_w)) < 0)
     return r;
+  // The state block (D52): without a state segment (a contract without <state>) publishing is a no-op.
+  static const struct arflex_port_type st_t = {ARFLEX_TYPE_FORCE_GUARD_STATE_NAME,
+                                               ARFLEX_TYPE_FORCE_GUARD_STATE_VERSION_MAJOR,
+                                               ARFLEX_TYPE_FORCE_GUARD_STATE_VERSION_MINOR,
+                                               ARFLEX_TYPE_FORCE_GUARD_STATE_SIZE};
+  if ((r = arflex_component_state(c, &st_t, nullptr)) < 0 && r != -ENOENT) return r;
   const char* names[] = {"force_limit_n", "torque_limit_nm", "safe_power_fraction", "reset",
                          "payload_kg"};
   int* idx[] = {&g.p_force, &g.p_torque, &g.p_power, &g.p_reset, &g.p_payload};
@@ -89,6 +106,31 @@ int Start(struct arflex_component* c, void*) {
   return 0;
 }
 
+// The latch, the output's seq and the monitor's filter (D52), after every safety value.
+void PublishState(struct arflex_component* c, uint64_t release_ns) {
+  if (!arflex_component_state_open(c)) return;
+  struct arflex_force_guard_state& st = g.state;
+  st.t_ns = (int64_t)release_ns;
+  st.seq++;
+  st.out_seq = g.seq;
+  st.trips = g.trips;
+  const arflex::cellkin::ContactMonitor::Snapshot m = g.monitor.Save();
+  st.flags = (g.latched ? ARFLEX_FORCE_GUARD_STATE_FLAG_LATCHED : 0u) |
+             (m.have_prev ? ARFLEX_FORCE_GUARD_STATE_FLAG_MONITOR_PRIMED : 0u);
+  st.reason = g.latched ? g.reason : 0u;
+  st.force_norm = g.force_norm;
+  st.mon_t_ns = m.t_prev;
+  for (int j = 0; j < 6; ++j) {
+    st.mon_qd[j] = m.qd_prev[j];
+    st.mon_q[j] = m.q[j];
+    st.mon_ext[j] = m.ext[j];
+    st.hold_torque[j] = m.hold_t[j];
+  }
+  st.hold_force = m.hold_f;
+  for (int k = 0; k < 3; ++k) st.a_tool[k] = m.a_tool[k];
+  arflex_component_state_publish(c, &st, sizeof(st), release_ns);
+}
+
 int Write(struct arflex_component* c, uint64_t release_ns, uint32_t extra_flags) {
   struct arflex_safety_state s;
   memset(&s, 0, sizeof(s));
@@ -100,7 +142,9 @@ int Write(struct arflex_component* c, uint64_t release_ns, uint32_t extra_flags)
   s.power_scale = stop ? arflex_param_f64(c, g.p_power) : 1.0;
   s.force_norm = g.force_norm;
   s.force_limit = arflex_param_f64(c, g.p_force);
-  return arflex_state_write(g.out, &s, sizeof(s));
+  const int w = arflex_state_write(g.out, &s, sizeof(s));
+  PublishState(c, release_ns);
+  return w;
 }
 
 void ReadInputs() {
@@ -191,8 +235,49 @@ int Safe(struct arflex_component* c, void*, enum arflex_safe_mode, bool) {
   return Write(c, now, g.latched ? 0 : ARFLEX_SAFETY_STATE_FLAG_HEARTBEAT_LOST);
 }
 
+// The adopt hook (D52): right after Start, at the START of a change set's new version, the
+// state the running version published last. Latched there: latched here, RESET_REQUIRED on
+// this half's own control block (rt-core then runs Safe, which writes PROTECTIVE_STOP, until
+// the operator's RESET). The safety output's seq continues; the monitor goes on from the old
+// half's filter (no acceleration estimate lost, so no allowance missing at the switch). A
+// block this version cannot read: latched (fail closed), never refused.
+int Adopt(struct arflex_component* c, void*, const struct arflex_adopted_state* a) {
+  struct arflex_force_guard_state st;
+  const bool known = std::strcmp(a->type_name, ARFLEX_TYPE_FORCE_GUARD_STATE_NAME) == 0 &&
+                     a->major == ARFLEX_TYPE_FORCE_GUARD_STATE_VERSION_MAJOR && a->length >= sizeof(st);
+  if (known) std::memcpy(&st, a->data, sizeof(st));
+  if (!known || !arflex_force_guard_state_valid(&st)) {
+    g.latched = true;
+    g.reason = 0;  // the cause is unknown: RESET_REQUIRED alone says why
+    arflex_component_require_reset(c);
+    return 0;
+  }
+  g.seq = st.out_seq;
+  g.trips = st.trips;
+  g.force_norm = st.force_norm;
+  g.state.seq = st.seq;
+  if (st.flags & ARFLEX_FORCE_GUARD_STATE_FLAG_LATCHED) {
+    g.latched = true;
+    g.reason = st.reason;
+    arflex_component_require_reset(c);
+  }
+  arflex::cellkin::ContactMonitor::Snapshot m;
+  m.have_prev = (st.flags & ARFLEX_FORCE_GUARD_STATE_FLAG_MONITOR_PRIMED) != 0;
+  m.t_prev = st.mon_t_ns;
+  for (int j = 0; j < 6; ++j) {
+    m.qd_prev[j] = st.mon_qd[j];
+    m.q[j] = st.mon_q[j];
+    m.ext[j] = st.mon_ext[j];
+    m.hold_t[j] = st.hold_torque[j];
+  }
+  m.hold_f = st.hold_force;
+  for (int k = 0; k < 3; ++k) m.a_tool[k] = st.a_tool[k];
+  if (!g.monitor.Restore(m)) g.monitor.Reset();  // (valid() checked finiteness: not reached)
+  return 0;
+}
+
 const struct arflex_component_ops kOps = {
-    "force-guard", nullptr, Configure, Start, Update, nullptr, nullptr, Safe, nullptr,
+    "force-guard", nullptr, Configure, Start, Update, nullptr, nullptr, Safe, Adopt,
 };
 
 }  // namespace

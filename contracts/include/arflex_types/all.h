@@ -2,6 +2,7 @@
 #ifndef ARFLEX_TYPES_ALL_H
 #define ARFLEX_TYPES_ALL_H
 
+#include "force_guard_state.h"
 #include "image_frame.h"
 #include "joint_ref.h"
 #include "joint_state.h"
@@ -9,6 +10,7 @@
 #include "safety_state.h"
 #include "sample.h"
 #include "tcp_correction_state.h"
+#include "tcp_correction_state2.h"
 #include "tool_state.h"
 #include "trajectory_state.h"
 #include "wrench.h"

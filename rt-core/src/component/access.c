@@ -1,6 +1,5 @@
 /* The component template's accessors: parameters, the control block, holds, and the inputs a
- * component reads (with the per-input count of rejected values, ABI 1.2). Split out of
- * component.c, which keeps the RT thread, the mailbox thread and main. */
+ * component reads (with the per-input count of rejected values, ABI 1.2). */
 #include "arflex/component.h"
 
 #include <errno.h>

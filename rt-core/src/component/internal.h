@@ -1,11 +1,15 @@
-/* rt-core internal: the state of an RT half shared by component.c (the template: ports, the RT
- * loop, the mailbox) and supervisor.c (the supervisor's death and the orphan policy). Not
+/* rt-core internal: the state of an RT half shared by the files of src/component/: component.c
+ * (main: arguments, attach, configure, exit), ports.c (declaration and binding), rt.c (the RT
+ * thread), commands.c (the mailbox thread), access.c (the component's accessors), state.c (the
+ * state block, D41) and supervisor.c (the supervisor's death and the orphan policy). Not
  * installed, not API. */
 #ifndef ARFLEX_COMPONENT_INTERNAL_H
 #define ARFLEX_COMPONENT_INTERNAL_H
 
 #include <pthread.h>
+#include <signal.h>
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "arflex/component.h"
@@ -15,7 +19,6 @@
 #define LOAD(p) __atomic_load_n((p), __ATOMIC_ACQUIRE)
 #define STORE(p, v) __atomic_store_n((p), (v), __ATOMIC_RELEASE)
 #define XCHG(p, v) __atomic_exchange_n((p), (v), __ATOMIC_ACQ_REL)
-
 
 struct arflex_input {
 	char name[ARFLEX_NAME_SIZE];
@@ -87,6 +90,30 @@ struct arflex_component {
 /* One log line on stderr, one write (component.c). */
 void arflex_comp_log(const struct arflex_component *c, const char *fmt, ...)
 	__attribute__((format(printf, 2, 3)));
+
+/* ports.c: an output's object name; the inputs' bindings: taken by the RT thread at a cycle
+ * boundary, by the mailbox thread after a STOP (and the replaced ones unmapped), BIND/UNBIND;
+ * closing every port at exit. */
+int arflex_comp_output_obj_name(const struct arflex_component *c, const char *port, char *name,
+				size_t size);
+void arflex_comp_take_bindings(struct arflex_component *c);
+void arflex_comp_retire_bindings(struct arflex_component *c);
+int arflex_comp_bind_cmd(struct arflex_component *c, struct arflex_msg *m);
+void arflex_comp_close_ports(struct arflex_component *c);
+
+/* rt.c: the task's hooks (struct arflex_task_opts; the poll only for a sporadic half, D27). */
+int arflex_comp_rt_cycle(void *arg, uint64_t release_ns);
+int arflex_comp_rt_poll(void *arg, uint64_t now, uint64_t *events);
+int arflex_comp_rt_start(void *arg);
+int arflex_comp_rt_stop(void *arg);
+
+/* commands.c: the mailbox thread's loop until SHUTDOWN, *@signaled or the orphan policy; STOP
+ * (also at the end, when still running); the short wait and the deadline of a request the RT
+ * thread takes at its cycle boundary (SET_PARAM, BIND). */
+void arflex_comp_serve_loop(struct arflex_component *c, const volatile sig_atomic_t *signaled);
+int arflex_comp_stop(struct arflex_component *c);
+void arflex_comp_wait_short(void);
+uint64_t arflex_comp_apply_deadline(const struct arflex_component *c);
 
 /* state.c (D41): the ADOPT command (mailbox thread, not while running), the adoption at
  * START (RT thread, in the start hook's place), its report and release after START (mailbox

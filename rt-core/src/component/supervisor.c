@@ -7,7 +7,6 @@
 #include <errno.h>
 #include <poll.h>
 #include <signal.h>
-#include <stdio.h>
 
 #define TOKEN_WAIT_NS 5000000000u /* the manager writes the token right at the spawn */
 #define ORPHAN_SAFE_WAIT_NS 1000000000u /* after the hold: wait this long at most for the
@@ -160,13 +159,11 @@ void arflex_comp_watch_stop(struct arflex_component *c)
 /* No manager is left to remove the objects of an orphan (ABI.md 2, DECISIONS.md D10). */
 void arflex_comp_unlink_own(struct arflex_component *c, unsigned noutputs)
 {
-	char name[ARFLEX_OBJ_NAME_SIZE], chan[ARFLEX_NAME_SIZE + 8];
+	char name[ARFLEX_OBJ_NAME_SIZE];
 
-	for (unsigned i = 0; i < noutputs; i++) {
-		snprintf(chan, sizeof(chan), "out.%s", c->output_names[i]);
-		if (!arflex_ctl_obj_name(name, sizeof(name), c->rid, c->inst, chan))
+	for (unsigned i = 0; i < noutputs; i++)
+		if (!arflex_comp_output_obj_name(c, c->output_names[i], name, sizeof(name)))
 			arflex_sys_shm_unlink(name);
-	}
 	if (!arflex_ctl_obj_name(name, sizeof(name), c->rid, c->inst, "state"))
 		arflex_sys_shm_unlink(name); /* the state block (D41), if the manager made one */
 	if (!arflex_ctl_obj_name(name, sizeof(name), c->rid, c->inst, "cmd"))

@@ -34,7 +34,7 @@
 // (arflex_input_binding changes: a change set replaced the motion source, e.g. teach for
 // trajectory on the moving arm), the first value from the new provider is not taken as a step.
 // The difference between the reference written last (old provider, with any blend still in
-// progress) and the new value is added to the new reference and faded out over kBlendSeconds
+// progress) and the new value is added to the new reference and faded out over blend_time (0.5 s)
 // with a quintic (zero speed and acceleration at both ends), as sim-robot takes up an acquired
 // reference (D9). A robot on a stiff servo turns a reference step into a torque step: the 6 mrad
 // by which the moving arm lags trajectory's reference was read as 770 N by the force guard
@@ -42,6 +42,7 @@
 // somewhere else entirely) is passed on as before, for the robot's own acquisition to judge.
 #include <algorithm>
 #include <cerrno>
+#include <cstddef>
 #include <cmath>
 #include <cstring>
 
@@ -55,10 +56,11 @@ extern "C" {
 #include "arflex_types/pose.h"
 #include "arflex_types/sample.h"
 #include "arflex_types/tcp_correction_state.h"
+#include "arflex_types/tcp_correction_state2.h"
 
 namespace {
 
-constexpr double kBlendSeconds = 0.5;
+constexpr double kBlendSeconds = 0.5;  // blend_time's default; 1.0 faded over exactly this
 constexpr double kBlendMaxOffset = 0.05;  // rad, any joint: sim-robot's ref_acquire_tol default
 
 using arflex::tcpcorr::CorrectionLaw;
@@ -72,7 +74,8 @@ struct TcpCorrection {
   arflex_port* error = nullptr;
   arflex_port* size = nullptr;
   int p_gain = -1, p_step = -1, p_rate = -1, p_max = -1, p_enable = -1, p_orientation = -1, p_sigma = -1,
-      p_track = -1;
+      p_track = -1, p_blend = -1;
+  double blend_time = kBlendSeconds;  // s: the parameter, for the next provider change
   double track_tol = 2e-3;  // rad: a robot further than this from our output is not following
   double max_sigma = 2e-4;  // m: a measurement less certain than this is treated as invalid
   arflex::cellmodel::NominalKinematics kinematics{arflex::cellmodel::DefaultArm()};
@@ -86,19 +89,24 @@ struct TcpCorrection {
   arflex_joint_state js{};                   // the robot's newest joint state (seq 0: none)
   uint32_t ref_binding = 0;  // binding of the reference input the last value came through
   double blend_offset[6] = {0, 0, 0, 0, 0, 0};  // faded out after a provider change
-  double blend_t = kBlendSeconds;               // s since that change; >= kBlendSeconds: none
+  double blend_duration = kBlendSeconds;        // s: the fade in progress lasts this long
+  double blend_t = kBlendSeconds;               // s since that change; >= blend_duration: none
   bool ref_invalid = false;  // the newest reference was rejected: the output holds
   bool js_invalid = false;   // the newest joint state was rejected: measurements are held
   double dt = 0.001;
-  arflex_tcp_correction_state state{};  // the state block published every cycle (D41)
+  // The state block published every cycle (D41): arflex.TcpCorrectionState2 (this version's,
+  // D52), or its 1.0 prefix when the manager made a 1.0 block (a contract declaring the older
+  // state, e.g. a 1.0.x version made of this executable).
+  arflex_tcp_correction_state2 state{};
+  bool state_v1 = false;
 };
 
 TcpCorrection g;
 
 // What is left of a blend's offset now: 1 - s(u), s the quintic 10u^3 - 15u^4 + 6u^5.
 double BlendRest() {
-  if (g.blend_t >= kBlendSeconds) return 0.0;
-  const double u = g.blend_t / kBlendSeconds;
+  if (g.blend_t >= g.blend_duration) return 0.0;
+  const double u = g.blend_t / g.blend_duration;
   return 1.0 - u * u * u * (10.0 - 15.0 * u + 6.0 * u * u);
 }
 
@@ -121,6 +129,7 @@ void ApplyParams(arflex_component* c) {
   g.law.SetOptions(o);  // invalid values (outside the contract's ranges) keep the old ones
   g.max_sigma = F64(c, g.p_sigma, 2e-4);
   g.track_tol = F64(c, g.p_track, 2e-3);
+  g.blend_time = F64(c, g.p_blend, kBlendSeconds);  // 1.1.0; absent (a 1.0 contract): 1.0's 0.5 s
   const bool enable = Bool(c, g.p_enable, true);
   if (enable != g.law.enabled()) g.law.SetEnabled(enable);
 }
@@ -152,10 +161,20 @@ int Configure(arflex_component* c, void*) {
   if (r == 0) r = arflex_component_output(c, "correction", ARFLEX_PORT_STATE, &kSampleType, &g.size);
   if (r < 0) return r;
   // The state block (contract <state>, D41): without a state segment publishing is a no-op.
+  // This version's block is arflex.TcpCorrectionState2 (D52); a contract that declares the
+  // 1.0 block gets that one published (its prefix: the same fields at the same offsets).
   static const arflex_port_type kStateBlock = {
+      ARFLEX_TYPE_TCP_CORRECTION_STATE2_NAME, ARFLEX_TYPE_TCP_CORRECTION_STATE2_VERSION_MAJOR,
+      ARFLEX_TYPE_TCP_CORRECTION_STATE2_VERSION_MINOR, ARFLEX_TYPE_TCP_CORRECTION_STATE2_SIZE};
+  static const arflex_port_type kStateBlockV1 = {
       ARFLEX_TYPE_TCP_CORRECTION_STATE_NAME, ARFLEX_TYPE_TCP_CORRECTION_STATE_VERSION_MAJOR,
       ARFLEX_TYPE_TCP_CORRECTION_STATE_VERSION_MINOR, ARFLEX_TYPE_TCP_CORRECTION_STATE_SIZE};
-  if ((r = arflex_component_state(c, &kStateBlock, nullptr)) < 0 && r != -ENOENT) return r;
+  r = arflex_component_state(c, &kStateBlock, nullptr);
+  if (r == -EPROTOTYPE) {
+    r = arflex_component_state(c, &kStateBlockV1, nullptr);
+    g.state_v1 = r == 0;
+  }
+  if (r < 0 && r != -ENOENT) return r;
   g.p_gain = arflex_component_param(c, "gain");
   g.p_step = arflex_component_param(c, "max_step");
   g.p_rate = arflex_component_param(c, "max_rate");
@@ -164,6 +183,7 @@ int Configure(arflex_component* c, void*) {
   g.p_orientation = arflex_component_param(c, "orientation");
   g.p_sigma = arflex_component_param(c, "max_sigma");
   g.p_track = arflex_component_param(c, "track_tol");
+  g.p_blend = arflex_component_param(c, "blend_time");
   const uint64_t period = arflex_component_ctl(c)->config.period_ns;
   g.dt = period > 0 ? period * 1e-9 : 0.001;
   ApplyParams(c);
@@ -181,7 +201,8 @@ int Start(arflex_component* c, void*) {
   ApplyParams(c);
   g.have_ref = false;
   g.ref_binding = 0;
-  g.blend_t = kBlendSeconds;
+  g.blend_duration = g.blend_time;
+  g.blend_t = g.blend_duration;
   g.ref_invalid = false;
   g.js_invalid = false;
   g.js = arflex_joint_state{};
@@ -194,7 +215,7 @@ int Start(arflex_component* c, void*) {
 // The correction, the fade of a provider change and the reference last passed on.
 void PublishState(arflex_component* c, uint64_t release_ns) {
   if (!arflex_component_state_open(c)) return;
-  arflex_tcp_correction_state& st = g.state;
+  arflex_tcp_correction_state2& st = g.state;
   st.t_ns = (int64_t)release_ns;
   st.seq++;
   st.pose_seq = g.pose_seq;
@@ -212,23 +233,45 @@ void PublishState(arflex_component* c, uint64_t release_ns) {
     st.ref_q[i] = g.ref.q[i];
     st.last_out[i] = g.last_out[i];
   }
-  st.blend_t = std::min(g.blend_t, kBlendSeconds);
+  st.blend_t = std::min(g.blend_t, g.blend_duration);
+  st.blend_duration = g.blend_duration;
   st.ref_t_ns = g.ref.t_ns;
-  arflex_component_state_publish(c, &st, sizeof(st), release_ns);
+  // a 1.0 block: the fields it has (the same offsets, checked below); its fade is always 0.5 s
+  arflex_component_state_publish(c, &st, g.state_v1 ? sizeof(arflex_tcp_correction_state) : sizeof(st), release_ns);
 }
 
 // The adopt hook (D41): after Start, at the switch of a change set's update, the state the
 // running version published last: the correction goes on where it was instead of restarting
-// at zero (a jump of up to max_correction with vision), a fade in progress goes on, and the
-// reference last passed on is the one the next provider change is faded from.
-// arflex.TcpCorrectionState 1.x only (-EPROTOTYPE refuses the START otherwise).
+// at zero (a jump of up to max_correction with vision), a fade in progress goes on over the
+// duration it started with, and the reference last passed on is the one the next provider
+// change is faded from. Takes arflex.TcpCorrectionState2 1.x, and converts
+// arflex.TcpCorrectionState 1.x (the contract's <convertsFrom>, D52): the same fields, and the
+// fade's duration that 1.0 did not record because it was always 0.5 s. Anything else refuses
+// the START (-EPROTOTYPE); a value out of its type's bounds too (-EINVAL).
+static_assert(sizeof(arflex_tcp_correction_state) == offsetof(arflex_tcp_correction_state2, blend_duration),
+              "TcpCorrectionState2 is TcpCorrectionState 1.0 with blend_duration appended");
+static_assert(offsetof(arflex_tcp_correction_state, last_out) == offsetof(arflex_tcp_correction_state2, last_out) &&
+                  offsetof(arflex_tcp_correction_state, blend_t) == offsetof(arflex_tcp_correction_state2, blend_t) &&
+                  offsetof(arflex_tcp_correction_state, target) == offsetof(arflex_tcp_correction_state2, target),
+              "the 1.0 fields at the same offsets");
 int Adopt(arflex_component*, void*, const arflex_adopted_state* a) {
-  arflex_tcp_correction_state st;
-  if (std::strcmp(a->type_name, ARFLEX_TYPE_TCP_CORRECTION_STATE_NAME) != 0 ||
-      a->major != ARFLEX_TYPE_TCP_CORRECTION_STATE_VERSION_MAJOR || a->length < sizeof(st))
+  arflex_tcp_correction_state2 st;
+  std::memset(&st, 0, sizeof(st));
+  if (std::strcmp(a->type_name, ARFLEX_TYPE_TCP_CORRECTION_STATE2_NAME) == 0 &&
+      a->major == ARFLEX_TYPE_TCP_CORRECTION_STATE2_VERSION_MAJOR && a->length >= sizeof(st)) {
+    std::memcpy(&st, a->data, sizeof(st));
+  } else if (std::strcmp(a->type_name, ARFLEX_TYPE_TCP_CORRECTION_STATE_NAME) == 0 &&
+             a->major == ARFLEX_TYPE_TCP_CORRECTION_STATE_VERSION_MAJOR &&
+             a->length >= sizeof(arflex_tcp_correction_state)) {
+    arflex_tcp_correction_state v1;
+    std::memcpy(&v1, a->data, sizeof(v1));
+    if (!arflex_tcp_correction_state_valid(&v1)) return -EINVAL;
+    std::memcpy(&st, &v1, sizeof(v1));  // the 1.0 fields, the same layout (asserted above)
+    st.blend_duration = kBlendSeconds;  // the conversion: 1.0 faded over a fixed 0.5 s
+  } else {
     return -EPROTOTYPE;
-  std::memcpy(&st, a->data, sizeof(st));
-  if (!arflex_tcp_correction_state_valid(&st)) return -EINVAL;
+  }
+  if (!arflex_tcp_correction_state2_valid(&st)) return -EINVAL;
   arflex::tcpcorr::Vector6d target, applied, last_error;
   for (int i = 0; i < 6; ++i) {
     target(i) = st.target[i];
@@ -238,7 +281,7 @@ int Adopt(arflex_component*, void*, const arflex_adopted_state* a) {
   // enabled is this version's parameter (ApplyParams runs first in every update)
   if (!g.law.Restore(target, applied, last_error, (long)st.updates, (long)st.holds, g.law.enabled()))
     return -EINVAL;
-  g.have_ref = (st.flags & ARFLEX_TCP_CORRECTION_STATE_FLAG_HAVE_REF) != 0;
+  g.have_ref = (st.flags & ARFLEX_TCP_CORRECTION_STATE2_FLAG_HAVE_REF) != 0;
   for (int i = 0; i < 6; ++i) {
     g.ref.q[i] = st.ref_q[i];
     g.last_out[i] = st.last_out[i];
@@ -246,7 +289,8 @@ int Adopt(arflex_component*, void*, const arflex_adopted_state* a) {
   }
   g.ref.t_ns = st.ref_t_ns;
   g.ref.seq = 0;
-  g.blend_t = st.blend_t;
+  g.blend_duration = st.blend_duration;
+  g.blend_t = std::min(st.blend_t, st.blend_duration);
   g.pose_seq = st.pose_seq;
   g.out_seq = st.out_seq;
   g.error_seq = st.error_seq;
@@ -279,9 +323,10 @@ int Update(arflex_component* c, void*, uint64_t release_ns) {
         }
         if (std::isfinite(biggest) && biggest <= kBlendMaxOffset) {
           for (int i = 0; i < 6; ++i) g.blend_offset[i] = offset[i];
+          g.blend_duration = g.blend_time;  // a new fade takes the parameter in force
           g.blend_t = 0;
         } else {
-          g.blend_t = kBlendSeconds;
+          g.blend_t = g.blend_duration;
         }
       }
       g.ref_binding = binding;
@@ -306,7 +351,7 @@ int Update(arflex_component* c, void*, uint64_t release_ns) {
   }
   // The reference part of the output: the newest reference plus what is left of a blend.
   const double rest = BlendRest();
-  if (g.blend_t < kBlendSeconds) g.blend_t += g.dt;
+  if (g.blend_t < g.blend_duration) g.blend_t += g.dt;
   arflex::cellmodel::JointVector q;
   for (int i = 0; i < 6; ++i) q[i] = g.ref.q[i] + g.blend_offset[i] * rest;
   arflex_joint_state js{};

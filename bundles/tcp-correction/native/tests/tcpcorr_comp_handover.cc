@@ -12,34 +12,22 @@ void CaseSwitch(Rig& rig) {
   rig.Watch(200 * kMs, false, true, Eigen::Vector3d::Zero());  // the correction's ramp done
   const arflex_joint_ref before = rig.last;
   const double excess = rig.max_jump_excess;
-  struct arflex_host_output fo;
-  std::memset(&fo, 0, sizeof(fo));
-  fo.port = "reference";
-  fo.spec.method = ARFLEX_PORT_STATE;
-  fo.spec.type = {ARFLEX_TYPE_JOINT_REF_NAME, 1, 0, ARFLEX_TYPE_JOINT_REF_SIZE};
-  fo.spec.depth = 1;
-  arflex_host_opts o;
-  std::memset(&o, 0, sizeof(o));
-  o.runtime = rid;
-  o.instance = "feeder2";
-  o.config = Config();
-  o.outputs = &fo;
-  o.noutputs = 1;
-  CHECK(arflex_host_create(&rig.feeder2, &o) == 0, "feeder2");
-  rig.feeder2_made = true;
-  arflex_joint_ref ref2;
+  CHECK(rig.MakeFeeder2(0.01) == 0, "feeder2");
+  arflex_joint_ref ref2;  // what feeder2 holds
   std::memset(&ref2, 0, sizeof(ref2));
   ref2.t_ns = 1;
   ref2.seq = 1;
   for (int i = 0; i < 6; ++i) ref2.q[i] = kRef[i] + (i == 0 ? 0.01 : 0.0);
-  arflex_state_write(arflex_host_output(&rig.feeder2, "reference"), &ref2, sizeof(ref2));
   CHECK(arflex_host_bind(&rig.corr, "reference", arflex_host_output_name(&rig.feeder2, "reference"), 2 * kSec) == 0,
         "BIND reference to feeder2");
   double worst = 0;  // the largest output step per cycle, any joint
   {
+    // The fade takes 500 of the corrector's cycles (0.5 s at 1 ms): wait for 600 of its outputs,
+    // not for wall time (a loaded machine skips releases; 800 ms of wall time failed at load 18).
     arflex_joint_ref prev = rig.last;
-    const uint64_t end = arflex_sys_now_ns() + 800 * kMs;
-    while (arflex_sys_now_ns() < end) {
+    const uint64_t from = prev.seq;
+    const uint64_t deadline = arflex_sys_now_ns() + 20 * kSec;
+    while (rig.last.seq < from + 600 && arflex_sys_now_ns() < deadline) {
       if (!rig.Read()) continue;
       const double cycles = static_cast<double>(rig.last.seq - prev.seq);
       for (int i = 0; i < 6; ++i) worst = std::max(worst, std::abs(rig.last.q[i] - prev.q[i]) / cycles);

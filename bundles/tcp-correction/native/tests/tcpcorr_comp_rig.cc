@@ -52,9 +52,10 @@ int Rig::Create(const char* exe) {
   if (r < 0) return r;
   static const arflex_host_type types[] = {ARFLEX_HOST_TYPE(JOINT_REF), ARFLEX_HOST_TYPE(JOINT_STATE),
                                            ARFLEX_HOST_TYPE(POSE), ARFLEX_HOST_TYPE(SAMPLE),
-                                           ARFLEX_HOST_TYPE(TCP_CORRECTION_STATE)};
+                                           ARFLEX_HOST_TYPE(TCP_CORRECTION_STATE),
+                                           ARFLEX_HOST_TYPE(TCP_CORRECTION_STATE2)};
   char err[512];
-  r = arflex_host_load_contract(&c, contract_xml, types, 5, err, sizeof(err));
+  r = arflex_host_load_contract(&c, contract_xml, types, 6, err, sizeof(err));
   if (r < 0) {
     std::fprintf(stderr, "%s\n", err);
     return r;
@@ -109,9 +110,10 @@ Rig::~Rig() {
   if (feeder2_made) arflex_host_destroy(&feeder2);
 }
 
-int Rig::Second(arflex_host* h, const char* inst, const char* exe, arflex_port* o) {
+int Rig::Second(arflex_host* h, const char* inst, const char* exe, arflex_port* o, const arflex_port_type* state) {
   arflex_host_opts opts;
   arflex_host_contract_opts(&c, rid, inst, &opts);
+  if (state) opts.state = state;
   opts.config.priority = 0;
   opts.config.hb_timeout_ns = 0;
   opts.config.cfg_flags |= ARFLEX_CFG_NO_MLOCK | ARFLEX_CFG_NO_DMA_LATENCY;
@@ -123,6 +125,32 @@ int Rig::Second(arflex_host* h, const char* inst, const char* exe, arflex_port* 
   if (r == 0) r = arflex_host_bind(h, "reference", arflex_host_output_name(&feeder, "reference"), 2 * kSec);
   if (r == 0) r = arflex_host_bind(h, "tcp_pose", arflex_host_output_name(&feeder, "tcp_pose"), 2 * kSec);
   return r;
+}
+
+int Rig::MakeFeeder2(double dq0) {
+  struct arflex_host_output fo;
+  std::memset(&fo, 0, sizeof(fo));
+  fo.port = "reference";
+  fo.spec.method = ARFLEX_PORT_STATE;
+  fo.spec.type = {ARFLEX_TYPE_JOINT_REF_NAME, 1, 0, ARFLEX_TYPE_JOINT_REF_SIZE};
+  fo.spec.depth = 1;
+  arflex_host_opts o;
+  std::memset(&o, 0, sizeof(o));
+  o.runtime = rid;
+  o.instance = "feeder2";
+  o.config = Config();
+  o.outputs = &fo;
+  o.noutputs = 1;
+  const int r = arflex_host_create(&feeder2, &o);
+  if (r < 0) return r;
+  feeder2_made = true;
+  arflex_joint_ref ref2;
+  std::memset(&ref2, 0, sizeof(ref2));
+  ref2.t_ns = 1;
+  ref2.seq = 1;
+  for (int i = 0; i < 6; ++i) ref2.q[i] = kRef[i] + (i == 0 ? dq0 : 0.0);
+  arflex_state_write(arflex_host_output(&feeder2, "reference"), &ref2, sizeof(ref2));
+  return 0;
 }
 
 bool Rig::Read() {

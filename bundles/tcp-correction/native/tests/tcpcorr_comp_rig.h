@@ -20,6 +20,7 @@ extern "C" {
 #include "arflex_types/pose.h"
 #include "arflex_types/sample.h"
 #include "arflex_types/tcp_correction_state.h"
+#include "arflex_types/tcp_correction_state2.h"
 
 namespace tcpcorr_comp {
 
@@ -70,8 +71,13 @@ struct Rig {
   int Create(const char* exe);
   ~Rig();
   // Another half of tcp-correction (`inst`) bound to the feeder's reference and tcp_pose, with
-  // its corrected output open in `o`: READY, not started.
-  int Second(arflex_host* h, const char* inst, const char* exe, arflex_port* o);
+  // its corrected output open in `o`: READY, not started. `state`, when given, is the type of
+  // its state block instead of the contract's (a half whose contract declares an older one).
+  int Second(arflex_host* h, const char* inst, const char* exe, arflex_port* o,
+             const arflex_port_type* state = nullptr);
+  // Creates feeder2, a second motion source, with one reference: kRef with `dq0` added to
+  // joint 0.
+  int MakeFeeder2(double dq0);
   // Reads the newest output; checks that it never jumps. Returns true on a new value.
   bool Read();
   // The plant: the measurement of the corrected output (nominal TCP + the plant's error).
@@ -101,6 +107,7 @@ void CaseInvalid(Rig& rig);                 // tcpcorr_comp_held.cc
 void CaseHold(Rig& rig);                    // tcpcorr_comp_held.cc
 void CaseSwitch(Rig& rig);                  // tcpcorr_comp_handover.cc
 void CaseAdopt(Rig& rig, const char* exe);  // tcpcorr_comp_handover.cc
+void CaseConvert(Rig& rig, const char* exe);  // tcpcorr_comp_convert.cc
 
 }  // namespace tcpcorr_comp
 

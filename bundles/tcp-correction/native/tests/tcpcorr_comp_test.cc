@@ -3,7 +3,8 @@
 // the plant: the measured TCP is the nominal TCP of the corrected output, shifted by a fixed
 // error (what the true arm does differently from the nominal model).
 //
-//   tcpcorr_comp_test <case> <tcp-correction exe> <contract>   cases: converge, hold, invalid, switch
+//   tcpcorr_comp_test <case> <tcp-correction exe> <contract>   cases: converge, hold, invalid, switch,
+//   adopt, convert
 //
 // The corrector's ports, parameters (max_rate, max_sigma, track_tol, orientation, ... with
 // their defaults), period and safe mode come from the bundle's contract
@@ -16,7 +17,7 @@
 //
 // The harness (the Rig, CHECK, the leak check) is tcpcorr_comp_rig.h/.cc; after the common part
 // below (converge) the cases are in tcpcorr_comp_held.cc (invalid, hold) and
-// tcpcorr_comp_handover.cc (switch, adopt).
+// tcpcorr_comp_handover.cc (switch, adopt) and tcpcorr_comp_convert.cc (convert).
 #include <unistd.h>
 
 #include "tcpcorr_comp_rig.h"
@@ -40,6 +41,7 @@ void RunCase(const std::string& name, const char* exe) {
   if (name == "invalid") CaseInvalid(rig);
   if (name == "switch") CaseSwitch(rig);
   if (name == "adopt") CaseAdopt(rig, exe);
+  if (name == "convert") CaseConvert(rig, exe);
   if (name == "hold") CaseHold(rig);
   if (failures) return;  // a check of the case failed: it ended there
   CHECK(rig.max_jump_excess < 1e-12, "output jumped %.3g rad beyond the rate limit", rig.max_jump_excess);
@@ -54,13 +56,15 @@ using namespace tcpcorr_comp;
 
 int main(int argc, char** argv) {
   if (argc != 4) {
-    std::fprintf(stderr, "usage: tcpcorr_comp_test <converge|hold|invalid|switch|adopt> <tcp-correction exe> <contract>\n");
+    std::fprintf(stderr,
+                 "usage: tcpcorr_comp_test <converge|hold|invalid|switch|adopt|convert> <tcp-correction exe> <contract>\n");
     return 2;
   }
   contract_xml = argv[3];
   std::snprintf(rid, sizeof(rid), "tcc%d", static_cast<int>(getpid()));
   const std::string name = argv[1];
-  if (name != "converge" && name != "hold" && name != "invalid" && name != "switch" && name != "adopt") {
+  if (name != "converge" && name != "hold" && name != "invalid" && name != "switch" && name != "adopt" &&
+      name != "convert") {
     std::fprintf(stderr, "tcpcorr_comp_test: unknown case '%s'\n", argv[1]);
     return 2;
   }

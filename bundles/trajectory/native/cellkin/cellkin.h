@@ -14,6 +14,8 @@
 
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
+#include <cmath>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -127,6 +129,33 @@ class ContactMonitor {
   Eigen::Vector3d ContactForce(const Eigen::Vector3d& f_sensor, double payload_kg) const;
   double force_allowance() const { return hold_f_; }
   bool ready() const { return have_prev_; }
+
+  // The filter's state, for handing it to another process (force-guard's state block,
+  // docs/DECISIONS.md D52): the previous sample, the external torques, the tool acceleration and
+  // the decaying allowances. Restore refuses (false, nothing changed) non-finite numbers and
+  // negative allowances.
+  struct Snapshot {
+    bool have_prev = false;
+    int64_t t_prev = 0;
+    Q qd_prev = Q::Zero(), q = Q::Zero(), ext = Q::Zero(), hold_t = Q::Zero();
+    Eigen::Vector3d a_tool = Eigen::Vector3d::Zero();
+    double hold_f = 0;
+  };
+  Snapshot Save() const { return {have_prev_, t_prev_, qd_prev_, q_, ext_, hold_t_, a_tool_, hold_f_}; }
+  bool Restore(const Snapshot& s) {
+    const bool finite = s.qd_prev.allFinite() && s.q.allFinite() && s.ext.allFinite() && s.hold_t.allFinite() &&
+                        s.a_tool.allFinite() && std::isfinite(s.hold_f);
+    if (!finite || s.hold_t.minCoeff() < 0 || s.hold_f < 0) return false;
+    have_prev_ = s.have_prev;
+    t_prev_ = s.t_prev;
+    qd_prev_ = s.qd_prev;
+    q_ = s.q;
+    ext_ = s.ext;
+    hold_t_ = s.hold_t;
+    a_tool_ = s.a_tool;
+    hold_f_ = s.hold_f;
+    return true;
+  }
 
  private:
   const Model* model_;

@@ -23,7 +23,9 @@
 #include "arflex/host.h"
 #include "arflex/host_contract.h"
 #include "arflex_types/joint_ref.h"
+#include "arflex_types/force_guard_state.h"
 #include "arflex_types/tcp_correction_state.h"
+#include "arflex_types/tcp_correction_state2.h"
 #include "arflex_types/trajectory_state.h"
 #include "arflex_types/joint_state.h"
 #include "arflex_types/safety_state.h"
@@ -136,6 +138,7 @@ void CaseLateRobot();       // test_cell_trajectory.cc
 void CaseStopAway();        // test_cell_stop_away.cc
 void CaseStateTransfer();   // test_cell_state_transfer.cc
 void CaseForceGuard();      // test_cell_force_guard.cc
+void CaseForceGuardState(); // test_cell_force_guard_state.cc (D52)
 void CaseTeachReplay();     // test_cell_teach.cc
 void CaseTools();           // test_cell_tools.cc
 void CaseInvalidInput();    // test_cell_input.cc

@@ -33,6 +33,12 @@ import org.junit.jupiter.api.Test;
  * runs 1.0.1 (committed after its window), in one change set. Throughout: the guard never leaves
  * NORMAL, sim-robot runs no safe cycle, nothing waits for a reset or a fresh command, sim-robot,
  * the guard and trajectory keep their pids.
+ *
+ * <p>D50: a gripper signed by an unknown key is refused naming the jar; a set whose faulty update
+ * is rejected in its shadow run leaves no bundle; a set whose faulty update is rolled back after
+ * its switch is taken back whole (its gripper, signed by a trusted key, uninstalled from the cell
+ * and from Felix, the guard's limit it wrote written back); a set of changes only uninstalls the
+ * gripper and writes the guard's limit, a value out of range refused naming its line.
  */
 class DeploymentSetIT {
 
@@ -81,6 +87,38 @@ class DeploymentSetIT {
                 + "</deployment>\n");
     }
 
+    /**
+     * A copy of {@code jar} signed by a new EC key (CN {@code cn}) with the JDK's jarsigner; when
+     * {@code trusted}, the key's certificate is put into the runtime's trust store ({@code trust}
+     * of its working directory, D14), readable by all, writable by the owner only.
+     */
+    static Path signed(Runtime rt, Path jar, String name, String cn, boolean trusted) throws Exception {
+        Path keys = Files.createDirectories(rt.dir.resolve("keys"));
+        Path ks = keys.resolve(name + ".p12");
+        jdk("keytool", "-genkeypair", "-alias", "k", "-keyalg", "EC", "-groupname", "secp256r1", "-validity", "30",
+                "-dname", "CN=" + cn, "-keystore", ks.toString(), "-storetype", "PKCS12", "-storepass", "changeit-test");
+        Path out = Files.copy(jar, jar.resolveSibling(name + ".jar"));
+        jdk("jarsigner", "-keystore", ks.toString(), "-storetype", "PKCS12", "-storepass", "changeit-test",
+                "-digestalg", "SHA-256", out.toString(), "k");
+        if (trusted) {
+            Path trust = Files.createDirectories(rt.dir.resolve("trust"));
+            Files.setPosixFilePermissions(trust, java.nio.file.attribute.PosixFilePermissions.fromString("rwxr-xr-x"));
+            Path crt = trust.resolve(name + ".crt");
+            jdk("keytool", "-exportcert", "-rfc", "-alias", "k", "-keystore", ks.toString(), "-storetype", "PKCS12",
+                    "-storepass", "changeit-test", "-file", crt.toString());
+            Files.setPosixFilePermissions(crt, java.nio.file.attribute.PosixFilePermissions.fromString("rw-r--r--"));
+        }
+        return out;
+    }
+
+    private static void jdk(String tool, String... args) throws Exception {
+        List<String> cmd = new ArrayList<>(List.of(Path.of(System.getProperty("java.home"), "bin", tool).toString()));
+        cmd.addAll(List.of(args));
+        Process p = new ProcessBuilder(cmd).redirectErrorStream(true).start();
+        String out = new String(p.getInputStream().readAllBytes(), java.nio.charset.StandardCharsets.UTF_8);
+        assertEquals(0, p.waitFor(), () -> tool + " failed: " + out);
+    }
+
     /** A jar named in a descriptor, as the DRCR resolves it (URI.resolve: {@code file:/...}). */
     static String at(Path descriptor, String jar) {
         return descriptor.toUri().resolve(jar).toString();
@@ -114,7 +152,7 @@ class DeploymentSetIT {
                 .noneMatch(p -> p.contains("--instance tool-gripper ") || p.contains("--instance 1-tcp-correction "))
                 && objects(rt, "tool-gripper").isEmpty() && objects(rt, "1-tcp-correction").isEmpty());
         assertEquals(tcpPid, rt.pid("tcp-correction"), "the running tcp-correction untouched");
-        assertTrue(rt.cmd("arflex:info tcp-correction").startsWith("tcp-correction 1.0.0 "), rt.cmd("arflex:info tcp-correction"));
+        assertTrue(rt.cmd("arflex:info tcp-correction").startsWith("tcp-correction 1.1.0 "), rt.cmd("arflex:info tcp-correction"));
     }
 
     /** The arm's record over a span: the guard's modes, sim-robot's stats before and after. */
@@ -159,7 +197,8 @@ class DeploymentSetIT {
             assertEquals(0, safe, what + ": sim-robot ran safe cycles");
             assertNull(safety.snapshot().stream().filter(s -> s.mode() != CellRig.Safety.NORMAL).findFirst().orElse(null),
                     what + ": the guard left NORMAL");
-            assertTrue(FailSafeIT.moving(js), what + ": the arm moves");
+            // the looping program passes its waypoints at rest: the arm moves again soon after any instant
+            rt.waitUntil(what + ": the arm moves", 5_000, () -> FailSafeIT.moving(js));
             assertEquals(List.of(), CellRig.awaitingReset(rt));
             assertEquals(List.of(), CellRig.awaitingCommand(rt));
             assertNull(FailSafeIT.holding(rt, "sim-robot"));
@@ -203,6 +242,16 @@ class DeploymentSetIT {
                 assertTrue(dry.startsWith("error: ") && dry.contains("REFUSED jar "), dry);
                 nothingInstalled(rt, tcpPid);
 
+                // signed="true", but by a key the trust store does not hold: refused, naming the jar and why
+                Path stranger = signed(rt, dir.resolve("tool-gripper.jar"), "tool-gripper-stranger", "Somebody else", false);
+                Path unknown = Files.writeString(dir.resolve("unknown-key.xml"), Files.readString(bad).replace(
+                        "tool-gripper.jar\" sha256=\"" + wrongPin + "\"", stranger.getFileName() + "\" signed=\"true\""));
+                out = rt.cmd("arflex:deploy set " + unknown.toUri());
+                System.out.println("DeploymentSetIT: a jar signed by an unknown key:\n" + out);
+                assertTrue(out.startsWith("error: ") && out.contains("REFUSED jar " + at(unknown, stranger.getFileName().toString())
+                        + " (line 3, install): not signed by a trusted key: "), out);
+                nothingInstalled(rt, tcpPid);
+
                 // (3) tcp-correction 1.0.2 writes 'corrected' as a stream, sim-robot reads a state
                 Path incompatible = descriptor(dir, "stream", gripperPin, "tcp-correction-1.0.2-stream.jar",
                         Jars.sha256(dir.resolve("tcp-correction-1.0.2-stream.jar")));
@@ -229,7 +278,21 @@ class DeploymentSetIT {
                 assertTrue(out.contains("\nuninstalled again: bundle "), out);
                 assertTrue(out.contains("tool-gripper"), out);
                 nothingInstalled(rt, tcpPid);
-                w.unharmed("after three refused sets");
+
+                // D50: rejected in its shadow run (D42): the faulty version crashes while it shadows the
+                // running one; nothing was switched, and the gripper's bundle installed for the set goes again
+                Path faulty = UpdateSetIT.version(dir, "1.0.2-faulty", FaultyVersions.crashingAfterMs(dir,
+                        CellRig.TCP_CORRECTION, UpdateSetIT.EXE, 500, "DeploymentSetIT"));
+                Path shadowed = Files.writeString(dir.resolve("shadowed.xml"), "<deployment xmlns=\"urn:arflex:deployment:1\">\n"
+                        + "  <install jar=\"tool-gripper.jar\" sha256=\"" + gripperPin + "\"/>\n"
+                        + "  <update component=\"tcp-correction\" jar=\"" + faulty.getFileName() + "\" sha256=\""
+                        + Jars.sha256(faulty) + "\" shadow=\"5000\" window=\"300\"/>\n</deployment>\n");
+                out = rt.cmd("arflex:deploy set " + shadowed.toUri());
+                System.out.println("DeploymentSetIT: a set rejected in shadow:\n" + out);
+                assertTrue(out.startsWith("error: ") && out.contains("update tcp-correction: rejected in shadow after "), out);
+                assertTrue(out.contains("\nuninstalled again: bundle ") && out.contains(at(shadowed, "tool-gripper.jar")), out);
+                nothingInstalled(rt, tcpPid);
+                w.unharmed("after five refused sets");
             }
         }
     }
@@ -277,6 +340,79 @@ class DeploymentSetIT {
             String again = rt.cmd("arflex:deploy set " + set.toUri());
             assertTrue(again.startsWith("error: ") && again.contains("already installed as bundle"), again);
             rt.awaitState("ACTIVE", T, "tool-gripper", "tcp-correction");
+
+            // D50: a set of changes only, the gripper uninstalled and the guard's limit written; first
+            // with a value out of range: refused naming its line, nothing changed
+            String head = "<deployment xmlns=\"urn:arflex:deployment:1\" name=\"changes\">\n"
+                    + "  <uninstall component=\"tool-gripper\"/>\n";
+            Path outOfRange = Files.writeString(dir.resolve("changes-bad.xml"), head
+                    + "  <set component=\"force-guard\" parameter=\"force_limit_n\" value=\"0.5\"/>\n</deployment>\n");
+            String refused = rt.cmd("arflex:deploy set " + outOfRange.toUri());
+            assertTrue(refused.startsWith("error: ") && refused.contains("refused: line 3, set force-guard force_limit_n 0.5: "
+                    + "force-guard.force_limit_n: 0.5 is out of range [1.0, 10000.0] N; nothing installed"), refused);
+            rt.awaitState("ACTIVE", T, "tool-gripper");
+            long trajPid = rt.pid("trajectory");
+            Path changes = Files.writeString(dir.resolve("changes.xml"), head
+                    + "  <set component=\"force-guard\" parameter=\"force_limit_n\" value=\"145\"/>\n</deployment>\n");
+            String applied = rt.cmd("arflex:deploy set " + changes.toUri());
+            System.out.println("DeploymentSetIT: a set of changes only:\n" + applied);
+            assertFalse(applied.startsWith("error: "), applied);
+            assertTrue(applied.contains("STOP     tool-gripper") && applied.contains("REBIND   trajectory"), applied);
+            rt.awaitState("INSTALLED", T, "tool-gripper");
+            assertTrue(rt.cmd("arflex:get force-guard force_limit_n").strip().startsWith("145"),
+                    rt.cmd("arflex:get force-guard force_limit_n"));
+            assertFalse(rt.cmd("arflex:bindings").contains("tool-gripper"), rt.cmd("arflex:bindings"));
+            assertEquals(trajPid, rt.pid("trajectory"));
+            rt.awaitState("ACTIVE", T, "tcp-correction", "trajectory", "sim-robot", "force-guard");
+        }
+    }
+
+    /**
+     * D50: a set whose update is rolled back after its switch (the faulty 1.0.2, killed by SIGSEGV
+     * 1.5 s after its spawn, window 5000 cycles) is taken back whole: the gripper it installed
+     * is uninstalled from the cell and from Felix, the guard's limit it wrote is written back, and
+     * the arm runs as before, tcp-correction 1.0.0 with the pid it had.
+     */
+    @Test
+    void aSetWhoseUpdateIsRolledBackAfterItsSwitchIsTakenBackOnTheMovingArm() throws Exception {
+        CellRig.assertBuilt(CellRig.SIM_ROBOT, CellRig.TRAJECTORY, CellRig.FORCE_GUARD, CellRig.TCP_CORRECTION,
+                CellRig.GRIPPER);
+        try (Runtime rt = new Runtime("deploy-rollback")) {
+            FailSafeIT.movingCell(rt);
+            Path dir = folder(rt);
+            // killed 1.5 s after its spawn: after the switch even on a loaded machine, within the window
+            Path faulty = UpdateSetIT.version(dir, "1.0.2-faulty", FaultyVersions.crashingAfterMs(dir, CellRig.TCP_CORRECTION,
+                    UpdateSetIT.EXE, 1500, "DeploymentSetIT"));
+            Path gripper = signed(rt, dir.resolve("tool-gripper.jar"), "tool-gripper-signed", "DeploymentSetIT integrator", true);
+            String limit = rt.cmd("arflex:get force-guard force_limit_n").strip();
+            Path set = Files.writeString(dir.resolve("rolled-back.xml"), "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+                    + "<deployment xmlns=\"urn:arflex:deployment:1\" name=\"rolled-back\">\n"
+                    + "  <install jar=\"" + gripper.getFileName() + "\" signed=\"true\"/>\n"
+                    + "  <update component=\"tcp-correction\" jar=\"" + faulty.getFileName() + "\" sha256=\""
+                    + Jars.sha256(faulty) + "\" window=\"5000\" shadow=\"0\"/>\n"
+                    + "  <set component=\"force-guard\" parameter=\"force_limit_n\" value=\"140\"/>\n"
+                    + "</deployment>\n");
+            long tcpPid = rt.pid("tcp-correction");
+            try (Watch w = new Watch(rt)) {
+                String out = rt.cmd("arflex:deploy set " + set.toUri());
+                System.out.println("DeploymentSetIT: a set rolled back after its switch:\n" + out);
+                assertTrue(out.startsWith("error: "), out);
+                assertTrue(out.contains("install tool-gripper 1.0.0 from " + at(set, gripper.getFileName().toString())
+                        + " (signed by CN=DeploymentSetIT integrator, sha256 "), "admitted by its signature: " + out);
+                assertTrue(out.contains("\napplied: "), "the set was switched: " + out);
+                assertTrue(out.contains("update tcp-correction: rolled back after ") && out.contains("killed by signal 11"), out);
+                assertTrue(out.contains("taking the set back (update tcp-correction rolled back after the switch): "
+                        + "uninstall tool-gripper; set force-guard force_limit_n " + limit + "\n"), out);
+                assertTrue(out.contains("\nuninstalled again: bundle ") && out.contains(at(set, gripper.getFileName().toString())),
+                        out);
+                assertTrue(out.strip().endsWith("refused: update tcp-correction rolled back after the switch; the set was "
+                        + "taken back"), out);
+                assertEquals(limit, rt.cmd("arflex:get force-guard force_limit_n").strip(), "the guard's limit written back");
+                nothingInstalled(rt, tcpPid);
+                String b = rt.cmd("arflex:bindings");
+                assertTrue(b.contains("sim-robot.joint_ref <- tcp-correction.corrected") && !b.contains("tool-gripper"), b);
+                w.unharmed("a set taken back");
+            }
         }
     }
 }

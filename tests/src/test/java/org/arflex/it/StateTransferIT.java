@@ -44,7 +44,11 @@ class StateTransferIT {
     /** One cycle of the program's fastest motion: speed 0.1 of joint 0's 123 deg/s over 1 ms, rad. */
     static final double ONE_CYCLE = 0.1 * CellRig.VMAX[0] * 1e-3;
 
-    /** arflex.TcpCorrectionState 1.0: its size and the offset of blend_offset[6] (contracts/types). */
+    /**
+     * arflex.TcpCorrectionState 1.0: its size and the offset of blend_offset[6] (contracts/types);
+     * tcp-correction 1.1.0 publishes arflex.TcpCorrectionState2, which has these fields at the same
+     * offsets (D52), so its first 368 bytes are read the same way.
+     */
     static final int TCS_SIZE = 368; // TcpCorrectionStateLayout.SIZE (contracts: not on this classpath)
     static final int TCS_BLEND_OFFSET = 208; // TcpCorrectionStateLayout.OFFSET_BLEND_OFFSET
 

@@ -99,6 +99,15 @@ class UpdateSetIT {
 
     /** As above, with the options after the pin as given ({@code window <cycles>}, {@code envelope ...}). */
     static Run update(Runtime rt, Path jar, String options) throws Exception {
+        return update(rt, jar, options, null);
+    }
+
+    /**
+     * As above; {@code traces}, when given, gets the corrected references of the old and of the
+     * new half recorded from before the apply to 2000 references after it (StateConversionIT).
+     */
+    static Run update(Runtime rt, Path jar, String options,
+            java.util.function.BiConsumer<List<CellRig.Ref>, List<CellRig.Ref>> traces) throws Exception {
         long robotPid = rt.pid("sim-robot");
         long guardPid = rt.pid("force-guard");
         long oldPid = rt.pid("tcp-correction");
@@ -204,6 +213,9 @@ class UpdateSetIT {
                 // a stall that matters to the arm shows as safe cycles or the guard's stop above.
                 assertEquals(robotPid, rt.pid("sim-robot"));
                 assertEquals(guardPid, rt.pid("force-guard"));
+                if (traces != null) {
+                    traces.accept(o, n);
+                }
                 return r;
             } finally {
                 if (np != null) {

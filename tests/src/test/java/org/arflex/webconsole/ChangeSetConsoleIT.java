@@ -386,4 +386,42 @@ class ChangeSetConsoleIT {
             b.screenshot(Path.of(System.getProperty("arflex.screenshots", "target/screenshots")).resolve("changesets-outcome.png"));
         }
     }
+
+    /**
+     * D50: deployment sets refused before their change set, one for its descriptor, one by the
+     * code gate, are in the DRCR's history as the page lists it: the action {@code deploy <url>},
+     * refused, with the reason (the descriptor's line; the jar and both hashes); nothing applied.
+     */
+    @Test
+    @Order(8)
+    void deploymentSetsRefusedBeforeTheirChangeSetAreInTheHistoryWithTheirReason() throws IOException {
+        Path dir = Files.createDirectories(Path.of(System.getProperty("arflex.it.work", "target/it"))
+                .resolve("changeset-console").toAbsolutePath().resolve("sets"));
+        Path bad = Files.writeString(dir.resolve("bad.xml"), "<deployment xmlns=\"urn:arflex:deployment:1\">\n"
+                + "  <uninstall component=\"sample-counter\" jar=\"x.jar\"/>\n</deployment>\n");
+        Path scaler = org.arflex.it.Components.jar("sample-scaler");
+        String zeros = "0".repeat(64);
+        Path pin = Files.writeString(dir.resolve("pin.xml"), "<deployment xmlns=\"urn:arflex:deployment:1\">\n"
+                + "  <install jar=\"" + scaler.toUri() + "\" sha256=\"" + zeros + "\"/>\n</deployment>\n");
+        int before = history().size();
+        String scalerState = state("sample-scaler");
+        rt.gogo("arflex:deploy set " + bad.toUri());
+        rt.gogo("arflex:deploy set " + pin.toUri());
+        RuntimeUnderTest.awaitCondition("two refused deployment sets in the history", WAIT,
+                () -> history().size() == before + 2);
+        List<Map<String, Object>> h = history();
+        Map<String, Object> gate = h.get(0);
+        Map<String, Object> syntax = h.get(1);
+        assertEquals(List.of("deploy " + bad.toUri()), syntax.get("actions"));
+        assertEquals("refused", syntax.get("outcome"), String.valueOf(syntax));
+        assertEquals(false, syntax.get("applied"));
+        assertTrue(String.valueOf(syntax.get("why")).matches("descriptor: " + Pattern.quote(bad.toUri().toString())
+                + ":2:\\d+: <uninstall>: unknown attribute 'jar' \\(allowed: component\\)"), String.valueOf(syntax));
+        assertEquals(List.of("deploy " + pin.toUri()), gate.get("actions"));
+        assertEquals("refused", gate.get("outcome"), String.valueOf(gate));
+        String why = String.valueOf(gate.get("why"));
+        assertTrue(why.startsWith("jar " + scaler.toUri() + " (line 2, install): ") && why.contains("pinned " + zeros)
+                && why.endsWith("; nothing installed"), why);
+        assertEquals(scalerState, state("sample-scaler"), "nothing of the refused sets changed the cell");
+    }
 }

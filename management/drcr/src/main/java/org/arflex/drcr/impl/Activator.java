@@ -70,6 +70,9 @@ public final class Activator implements BundleActivator {
     private ThreadActor actor;
     private java.util.concurrent.ExecutorService stopper;
     private java.util.concurrent.ExecutorService launches;
+    private java.util.concurrent.ExecutorService prepares;
+    private java.util.concurrent.ExecutorService registrar;
+    private org.arflex.drcr.impl.services.ManagementRegistrations registrations;
     private Cell cell;
     private Services services;
     private ScheduledExecutorService ticker;
@@ -145,6 +148,12 @@ public final class Activator implements BundleActivator {
             t.setDaemon(true);
             return t;
         });
+        // installed contract bundles have their executables extracted ahead of their start (D54)
+        prepares = Executors.newSingleThreadExecutor(r -> {
+            Thread t = new Thread(r, "arflex-drcr-prepare");
+            t.setDaemon(true);
+            return t;
+        });
         VerifiedExecutables executables = new VerifiedExecutables(storage, log);
         Cell.Config cfg = new Cell.Config(rid, Long.parseLong(prop(ctx, "arflex.ready.timeout.ms", "5000")), 3_000,
                 Boolean.parseBoolean(prop(ctx, "arflex.nomlock", "false")), types, Posix::monotonicNs,
@@ -171,8 +180,15 @@ public final class Activator implements BundleActivator {
         VerifiedInstaller installer = new VerifiedInstaller(ctx, gate, log);
         // arflex:await looks at the cell again on each of its changes
         watch = new CellWatch();
+        // the ComponentManagement registrations are made off the actor (D54)
+        registrar = Executors.newSingleThreadExecutor(r -> {
+            Thread t = new Thread(r, "arflex-drcr-registrar");
+            t.setDaemon(true);
+            return t;
+        });
+        registrations = new org.arflex.drcr.impl.services.ManagementRegistrations(cell, ctx, registrar);
         cell.onChange(() -> {
-            services.sync();
+            registrations.sync();
             watch.changed();
         });
         regs.add(ctx.registerService(DrcrService.class, services, null));
@@ -257,7 +273,7 @@ public final class Activator implements BundleActivator {
                     public void forget(java.nio.file.Path exe) {
                         executables.forget(exe);
                     }
-                }, gateHook::refusal, log);
+                }, gateHook::refusal, prepares, gate::check, log);
         changeSets.executables(extender::executable);
         changeSets.bundles(new org.arflex.drcr.impl.services.UpdatedBundles(ctx, cell,
                 new org.arflex.drcr.impl.services.UpdatedBundles.Carrier() {
@@ -338,6 +354,9 @@ public final class Activator implements BundleActivator {
         if (tracker != null) {
             tracker.close();
         }
+        if (prepares != null) {
+            prepares.shutdownNow();
+        }
         for (ServiceRegistration<?> r : regs) {
             try {
                 r.unregister();
@@ -346,10 +365,20 @@ public final class Activator implements BundleActivator {
             }
         }
         regs.clear();
+        if (registrar != null) {
+            // its last registrations made (off the actor: a listener may call into the cell);
+            // from here on the actor makes them itself, until they are closed
+            registrar.shutdown();
+            if (!registrar.awaitTermination(30, TimeUnit.SECONDS)) {
+                log.accept("arflex: the registrar of the management services did not end within 30 s");
+            }
+        }
         if (cell != null) {
             actor.call(() -> {
                 cell.shutdownAll("DRCR stopping");
-                services.unregisterAll();
+                if (registrations != null) {
+                    registrations.close();
+                }
                 return null;
             }, 120_000);
             // the halves stop on the stop threads; their outcomes are recorded on the actor

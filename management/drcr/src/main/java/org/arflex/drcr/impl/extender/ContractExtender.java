@@ -22,9 +22,10 @@ import org.osgi.util.tracker.BundleTrackerCustomizer;
 /**
  * The extender: tracks installed bundles whose manifest has {@code ARFLEX-Contract}. When such
  * a bundle is installed its contracts are read (a bad one is reported and skipped) and its
- * components show as INSTALLED; when it starts (by our commands, Felix's {@code start} or
- * {@code update}) its executables are extracted into its data area and its components
- * installed into the cell; when it stops (Felix's {@code stop}, {@code uninstall},
+ * components show as INSTALLED, and it is prepared for its start on a thread of its own (its
+ * executables extracted once the code gate admits it; D54); when it starts (by
+ * our commands, Felix's {@code start} or {@code update}) its executables are extracted into its
+ * data area (or the prepared copies taken) and its components installed into the cell; when it stops (Felix's {@code stop}, {@code uninstall},
  * {@code update}) they are destroyed before the bundle is gone and show as INSTALLED again;
  * when it is uninstalled they disappear. Callbacks come on the framework's thread and wait for
  * the actor, so Felix's command returns only when the cell has followed.
@@ -37,10 +38,15 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
     public static final class Tracked {
         List<Contract> contracts = List.of();
         /** Names installed into the cell while the bundle is ACTIVE; null when not active. */
-        List<String> active;
+        volatile List<String> active;
         /** Executables extracted from this bundle (released when it is updated or uninstalled). */
         final java.util.Set<Path> extracted = new java.util.HashSet<>();
+        /** Executables extracted ahead of the next start, by name ({@link StartPreparation}). */
+        final java.util.Map<String, Path> prepared = new java.util.HashMap<>();
+        /** Counts the bundle's revisions gone: a preparation of an older one extracts nothing. */
+        int revision;
     }
+
 
     /**
      * Per bundle id, the components that keep running across the bundle's next stop, update and
@@ -56,6 +62,7 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
     private final Consumer<String> log;
     private final Extractor extractor;
     private final Admission admission;
+    private final StartPreparation preparation;
 
     /** The code gate: whether a bundle may run its RT halves. */
     @FunctionalInterface
@@ -64,9 +71,17 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
         String refusal(Bundle bundle);
     }
 
+    /**
+     * @param prepare     the thread that prepares installed bundles for their start (extracts their
+     *                    executables once the gate admits them; D54)
+     * @param lookAhead   the gate's verdict for that preparation: neither logged nor kept (a bundle
+     *                    is judged for its start, when Felix resolves it, as before)
+     */
     public ContractExtender(Cell cell, ContractReader reader, BundleContext own, Extractor extractor,
-                            Admission admission, Consumer<String> log) {
+                            Admission admission, java.util.concurrent.Executor prepare, Admission lookAhead,
+                            Consumer<String> log) {
         this.admission = admission;
+        this.preparation = new StartPreparation(prepare, lookAhead, this::extract, log);
         this.cell = cell;
         this.reader = reader;
         this.own = own;
@@ -88,6 +103,7 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
         }
         Tracked t = new Tracked();
         read(bundle, t);
+        preparation.submit(bundle, t);
         follow(bundle, t);
         return t;
     }
@@ -97,7 +113,7 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
         if (event != null && event.getType() == BundleEvent.UPDATED) {
             deactivate(bundle, t);
             forget(bundle, t);
-            read(bundle, t);
+            read(bundle, t); // not prepared: Felix starts an updated bundle at once
         }
         follow(bundle, t);
     }
@@ -128,7 +144,9 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
             return u == null ? null : u.openStream();
         });
         log.accept("arflex: " + label + ": contracts read in " + (System.nanoTime() - t0) / 1000 + " us");
-        t.contracts = r.contracts();
+        synchronized (t) {
+            t.contracts = r.contracts();
+        }
         cell.actor().call(() -> {
             for (String p : r.problems()) {
                 cell.problem(p);
@@ -141,11 +159,15 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
     }
 
     private void forget(Bundle bundle, Tracked t) {
-        List<Contract> cs = t.contracts;
-        t.contracts = List.of();
-        // the record of each copy holds a way back into this bundle revision: let both go
-        t.extracted.forEach(extractor::forget);
-        t.extracted.clear();
+        List<Contract> cs;
+        synchronized (t) {
+            cs = t.contracts;
+            t.contracts = List.of();
+            StartPreparation.drop(t);
+            // the record of each copy holds a way back into this bundle revision: let both go
+            t.extracted.forEach(extractor::forget);
+            t.extracted.clear();
+        }
         cell.actor().call(() -> {
             for (Contract c : cs) {
                 cell.unregister(c.name(), bundle.getBundleId());
@@ -174,8 +196,7 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
         for (Contract c : t.contracts) {
             Path exe;
             try {
-                exe = extract(bundle, c.executable());
-                t.extracted.add(exe);
+                exe = executableFor(bundle, t, c);
             } catch (IOException e) {
                 String p = label + ": cannot extract " + ContractReader.NATIVE_DIR + c.executable() + ": " + e.getMessage();
                 cell.actor().submit(() -> cell.problem(p));
@@ -189,6 +210,18 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
         t.active = installed;
         log.accept("arflex: " + label + " started: components " + installed + " in " + (System.nanoTime() - t0) / 1000
                 + " us");
+    }
+
+    /** The executable of {@code c} for this start: the one prepared ahead of it (D54), or extracted now. */
+    private Path executableFor(Bundle bundle, Tracked t, Contract c) throws IOException {
+        synchronized (t) {
+            Path exe = StartPreparation.take(t, c.executable());
+            if (exe == null) {
+                exe = extract(bundle, c.executable());
+                t.extracted.add(exe);
+            }
+            return exe;
+        }
     }
 
     private void deactivate(Bundle bundle, Tracked t) {
@@ -282,8 +315,10 @@ public final class ContractExtender implements BundleTrackerCustomizer<ContractE
 
     /**
      * Hands {@code native/linux-x86_64/<exe>} to the extractor, into the bundle's data area (our
-     * own data area when the bundle has none). Every start extracts afresh: nothing is reused by
-     * its timestamp (issue 16 finding 5).
+     * own data area when the bundle has none). Every start extracts afresh, except the first
+     * after an install or update, which takes the copy {@link StartPreparation} made of the same
+     * revision once the gate admitted it (D54); nothing is reused by its timestamp (issue 16
+     * finding 5), and every spawn hashes the file against the bytes read from the bundle.
      */
     Path extract(Bundle bundle, String exe) throws IOException {
         URL u = bundle.getEntry(ContractReader.NATIVE_DIR + exe);

@@ -240,6 +240,9 @@ final class ChangeSetExecutor {
                     + "outside a change set";
         }
         String state = StateTransfer.problem(inst.contract, u.contract());
+        if (state == null) {
+            state = StateTransfer.latchProblem(inst); // D52
+        }
         if (state != null) {
             return state;
         }

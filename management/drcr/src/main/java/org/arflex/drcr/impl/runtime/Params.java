@@ -2,8 +2,12 @@ package org.arflex.drcr.impl.runtime;
 
 import org.arflex.contract.PropertySpec;
 
-/** Parsing, range checking and formatting of parameter values (8-byte control block encoding). */
-final class Params {
+/**
+ * Parsing, range checking and formatting of parameter values (8-byte control block encoding).
+ * Public for {@link #parse}: a deployment set checks its parameter writes before anything is
+ * installed (D50).
+ */
+public final class Params {
 
     private Params() {
     }
@@ -13,7 +17,7 @@ final class Params {
      *
      * @throws IllegalArgumentException naming the parameter, the value and the rule
      */
-    static long parse(PropertySpec p, String text) {
+    public static long parse(PropertySpec p, String text) {
         String t = text.trim();
         long bits;
         double numeric;

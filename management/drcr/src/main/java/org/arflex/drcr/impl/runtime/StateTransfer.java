@@ -5,6 +5,7 @@ import org.arflex.contract.Contract;
 import org.arflex.contract.PortType;
 import org.arflex.contract.PortTypes;
 import org.arflex.contract.StateSpec;
+import org.arflex.drcr.impl.abi.ControlBlock;
 import org.arflex.drcr.impl.abi.PortSegment;
 import org.arflex.drcr.impl.supervisor.RtLauncher;
 
@@ -69,6 +70,25 @@ final class StateTransfer {
                     + next.version() + " takes " + to + " and declares no conversion from " + from;
         }
         return null;
+    }
+
+    /**
+     * Why the running half {@code inst} may not be replaced by a new version in a change set
+     * because of a stop it holds, or null: it awaits an operator reset (the DRCR's own after a
+     * restart, or RESET_REQUIRED on its control block: a latched protective stop) and its version
+     * declares no state block, so the new half would start from nothing, i.e. without the stop
+     * (docs/DECISIONS.md D52: fail closed). A running version with a state hands the latch over
+     * (force-guard's adopt hook latches the new half).
+     */
+    static String latchProblem(Instance inst) {
+        if (inst.contract.state().isPresent()) {
+            return null;
+        }
+        boolean awaiting = inst.awaitingReset
+                || (inst.half != null && (inst.half.flags() & ControlBlock.FLAG_RESET_REQUIRED) != 0);
+        return !awaiting ? null : "'" + inst.name + "' awaits an operator reset and its running version "
+                + inst.contract.version() + " hands over no state block: a new half would start without the stop; "
+                + "reset it first, or update it outside a change set";
     }
 
     /**

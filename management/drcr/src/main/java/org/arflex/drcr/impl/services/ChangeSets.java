@@ -104,6 +104,7 @@ public final class ChangeSets implements ChangeSetService {
     /** Who applies deployment sets (D45). */
     public void deployments(DeploymentSets d) {
         deployments = d;
+        d.recordInto(history); // its refusals before the change set, in the same history (D50)
     }
 
     @Override

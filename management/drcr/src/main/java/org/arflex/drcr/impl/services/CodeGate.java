@@ -97,8 +97,28 @@ public final class CodeGate {
         return v.accepted() || problem == null ? v : JarSignatures.Verdict.refused(v.reason() + " (" + problem + ")");
     }
 
-    /** Null when the bundle may run its RT halves, else why not (for the cell's problems). */
+    /** Null when the bundle may run its RT halves, else why not (for the cell's problems); logged. */
     public String refusal(Bundle b) {
+        Decision d = judge(b);
+        log.accept("arflex: code gate: bundle " + b.getBundleId() + " " + (d.admitted() ? "admitted: " : "refused: ")
+                + d.reason());
+        return refusalText(b, d);
+    }
+
+    /**
+     * As {@link #refusal}, not logged: a look ahead (D54, the preparation of an installed bundle
+     * for its start), whose refusal refuses nothing (the start asks again, and that is logged).
+     */
+    public String check(Bundle b) {
+        return refusalText(b, judge(b));
+    }
+
+    private static String refusalText(Bundle b, Decision d) {
+        return d.admitted() ? null : "bundle " + b.getBundleId() + " (" + b.getSymbolicName() + ", location "
+                + b.getLocation() + ") " + d.reason();
+    }
+
+    private Decision judge(Bundle b) {
         Map<String, byte[]> entries = null;
         String digest;
         try {
@@ -108,12 +128,9 @@ public final class CodeGate {
             digest = "(unreadable: " + e.getMessage() + ")";
         }
         Map<String, byte[]> content = entries;
-        Decision d = decide(b.getLocation(), digest, () -> content == null
-                ? JarSignatures.Verdict.refused("its content is unreadable") : signature(content));
-        log.accept("arflex: code gate: bundle " + b.getBundleId() + " " + (d.admitted() ? "admitted: " : "refused: ")
-                + d.reason());
-        return d.admitted() ? null : "bundle " + b.getBundleId() + " (" + b.getSymbolicName() + ", location "
-                + b.getLocation() + ") " + d.reason();
+        String unreadable = digest; // "(unreadable: why)": CodeGateHook keeps no verdict that says so
+        return decide(b.getLocation(), digest, () -> content == null
+                ? JarSignatures.Verdict.refused("its content is " + unreadable) : signature(content));
     }
 
     /** The decision for a bundle installed from {@code location} whose content has {@code digest}, unsigned. */

@@ -17,9 +17,10 @@ import javax.xml.stream.XMLStreamException;
 import javax.xml.stream.XMLStreamReader;
 
 /**
- * A deployment set's descriptor (docs/DECISIONS.md D45, docs/deployment-sets.md): one XML document
- * at one URL naming several bundles, each a new component to install or the update of a running
- * one, each jar pinned by its SHA-256 or declared signed by a key of the trust store.
+ * A deployment set's descriptor (docs/DECISIONS.md D45, D50, docs/deployment-sets.md): one XML
+ * document at one URL naming several bundles, each a new component to install or the update of a
+ * running one, each jar pinned by its SHA-256 or declared signed by a key of the trust store; and
+ * the change-set actions without a jar, uninstalls of running components and parameter writes.
  *
  * <pre>{@code
  * <deployment xmlns="urn:arflex:deployment:1" name="cell-2026-11">
@@ -29,6 +30,8 @@ import javax.xml.stream.XMLStreamReader;
  *     <envelope port="corrected" field="q" min="-3.2" max="3.2"/>
  *     <tolerance port="corrected" field="q" max="0.001"/>
  *   </update>
+ *   <uninstall component="teach-pendant"/>
+ *   <set component="tcp-correction" parameter="gain" value="0.5"/>
  * </deployment>
  * }</pre>
  *
@@ -52,28 +55,54 @@ public record DeploymentDescriptor(String name, URI source, List<Entry> entries)
     static final Pattern COMPONENT = Pattern.compile("[a-z][a-z0-9-]{0,47}");
     static final Pattern PORT_OR_FIELD = Pattern.compile("[a-z][a-z0-9_]{0,31}");
     static final Pattern SHA256 = Pattern.compile("[0-9a-fA-F]{64}");
+    static final Pattern PARAMETER = Pattern.compile("[a-z][a-z0-9_.]{0,30}");
+    /** A parameter's value as one change-set word: printable ASCII without blanks, ';' or ','. */
+    static final Pattern VALUE = Pattern.compile("[\\x21-\\x7e&&[^;,]]{1,64}");
     static final Pattern CYCLES = Pattern.compile("0|[1-9][0-9]{0,8}");
 
-    /** What a bundle of the set is. */
-    public enum Kind { INSTALL, UPDATE }
+    /** What an action of the set is: a bundle (install, update) or a change without a jar. */
+    public enum Kind { INSTALL, UPDATE, UNINSTALL, SET }
 
     /**
-     * One bundle of the set.
+     * One action of the set: a bundle, or (without jar) an uninstall or a parameter write.
      *
      * @param line      the line of its element in the descriptor
-     * @param jar       its jar, resolved against the descriptor's URL
+     * @param jar       its jar, resolved against the descriptor's URL; null for an uninstall or a write
      * @param sha256    its pinned SHA-256 (lower case), or null: signed by a key of the trust store
-     * @param component for an update, the running component it replaces; null for an install
+     * @param component the running component an update replaces, an uninstall stops or a write
+     *                  sets; null for an install
      * @param window    an update's rollback window in cycles, or null (the default)
      * @param shadow    an update's shadow run in cycles, or null (none, or its contract's)
      * @param options   an update's {@code envelope <port>.<field> <min> <max>} and
      *                  {@code tolerance <port>.<field> <max>}, as change-set options
+     * @param parameter a write's parameter, else null
+     * @param value     a write's value, else null
      */
     public record Entry(Kind kind, int line, URI jar, String sha256, String component, Long window, Long shadow,
-                        List<String> options) {
+                        List<String> options, String parameter, String value) {
 
         public Entry {
             options = List.copyOf(options);
+        }
+
+        public Entry(Kind kind, int line, URI jar, String sha256, String component, Long window, Long shadow,
+                     List<String> options) {
+            this(kind, line, jar, sha256, component, window, shadow, options, null, null);
+        }
+
+        /** The change-set action of an uninstall or a write ({@code uninstall c}, {@code set c p v}). */
+        public String action() {
+            return switch (kind) {
+                case UNINSTALL -> "uninstall " + component;
+                case SET -> "set " + component + " " + parameter + " " + value;
+                case UPDATE -> updateAction();
+                case INSTALL -> "install " + jar;
+            };
+        }
+
+        /** True for an install or an update: an entry with a jar. */
+        public boolean bundle() {
+            return jar != null;
         }
 
         /** How its code is admitted: the pin, or a trusted signature. */
@@ -81,9 +110,13 @@ public record DeploymentDescriptor(String name, URI source, List<Entry> entries)
             return sha256 != null ? "sha256 " + sha256 : "signed by a key of the trust store";
         }
 
-        /** {@code install <jar>} or {@code update <component> <jar>}, for messages. */
+        /** {@code install <jar>}, {@code update <component> <jar>} or the action, for messages. */
         public String describe() {
-            return kind == Kind.INSTALL ? "install " + jar : "update " + component + " from " + jar;
+            return switch (kind) {
+                case INSTALL -> "install " + jar;
+                case UPDATE -> "update " + component + " from " + jar;
+                default -> action();
+            };
         }
 
         /** The change-set action of an update (ChangeSets' syntax, D38, D42). */
@@ -117,6 +150,16 @@ public record DeploymentDescriptor(String name, URI source, List<Entry> entries)
     /** The updates of the set, in document order. */
     public List<Entry> updates() {
         return entries.stream().filter(e -> e.kind() == Kind.UPDATE).toList();
+    }
+
+    /** The entries with a jar (installs and updates), in document order. */
+    public List<Entry> bundles() {
+        return entries.stream().filter(Entry::bundle).toList();
+    }
+
+    /** The uninstalls and parameter writes, in document order. */
+    public List<Entry> changes() {
+        return entries.stream().filter(e -> !e.bundle()).toList();
     }
 
     /**
@@ -219,8 +262,8 @@ public record DeploymentDescriptor(String name, URI source, List<Entry> entries)
                 throw new IllegalArgumentException(label + ": (document): no <deployment> element");
             }
             if (entries.isEmpty()) {
-                throw new IllegalArgumentException(label + ": <deployment>: names no bundle (an <install> or "
-                        + "<update> element)");
+                throw new IllegalArgumentException(label + ": <deployment>: names no action (an <install>, <update>, "
+                        + "<uninstall> or <set> element)");
             }
             return new DeploymentDescriptor(name, base, entries);
         }
@@ -229,7 +272,8 @@ public record DeploymentDescriptor(String name, URI source, List<Entry> entries)
         private List<Entry> children() throws XMLStreamException {
             List<Entry> out = new ArrayList<>();
             Set<URI> jars = new HashSet<>();
-            Set<String> updated = new HashSet<>();
+            java.util.Map<String, Entry> named = new java.util.HashMap<>();
+            Set<String> written = new HashSet<>();
             while (true) {
                 int ev = r.next();
                 if (ev == XMLStreamConstants.END_ELEMENT) {
@@ -244,21 +288,35 @@ public record DeploymentDescriptor(String name, URI source, List<Entry> entries)
                     continue;
                 }
                 String el = r.getLocalName();
-                if (!NAMESPACE.equals(r.getNamespaceURI()) || !(el.equals("install") || el.equals("update"))) {
-                    throw error(el, "unknown element in <deployment> (expected <install> or <update> in namespace "
-                            + NAMESPACE + ")");
+                if (!NAMESPACE.equals(r.getNamespaceURI()) || !List.of("install", "update", "uninstall", "set").contains(el)) {
+                    throw error(el, "unknown element in <deployment> (expected <install>, <update>, <uninstall> or <set> "
+                            + "in namespace " + NAMESPACE + ")");
                 }
                 if (out.size() == MAX_ENTRIES) {
-                    throw error(el, "more than " + MAX_ENTRIES + " bundles in one set");
+                    throw error(el, "more than " + MAX_ENTRIES + " actions in one set");
                 }
-                Entry e = el.equals("install") ? install() : update();
-                if (!jars.add(e.jar())) {
+                Entry e = switch (el) {
+                    case "install" -> install();
+                    case "update" -> update();
+                    case "uninstall" -> uninstall();
+                    default -> write();
+                };
+                if (e.jar() != null && !jars.add(e.jar())) {
                     throw new IllegalArgumentException(label + ":" + e.line() + ": <" + el + ">: jar " + e.jar()
                             + " is named twice in the set");
                 }
-                if (e.component() != null && !updated.add(e.component())) {
-                    throw new IllegalArgumentException(label + ":" + e.line() + ": <update>: component '" + e.component()
-                            + "' is updated twice in the set");
+                if (e.kind() == Kind.SET) {
+                    if (!written.add(e.component() + "." + e.parameter())) {
+                        throw new IllegalArgumentException(label + ":" + e.line() + ": <set>: parameter " + e.component()
+                                + "." + e.parameter() + " is written twice in the set");
+                    }
+                } else if (e.component() != null) {
+                    Entry before = named.putIfAbsent(e.component(), e);
+                    if (before != null) {
+                        throw new IllegalArgumentException(label + ":" + e.line() + ": <" + el + ">: component '"
+                                + e.component() + "' is named twice in the set (also <"
+                                + before.kind().name().toLowerCase(Locale.ROOT) + "> on line " + before.line() + ")");
+                    }
                 }
                 out.add(e);
             }
@@ -273,16 +331,46 @@ public record DeploymentDescriptor(String name, URI source, List<Entry> entries)
             return new Entry(Kind.INSTALL, line, jar, sha, null, null, null, List.of());
         }
 
+        private Entry uninstall() throws XMLStreamException {
+            int line = r.getLocation().getLineNumber();
+            attributes("uninstall", Set.of("component"));
+            String component = component("uninstall", "the running component it stops and removes");
+            empty("uninstall");
+            return new Entry(Kind.UNINSTALL, line, null, null, component, null, null, List.of());
+        }
+
+        /** {@code <set component parameter value>}: a parameter write, as {@code set c p v} in a change set. */
+        private Entry write() throws XMLStreamException {
+            int line = r.getLocation().getLineNumber();
+            attributes("set", Set.of("component", "parameter", "value"));
+            String component = component("set", "the component whose parameter it writes");
+            String parameter = required("set", "parameter");
+            if (!PARAMETER.matcher(parameter).matches()) {
+                throw error("set", "parameter '" + parameter + "' is not a parameter name (" + PARAMETER.pattern() + ")");
+            }
+            String value = required("set", "value");
+            if (!VALUE.matcher(value).matches()) {
+                throw error("set", "value '" + value + "': 1 to 64 printable characters without blanks, ';' or ','");
+            }
+            empty("set");
+            return new Entry(Kind.SET, line, null, null, component, null, null, List.of(), parameter, value);
+        }
+
+        private String component(String el, String what) {
+            String component = r.getAttributeValue(null, "component");
+            if (component == null) {
+                throw error(el, "attribute 'component' is required (" + what + ")");
+            }
+            if (!COMPONENT.matcher(component).matches()) {
+                throw error(el, "component '" + component + "' is not a component name (" + COMPONENT.pattern() + ")");
+            }
+            return component;
+        }
+
         private Entry update() throws XMLStreamException {
             int line = r.getLocation().getLineNumber();
             attributes("update", Set.of("component", "jar", "sha256", "signed", "window", "shadow"));
-            String component = r.getAttributeValue(null, "component");
-            if (component == null) {
-                throw error("update", "attribute 'component' is required (the running component it updates)");
-            }
-            if (!COMPONENT.matcher(component).matches()) {
-                throw error("update", "component '" + component + "' is not a component name (" + COMPONENT.pattern() + ")");
-            }
+            String component = component("update", "the running component it updates");
             URI jar = jar("update");
             String sha = gate("update");
             Long window = cycles("update", "window");

@@ -43,9 +43,13 @@ import org.osgi.framework.BundleException;
  * <li>applying only: the new components' bundles are installed in Felix, not started (their
  * components show as INSTALLED), and the set is handed to the {@link ChangeSets} as
  * {@code install <component>...} and {@code update <component> <jar> ...} actions; the update
- * jars are not fetched again ({@link #versions}). A set the change set refuses or tears down
- * leaves no bundle behind: the bundles installed for it are uninstalled again.</li>
+ * jars are not fetched again ({@link #versions}), then its uninstalls and writes. A set the
+ * change set refuses, tears down or rejects in a shadow run leaves no bundle behind: the
+ * bundles installed for it are uninstalled again; a set one of whose updates is rolled back
+ * after the switch is taken back ({@link DeploymentUndo}, D50).</li>
  * </ol>
+ * A set refused before its change set is recorded in the change-set history (D50), as the change
+ * set's own outcome is.
  */
 public final class DeploymentSets {
 
@@ -62,6 +66,9 @@ public final class DeploymentSets {
     private final ChangeSets.Versions updates;
     private final ChangeSetService changeSets;
     private final Consumer<String> log;
+    private final DeploymentUndo undo;
+    /** Where refusals before the change set are recorded (the change sets' history, D50); null: nowhere. */
+    private volatile ChangeSetHistory history;
     /** The update jars a set being applied has read, by component, URL and pin, for the change set. */
     private final Map<String, ChangeSets.Version> held = new ConcurrentHashMap<>();
 
@@ -80,6 +87,12 @@ public final class DeploymentSets {
         this.updates = updates;
         this.changeSets = changeSets;
         this.log = log;
+        this.undo = new DeploymentUndo(changeSets, log);
+    }
+
+    /** Records refusals made before the change set into {@code h} (the change sets' own history). */
+    void recordInto(ChangeSetHistory h) {
+        history = h;
     }
 
     /**
@@ -102,6 +115,16 @@ public final class DeploymentSets {
      * at {@code url}.
      */
     public ChangeSetDTO deploy(String url, boolean apply) {
+        boolean[] handedOver = {false};
+        ChangeSetDTO d = deployOnce(url, apply, handedOver);
+        ChangeSetHistory h = history;
+        if (apply && !handedOver[0] && h != null) {
+            h.record(d); // a set's change set records its own outcome; a refusal before it is recorded here
+        }
+        return d;
+    }
+
+    private ChangeSetDTO deployOnce(String url, boolean apply, boolean[] handedOver) {
         StringBuilder text = new StringBuilder();
         URI source;
         try {
@@ -122,12 +145,13 @@ public final class DeploymentSets {
             return refused(url, text, "descriptor: " + e.getMessage());
         }
         text.append("deployment set ").append(d.name() == null ? "" : d.name() + " ").append("from ").append(url)
-                .append(": ").append(d.entries().size()).append(d.entries().size() == 1 ? " bundle" : " bundles")
-                .append('\n');
+                .append(": ").append(d.bundles().size()).append(d.bundles().size() == 1 ? " bundle" : " bundles")
+                .append(d.changes().isEmpty() ? "" : ", " + d.changes().size() + (d.changes().size() == 1 ? " change"
+                        : " changes")).append('\n');
         // 2. every jar through the gate; all failures named, nothing installed
         List<Jar> jars = new ArrayList<>();
         List<String> failed = new ArrayList<>();
-        for (DeploymentDescriptor.Entry e : d.entries()) {
+        for (DeploymentDescriptor.Entry e : d.bundles()) {
             try {
                 Jar j = read(e);
                 jars.add(j);
@@ -143,7 +167,8 @@ public final class DeploymentSets {
             return refused(url, text, String.join("; ", failed) + "; nothing installed");
         }
         // 3. the set against the cell and Felix
-        String misfit = misfit(jars);
+        d.changes().forEach(e -> text.append("  ").append(e.action()).append('\n'));
+        String misfit = misfit(jars, d.changes());
         if (misfit != null) {
             return refused(url, text, misfit + "; nothing installed");
         }
@@ -157,9 +182,17 @@ public final class DeploymentSets {
                 installs.addAll(j.contracts());
             }
         }
+        List<String> changes = cell.actor().call(() -> DeploymentChanges.check(d.changes(), cell.planner().contracts(),
+                installs, updated), Services.CALL_MS);
+        if (!changes.isEmpty()) {
+            return refused(url, text, String.join("; ", changes) + "; nothing installed");
+        }
+        Set<String> uninstalls = new LinkedHashSet<>();
+        d.changes().stream().filter(e -> e.kind() == DeploymentDescriptor.Kind.UNINSTALL)
+                .forEach(e -> uninstalls.add(e.component()));
         PortFormats formats = new PortFormats(cell.config().types());
         List<String> formatProblems = cell.actor().call(() -> formats.check(cell.planner().contracts(),
-                cell.planner().wires(), installs, updated), Services.CALL_MS);
+                cell.planner().wires(), installs, updated, uninstalls), Services.CALL_MS);
         if (!formatProblems.isEmpty()) {
             return refused(url, text, "port formats: " + String.join("; ", formatProblems) + "; nothing installed");
         }
@@ -167,6 +200,7 @@ public final class DeploymentSets {
         Change.Builder b = Change.builder();
         installs.forEach(b::install);
         updated.forEach(b::replace);
+        uninstalls.forEach(b::uninstall);
         Change change = b.build();
         Plan plan;
         try {
@@ -174,7 +208,7 @@ public final class DeploymentSets {
         } catch (IllegalArgumentException e) {
             return refused(url, text, "the planner refused the set: " + e.getMessage() + "; nothing installed");
         }
-        String admission = admission(plan, installs, updated);
+        String admission = admission(plan, installs, updated, uninstalls);
         if (admission != null) {
             text.append(plan.toText());
             return refused(url, text, admission + "; nothing installed");
@@ -185,12 +219,14 @@ public final class DeploymentSets {
             dto.admitted = true;
             return dto;
         }
-        return applySet(url, text, jars);
+        return applySet(url, text, jars, d.changes(), handedOver);
     }
 
     /** 6: the bundles of new components installed, not started; the set applied; undone when refused. */
-    private ChangeSetDTO applySet(String url, StringBuilder text, List<Jar> jars) {
+    private ChangeSetDTO applySet(String url, StringBuilder text, List<Jar> jars, List<DeploymentDescriptor.Entry> changes,
+                                  boolean[] handedOver) {
         List<Bundle> installed = new ArrayList<>();
+        List<String> newComponents = new ArrayList<>();
         List<String> actions = new ArrayList<>();
         List<String> keys = new ArrayList<>();
         try {
@@ -216,6 +252,7 @@ public final class DeploymentSets {
                                 + ": its component '" + c.name() + "' did not appear in the cell as INSTALLED");
                     }
                     actions.add("install " + c.name());
+                    newComponents.add(c.name());
                 }
             }
             for (Jar j : jars) {
@@ -227,10 +264,24 @@ public final class DeploymentSets {
                     actions.add(e.updateAction());
                 }
             }
+            changes.forEach(e -> actions.add(e.action()));
+            DeploymentUndo.Done done = done(installed, newComponents, jars, changes);
+            handedOver[0] = true;
             ChangeSetDTO r = changeSets.apply(actions);
             text.append(r.text);
             if (!r.applied) {
                 return undone(url, text, installed, r.refusal == null ? "not applied" : r.refusal);
+            }
+            List<String> back = DeploymentUndo.notHeld(r.text, done.updated());
+            if (!back.isEmpty()) {
+                String why = undo.takeBack(url, text, done, back);
+                ChangeSetDTO dto = refused(url, text, why);
+                dto.actions = actions.toArray(String[]::new);
+                dto.admitted = true;
+                dto.applied = true;
+                dto.prepareMs = r.prepareMs;
+                dto.switchUs = r.switchUs;
+                return dto;
             }
             ChangeSetDTO dto = dto(url, text.toString());
             dto.actions = actions.toArray(String[]::new);
@@ -245,6 +296,23 @@ public final class DeploymentSets {
         } finally {
             keys.forEach(held::remove);
         }
+    }
+
+    /** What the set will change, for {@link DeploymentUndo}: the old values of its writes read now. */
+    private DeploymentUndo.Done done(List<Bundle> installed, List<String> newComponents, List<Jar> jars,
+                                     List<DeploymentDescriptor.Entry> changes) {
+        List<String> updated = jars.stream().filter(j -> j.version() != null).map(j -> j.entry().component()).toList();
+        List<String> uninstalled = changes.stream().filter(e -> e.kind() == DeploymentDescriptor.Kind.UNINSTALL)
+                .map(DeploymentDescriptor.Entry::component).toList();
+        Map<String, String> old = new LinkedHashMap<>();
+        for (DeploymentDescriptor.Entry e : changes) {
+            if (e.kind() == DeploymentDescriptor.Kind.SET && !newComponents.contains(e.component())
+                    && !updated.contains(e.component())) {
+                old.put(e.component() + " " + e.parameter(), cell.actor().call(() -> cell.getParam(e.component(),
+                        e.parameter()), Services.CALL_MS));
+            }
+        }
+        return new DeploymentUndo.Done(List.copyOf(installed), List.copyOf(newComponents), uninstalled, updated, old);
     }
 
     /** Reads and gates one jar; an update's through {@link #updates}, which also reads its contract. */
@@ -286,9 +354,14 @@ public final class DeploymentSets {
     }
 
     /** Why the set does not fit the cell or Felix as they are, or null. */
-    private String misfit(List<Jar> jars) {
+    private String misfit(List<Jar> jars, List<DeploymentDescriptor.Entry> changes) {
         List<String> problems = new ArrayList<>();
         Set<String> named = new LinkedHashSet<>();
+        List<String> uninstalled = changes.stream().filter(e -> e.kind() == DeploymentDescriptor.Kind.UNINSTALL)
+                .map(DeploymentDescriptor.Entry::component).toList();
+        for (String n : uninstalled) {
+            problems.addAll(uninstallMisfit(n, uninstalled));
+        }
         for (Jar j : jars) {
             for (Contract c : j.contracts()) {
                 if (!named.add(c.name())) {
@@ -325,8 +398,28 @@ public final class DeploymentSets {
         return problems.isEmpty() ? null : String.join("; ", problems);
     }
 
+    /**
+     * An uninstall's bundle stops when the set is applied (as in arflex:change): it may carry no
+     * component the set does not uninstall too.
+     */
+    private List<String> uninstallMisfit(String n, List<String> uninstalled) {
+        Long bundle = cell.actor().call(() -> cell.instance(n).map(i -> i.bundleId).orElse(null), Services.CALL_MS);
+        if (bundle == null || context == null) {
+            return List.of(); // not running: DeploymentChanges says so
+        }
+        List<String> others = cell.actor().call(() -> cell.namesOfBundle(bundle), Services.CALL_MS).stream()
+                .filter(o -> !uninstalled.contains(o)).toList();
+        return others.isEmpty() ? List.of() : List.of("uninstall " + n + ": its bundle " + bundle + " also carries "
+                + others + ", which the set does not uninstall");
+    }
+
     /** The change-set rules (D35) on the planner's dry run: why the set would not be admitted, or null. */
     static String admission(Plan plan, List<Contract> installs, List<Contract> updates) {
+        return admission(plan, installs, updates, Set.of());
+    }
+
+    /** As above; a component the set uninstalls may stop. */
+    static String admission(Plan plan, List<Contract> installs, List<Contract> updates, Set<String> uninstalls) {
         List<String> refused = new ArrayList<>();
         Set<String> updated = new LinkedHashSet<>();
         updates.forEach(c -> updated.add(c.name()));
@@ -341,7 +434,11 @@ public final class DeploymentSets {
         }
         for (Plan.Action a : plan.actions()) {
             switch (a.op()) {
-                case STOP -> refused.add("the set would stop '" + a.component() + "' (" + a.reason() + ")");
+                case STOP -> {
+                    if (!uninstalls.contains(a.component())) {
+                        refused.add("the set would stop '" + a.component() + "' (" + a.reason() + ")");
+                    }
+                }
                 case RESTART -> {
                     if (!updated.contains(a.component())) {
                         refused.add("the set would restart '" + a.component() + "' (" + a.reason()
@@ -359,21 +456,7 @@ public final class DeploymentSets {
 
     /** Uninstalls what the set installed in Felix, and says so. */
     private ChangeSetDTO undone(String url, StringBuilder text, List<Bundle> installed, String why) {
-        List<String> gone = new ArrayList<>();
-        for (Bundle b : installed) {
-            try {
-                b.uninstall();
-                gone.add("bundle " + b.getBundleId() + " (" + b.getLocation() + ")");
-            } catch (BundleException | IllegalStateException e) {
-                String p = "deployment set " + url + ": bundle " + b.getBundleId() + " could not be uninstalled again: "
-                        + e.getMessage();
-                log.accept("arflex: " + p);
-                text.append("warning: ").append(p).append('\n');
-            }
-        }
-        if (!gone.isEmpty()) {
-            text.append("uninstalled again: ").append(String.join(", ", gone)).append('\n');
-        }
+        undo.uninstall(url, text, installed);
         return refused(url, text, why);
     }
 

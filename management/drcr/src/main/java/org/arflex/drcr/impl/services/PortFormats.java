@@ -35,7 +35,7 @@ import org.arflex.planner.Wire;
  * running consumer that names one of its outputs explicitly reads that output's format.</li>
  * </ul>
  * The peers are taken as they will be after the set (a peer updated by the same set with its
- * new contract). Pure: no cell, no I/O.
+ * new contract; a component the set uninstalls is no peer, D50). Pure: no cell, no I/O.
  */
 public final class PortFormats {
 
@@ -55,8 +55,17 @@ public final class PortFormats {
      * @param updates  the new contracts of the components the set updates
      */
     public List<String> check(List<Contract> running, List<Wire> wires, List<Contract> installs, List<Contract> updates) {
+        return check(running, wires, installs, updates, java.util.Set.of());
+    }
+
+    /**
+     * As {@link #check(List, List, List, List)}, with the components the set uninstalls: they are
+     * no peers after the set (their wires go, no new input may name them).
+     */
+    public List<String> check(List<Contract> running, List<Wire> wires, List<Contract> installs, List<Contract> updates,
+                              java.util.Set<String> uninstalls) {
         Map<String, Contract> after = new LinkedHashMap<>();
-        running.forEach(c -> after.put(c.name(), c));
+        running.stream().filter(c -> !uninstalls.contains(c.name())).forEach(c -> after.put(c.name(), c));
         updates.forEach(c -> after.put(c.name(), c));
         installs.forEach(c -> after.put(c.name(), c));
         Map<String, Contract> updated = new LinkedHashMap<>();
@@ -100,7 +109,7 @@ public final class PortFormats {
         }
         for (Contract n : installs) {
             for (PortSpec in : n.inputs()) {
-                problems.addAll(input(n, in, after));
+                problems.addAll(input(n, in, after, uninstalls));
             }
             for (PortSpec out : n.outputs()) {
                 for (Contract c : after.values()) {
@@ -120,13 +129,16 @@ public final class PortFormats {
     }
 
     /** A new component's input against the providers it can be bound to. */
-    private List<String> input(Contract n, PortSpec in, Map<String, Contract> after) {
+    private List<String> input(Contract n, PortSpec in, Map<String, Contract> after, java.util.Set<String> uninstalls) {
         String head = "install " + n.name() + " " + n.version() + ": input '" + in.name() + "' (" + format(in) + ")";
         Optional<Binding> b = in.binding();
         if (b.isPresent() && b.get().component().isPresent()) {
             String peer = b.get().component().get();
             String port = b.get().port().orElse("");
             Contract p = after.get(peer);
+            if (p == null && uninstalls.contains(peer)) {
+                return List.of(head + " names its peer " + peer + "." + port + ", but the set uninstalls " + peer);
+            }
             if (p == null) {
                 return List.of(); // not in the cell: the planner says so
             }

@@ -8,7 +8,6 @@ import java.security.NoSuchAlgorithmException;
 import java.util.ArrayList;
 import java.util.HashMap;
 import java.util.HexFormat;
-import java.util.Hashtable;
 import java.util.List;
 import java.util.Map;
 import java.util.Optional;
@@ -33,11 +32,10 @@ import org.arflex.planner.Change;
 import org.osgi.framework.Bundle;
 import org.osgi.framework.BundleContext;
 import org.osgi.framework.BundleException;
-import org.osgi.framework.ServiceRegistration;
 
 /**
- * The DRCR's services: the read-only {@link DrcrService}, the {@link UpdateService}, and the
- * registrations of one {@link ComponentManagement} per instance, kept in step with the cell.
+ * The DRCR's services: the read-only {@link DrcrService} and the {@link UpdateService} (the
+ * registrations of one {@link ComponentManagement} per instance: {@link ManagementRegistrations}).
  */
 public final class Services implements DrcrService, UpdateService {
 
@@ -50,9 +48,6 @@ public final class Services implements DrcrService, UpdateService {
     private final BundleContext context;
     private final Consumer<String> log;
     private final CodeGate gate;
-    private final Map<String, ServiceRegistration<ComponentManagement>> regs = new HashMap<>();
-    /** The state each registration's {@link ComponentManagement#STATE_PROPERTY} shows. */
-    private final Map<String, String> states = new HashMap<>();
 
     public Services(Cell cell, ResourceManagerImpl resources, ContractReader reader, BundleContext context,
                     CodeGate gate, Consumer<String> log) {
@@ -62,61 +57,6 @@ public final class Services implements DrcrService, UpdateService {
         this.reader = reader;
         this.context = context;
         this.log = log;
-    }
-
-    // ---- per-instance registrations ---------------------------------------------------------
-
-    /**
-     * Brings the ComponentManagement registrations in line with the cell, their state property
-     * included (actor thread).
-     */
-    public void sync() {
-        if (context == null) {
-            return;
-        }
-        List<String> names = cell.names();
-        for (String n : List.copyOf(regs.keySet())) {
-            if (!names.contains(n)) {
-                unregister(regs.remove(n));
-                states.remove(n);
-            }
-        }
-        for (String n : names) {
-            String state = cell.state(n);
-            if (regs.containsKey(n) && state.equals(states.get(n))) {
-                continue;
-            }
-            Hashtable<String, Object> props = new Hashtable<>();
-            props.put(ComponentManagement.COMPONENT_PROPERTY, n);
-            props.put(ComponentManagement.STATE_PROPERTY, state);
-            try {
-                if (regs.containsKey(n)) {
-                    regs.get(n).setProperties(props);
-                } else {
-                    regs.put(n, context.registerService(ComponentManagement.class, new ComponentManagementImpl(n, cell), props));
-                }
-                states.put(n, state);
-            } catch (IllegalStateException e) {
-                return; // the DRCR bundle is stopping
-            }
-        }
-    }
-
-    /** Unregisters every ComponentManagement service. */
-    public void unregisterAll() {
-        for (var r : regs.values()) {
-            unregister(r);
-        }
-        regs.clear();
-        states.clear();
-    }
-
-    private static void unregister(ServiceRegistration<?> r) {
-        try {
-            r.unregister();
-        } catch (IllegalStateException ignored) {
-            // already gone with the bundle
-        }
     }
 
     /** The management service of one instance (for the shell, without a registry lookup). */

@@ -150,6 +150,43 @@ class CellStateTransferTest {
         rig.stepUntil("the verdict", () -> r.verdict().isDone());
     }
 
+    /**
+     * D52: a running version that awaits an operator reset (a latched stop: RESET_REQUIRED on its
+     * control block) and declares no state would hand the new half nothing, so the new half
+     * would start without the stop: refused by the plan, nothing launched. With a state block
+     * the latch goes over with it (the adopt hook's part) and the update is admitted.
+     */
+    @Test
+    void aLatchedRunningHalfWithoutStateIsNotUpdatedWithStateItIs() throws Exception {
+        runningCell("");
+        fake.running.get("stage").flags = ControlBlock.FLAG_RESET_REQUIRED;
+        int before = fake.events.size();
+        ChangeSetResult r = apply(update(TRAJ));
+        assertFalse(r.applied(), r.text());
+        assertTrue(r.refusal().contains("update stage file:/x/stage-1.1.jar: 'stage' awaits an operator reset and its "
+                + "running version 1.0.0 hands over no state block: a new half would start without the stop; reset it "
+                + "first, or update it outside a change set"), r.text());
+        assertEquals(before, fake.events.size(), "nothing launched, created or bound: " + fake.events);
+        fake.running.get("stage").flags = 0;
+        ChangeSetResult ok = apply(update(TRAJ));
+        assertTrue(ok.applied(), "once reset it may be updated: " + ok.text());
+        fake.running.get("1-stage").stats = new ControlBlock.Stats(100, 0, 0, 0, 0, 0, 0, 0, 0, 0);
+        watch();
+        rig.stepUntil("the verdict", () -> ok.verdict().isDone());
+    }
+
+    @Test
+    void aLatchedRunningHalfWithStateIsUpdatedAndToldItsState() throws Exception {
+        runningCell(TRAJ);
+        fake.running.get("stage").flags = ControlBlock.FLAG_RESET_REQUIRED;
+        ChangeSetResult r = apply(update(TRAJ));
+        assertTrue(r.applied(), r.text());
+        index("1-stage ADOPT /arflex.t.stage.state");
+        fake.running.get("1-stage").stats = new ControlBlock.Stats(100, 0, 0, 0, 0, 0, 0, 0, 0, 0);
+        watch();
+        rig.stepUntil("the verdict", () -> r.verdict().isDone());
+    }
+
     private static final String IN_GUARD = "<in name=\"safety\" type=\"arflex.SafetyState\" typeVersion=\"1.0\" "
             + "method=\"state\" safety=\"true\"><bind filter=\"(role=guard)\"/></in>";
     private static final String OUT_SAFETY = "<out name=\"safety\" type=\"arflex.SafetyState\" typeVersion=\"1.0\" "

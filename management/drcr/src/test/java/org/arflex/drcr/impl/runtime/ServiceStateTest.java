@@ -15,9 +15,7 @@ import org.arflex.contract.ContractParser;
 import org.arflex.contract.PortTypes;
 import org.arflex.drcr.ComponentManagement;
 import org.arflex.drcr.impl.lifecycle.ManualActor;
-import org.arflex.drcr.impl.services.CodeGate;
-import org.arflex.drcr.impl.services.ResourceManagerImpl;
-import org.arflex.drcr.impl.services.Services;
+import org.arflex.drcr.impl.services.ManagementRegistrations;
 import org.arflex.planner.Capacities;
 import org.arflex.planner.Planner;
 import org.junit.jupiter.api.Test;
@@ -103,8 +101,7 @@ class ServiceStateTest {
     void theStatePropertyFollowsTheInstance() throws Exception {
         Cell cell = new Cell(new Cell.Config("t", 1000, 1000, true, PortTypes.builtin(), () -> 1_000_000_000L, false),
                 actor, launcher, new Planner(Capacities.of(2, 1.0, 1L << 30, 1_000_000_000L)), log::add);
-        Services services = new Services(cell, new ResourceManagerImpl(cell, 1.0), new ContractReader(PortTypes.builtin()),
-                context(), new CodeGate(List.of(), log::add), log::add);
+        ManagementRegistrations services = new ManagementRegistrations(cell, context(), Runnable::run);
         cell.onChange(services::sync);
 
         install(cell, CONSUMER);
@@ -129,10 +126,37 @@ class ServiceStateTest {
         assertTrue(events.contains("UNREGISTERING prov"), events.toString());
         actor.call(() -> {
             cell.shutdownAll("test end");
-            services.unregisterAll();
+            services.close();
             return null;
         }, 0);
         actor.runAll();
         assertEquals(Map.of(), registry);
+    }
+
+    @Test
+    void registrationsAreMadeOnTheRegistrarNotOnTheActorAndOnlyTheNewestPictureIsApplied() throws Exception {
+        Cell cell = new Cell(new Cell.Config("t", 1000, 1000, true, PortTypes.builtin(), () -> 1_000_000_000L, false),
+                actor, launcher, new Planner(Capacities.of(2, 1.0, 1L << 30, 1_000_000_000L)), log::add);
+        List<Runnable> registrar = new ArrayList<>();
+        ManagementRegistrations services = new ManagementRegistrations(cell, context(), registrar::add);
+        cell.onChange(services::sync);
+
+        install(cell, CONSUMER); // UNSATISFIED
+        install(cell, PROVIDER); // then both ACTIVE: several changes on the actor
+        assertEquals(Map.of(), registry, "the actor registered nothing itself: " + events);
+        assertEquals(1, registrar.size(), "pictures taken while one waits are coalesced");
+        registrar.remove(0).run();
+        assertEquals("ACTIVE", state("prov"), events.toString());
+        assertEquals("ACTIVE", state("cons"), events.toString());
+        assertEquals(List.of("REGISTERED", "REGISTERED"), events.stream().map(e -> e.split(" ")[0]).toList(),
+                "the newest picture only, nothing of the states in between: " + events);
+
+        // the DRCR stops: the registrar has ended, the actor closes; later changes register nothing
+        services.close();
+        assertEquals(Map.of(), registry);
+        actor.call(() -> cell.uninstall("prov", "bundle stopped"), 0);
+        actor.runAll();
+        registrar.forEach(Runnable::run);
+        assertEquals(Map.of(), registry, events.toString());
     }
 }

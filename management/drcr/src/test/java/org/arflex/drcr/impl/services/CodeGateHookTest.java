@@ -58,4 +58,32 @@ class CodeGateHookTest {
         hook.begin(List.of()).filterResolvable(new ArrayList<>(List.of(fromCell, fromWeb)));
         assertEquals(lines, log.stream().filter(l -> l.contains("code gate: bundle")).count());
     }
+
+    /**
+     * A bundle judged while its install is still under way cannot be read yet: that verdict is
+     * not kept for its revision (the resolve that follows judges the readable content). It was
+     * kept: the refusal's text did not carry the marker the hook looks for, and a verified
+     * bundle stayed unresolvable ("Resolver hook prevented resolution").
+     */
+    @Test
+    void aVerdictOnContentNotYetReadableIsNotKept(@TempDir Path dir) throws Exception {
+        Path cell = Files.createDirectories(dir.resolve("cell"));
+        CodeGate gate = new CodeGate(List.of(cell), null, log::add);
+        CodeGateHook hook = new CodeGateHook(gate);
+        byte[] jar = CodeGateTest.jar("good", false);
+        gate.verified(jar, "a console upload, sha256 pinned"); // installed from outside the trusted folders
+        Bundle readable = SignedCodeGateTest.installed(dir.resolve("felix-cache/upload.jar").toUri().toString(), jar);
+        int[] reads = {0};
+        Bundle settling = (Bundle) Proxy.newProxyInstance(Bundle.class.getClassLoader(), new Class<?>[] {Bundle.class},
+                (proxy, m, args) -> {
+                    if (m.getName().equals("getEntryPaths") && reads[0]++ == 0) {
+                        throw new IllegalStateException("No bundle associated with resource");
+                    }
+                    return m.invoke(readable, args);
+                });
+        BundleRevision r = revision(settling);
+        assertNull(hook.refusal(r), String.join("\n", log));
+        assertTrue(log.stream().anyMatch(l -> l.contains("refused") && l.contains("(unreadable: No bundle associated")),
+                "the first verdict names why it refused: " + log);
+    }
 }

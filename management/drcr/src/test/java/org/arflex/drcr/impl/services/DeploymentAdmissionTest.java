@@ -63,4 +63,19 @@ class DeploymentAdmissionTest {
         String why = admission(List.of(), List.of(corr));
         assertTrue(why != null && why.startsWith("the set would stop 'robot' ("), why);
     }
+
+    @Test
+    void aComponentTheSetUninstallsMayStopAndItsConsumersMayNot() throws Exception {
+        Contract mon = PortFormatsTest.contract("mon", "1.0.0", null, "<in name=\"ref\" type=\"arflex.JointRef\" "
+                + "typeVersion=\"1.0\" method=\"state\"><bind component=\"corr\" port=\"corrected\"/></in>");
+        planner.apply(Change.install(mon));
+        Plan p = planner.plan(Change.builder().uninstall("mon").build());
+        assertNull(DeploymentSets.admission(p, List.of(), List.of(), java.util.Set.of("mon")));
+        assertTrue(DeploymentSets.admission(p, List.of(), List.of()).startsWith("the set would stop 'mon'"),
+                "without the uninstall named, the stop is refused");
+        // uninstalling corr would stop robot (and mon), which the set does not name
+        Plan q = planner.plan(Change.builder().uninstall("corr").build());
+        String why = DeploymentSets.admission(q, List.of(), List.of(), java.util.Set.of("corr"));
+        assertTrue(why != null && why.contains("the set would stop 'robot'") && !why.contains("stop 'corr'"), why);
+    }
 }

@@ -89,7 +89,8 @@ class DeploymentDescriptorTest {
                 + "urn:arflex:deployment:1 (it is in no namespace)"), ns);
         assertTrue(errorOf("<set xmlns=\"urn:arflex:deployment:1\"/>")
                 .endsWith("<set>: the root element must be <deployment>"));
-        assertEquals("file:/srv/sets/cell-2.xml: <deployment>: names no bundle (an <install> or <update> element)",
+        assertEquals("file:/srv/sets/cell-2.xml: <deployment>: names no action (an <install>, <update>, <uninstall> or <set> "
+                + "element)",
                 errorOf(HEAD + "</deployment>"));
         assertTrue(errorOf(HEAD.replace("cell-2", "cell 2") + "</deployment>")
                 .endsWith("<deployment>: name 'cell 2' is not a set name ([A-Za-z0-9][A-Za-z0-9._-]{0,63})"));
@@ -99,9 +100,10 @@ class DeploymentDescriptorTest {
 
     @Test
     void unknownElementsAttributesAndTextAreRefusedWithTheirLine() {
-        String unknown = error("<uninstall component=\"trajectory\"/>");
-        assertTrue(unknown.startsWith("file:/srv/sets/cell-2.xml:2:") && unknown.endsWith("<uninstall>: unknown element in "
-                + "<deployment> (expected <install> or <update> in namespace urn:arflex:deployment:1)"), unknown);
+        String unknown = error("<stop component=\"trajectory\"/>");
+        assertTrue(unknown.startsWith("file:/srv/sets/cell-2.xml:2:") && unknown.endsWith("<stop>: unknown element in "
+                + "<deployment> (expected <install>, <update>, <uninstall> or <set> in namespace urn:arflex:deployment:1)"),
+                unknown);
         assertTrue(error("<x:install xmlns:x=\"urn:other\" jar=\"a.jar\" signed=\"true\"/>")
                 .contains("<install>: unknown element in <deployment>"));
         assertTrue(error("<install jar=\"a.jar\" signed=\"true\" start=\"true\"/>")
@@ -188,7 +190,7 @@ class DeploymentDescriptorTest {
                 .endsWith("<tolerance>: unknown attribute 'min' (allowed: field, max, port)"));
         String twice = error("<update component=\"c\" jar=\"c1.jar\" signed=\"true\"/>\n"
                 + "<update component=\"c\" jar=\"c2.jar\" signed=\"true\"/>");
-        assertEquals("file:/srv/sets/cell-2.xml:3: <update>: component 'c' is updated twice in the set", twice);
+        assertEquals("file:/srv/sets/cell-2.xml:3: <update>: component 'c' is named twice in the set (also <update> on line 2)", twice);
     }
 
     @Test
@@ -198,6 +200,63 @@ class DeploymentDescriptorTest {
             sb.append("<install jar=\"b").append(i).append(".jar\" signed=\"true\"/>\n");
         }
         String e = error(sb.toString());
-        assertTrue(e.startsWith("file:/srv/sets/cell-2.xml:66:") && e.endsWith("<install>: more than 64 bundles in one set"), e);
+        assertTrue(e.startsWith("file:/srv/sets/cell-2.xml:66:") && e.endsWith("<install>: more than 64 actions in one set"), e);
+    }
+
+    @Test
+    void readsUninstallsAndParameterWritesAsChangeSetActions() {
+        DeploymentDescriptor d = parse(HEAD
+                + "  <install jar=\"tool-gripper.jar\" sha256=\"" + SHA + "\"/>\n"
+                + "  <uninstall component=\"teach\"/>\n"
+                + "  <set component=\"tcp-correction\" parameter=\"gain\" value=\"0.5\"/>\n"
+                + "  <set component=\"tcp-correction\" parameter=\"enable\" value=\"false\"></set>\n"
+                + "</deployment>\n");
+        assertEquals(4, d.entries().size());
+        assertEquals(1, d.bundles().size());
+        List<DeploymentDescriptor.Entry> c = d.changes();
+        assertEquals(List.of("uninstall teach", "set tcp-correction gain 0.5", "set tcp-correction enable false"),
+                c.stream().map(DeploymentDescriptor.Entry::action).toList());
+        assertEquals(List.of(3, 4, 5), c.stream().map(DeploymentDescriptor.Entry::line).toList());
+        assertEquals(DeploymentDescriptor.Kind.UNINSTALL, c.get(0).kind());
+        assertNull(c.get(0).jar());
+        // what ChangeSets reads back is what the descriptor says
+        List<String[]> parsed = ChangeSets.parse(c.stream().map(DeploymentDescriptor.Entry::action).toList());
+        assertEquals(List.of("uninstall teach", "set tcp-correction gain 0.5", "set tcp-correction enable false"),
+                parsed.stream().map(a -> String.join(" ", a)).toList());
+        // a set of changes only, without a jar
+        assertEquals(1, parse(HEAD + "<uninstall component=\"teach\"/></deployment>").entries().size());
+    }
+
+    @Test
+    void everyBadUninstallOrWriteIsNamedWithItsLine() {
+        String u = error("<uninstall/>");
+        assertTrue(u.matches("file:/srv/sets/cell-2.xml:2:\\d+: <uninstall>: attribute 'component' is required "
+                + "\\(the running component it stops and removes\\)"), u);
+        assertTrue(error("<uninstall component=\"teach\" jar=\"a.jar\"/>")
+                .matches("file:/srv/sets/cell-2.xml:2:\\d+: <uninstall>: unknown attribute 'jar' \\(allowed: component\\)"));
+        assertTrue(error("<uninstall component=\"Teach\"/>")
+                .endsWith("<uninstall>: component 'Teach' is not a component name ([a-z][a-z0-9-]{0,47})"));
+        assertTrue(error("<uninstall component=\"teach\"><envelope/></uninstall>")
+                .endsWith("<envelope>: <uninstall> has no child elements"));
+        assertTrue(error("<uninstall component=\"teach\">now</uninstall>").endsWith("<uninstall>: text 'now' is not allowed here"));
+        String s = error("\n\n<set component=\"c\" parameter=\"gain\"/>");
+        assertTrue(s.matches("file:/srv/sets/cell-2.xml:4:\\d+: <set>: attribute 'value' is required"), s);
+        assertTrue(error("<set component=\"c\" value=\"1\"/>").endsWith("<set>: attribute 'parameter' is required"));
+        assertTrue(error("<set parameter=\"gain\" value=\"1\"/>").endsWith("<set>: attribute 'component' is required "
+                + "(the component whose parameter it writes)"));
+        assertTrue(error("<set component=\"c\" parameter=\"Gain\" value=\"1\"/>")
+                .endsWith("<set>: parameter 'Gain' is not a parameter name ([a-z][a-z0-9_.]{0,30})"));
+        for (String v : new String[] {"1 2", "1;uninstall x", "1,2", "", "\u00e9", "x".repeat(65)}) {
+            assertTrue(error("<set component=\"c\" parameter=\"gain\" value=\"" + v + "\"/>")
+                    .endsWith("<set>: value '" + v + "': 1 to 64 printable characters without blanks, ';' or ','"), v);
+        }
+        assertTrue(error("<set component=\"c\" parameter=\"gain\" value=\"1\" unit=\"1\"/>")
+                .endsWith("<set>: unknown attribute 'unit' (allowed: component, parameter, value)"));
+        assertEquals("file:/srv/sets/cell-2.xml:3: <set>: parameter c.gain is written twice in the set",
+                error("<set component=\"c\" parameter=\"gain\" value=\"1\"/>\n<set component=\"c\" parameter=\"gain\" value=\"2\"/>"));
+        assertEquals("file:/srv/sets/cell-2.xml:3: <uninstall>: component 'c' is named twice in the set (also <update> on line 2)",
+                error("<update component=\"c\" jar=\"c1.jar\" signed=\"true\"/>\n<uninstall component=\"c\"/>"));
+        assertTrue(error("<remove component=\"c\"/>").endsWith("<remove>: unknown element in <deployment> (expected "
+                + "<install>, <update>, <uninstall> or <set> in namespace urn:arflex:deployment:1)"));
     }
 }

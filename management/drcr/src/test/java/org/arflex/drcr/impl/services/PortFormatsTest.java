@@ -1,6 +1,7 @@
 package org.arflex.drcr.impl.services;
 
 import static org.junit.jupiter.api.Assertions.assertEquals;
+import static org.junit.jupiter.api.Assertions.assertTrue;
 
 import java.util.List;
 import org.arflex.contract.Contract;
@@ -150,5 +151,28 @@ class PortFormatsTest {
         assertEquals(List.of("install gauge 1.0.0: output 'value' is arflex.Sample 1.0 stream, but its peer panel.t names "
                 + "it and reads arflex.Sample 1.0 state (method stream is not state)"),
                 formats.check(List.of(traj, corr, robot, waiting), wires, List.of(gauge), List.of()));
+    }
+
+    @Test
+    void aComponentTheSetUninstallsIsNoPeer() throws Exception {
+        // corr 2.0.0 writes a stream, but its only reader, robot, is uninstalled by the same set
+        Contract stream = contract("corr", "2.0.0", "correction", REF_IN
+                + "<out name=\"corrected\" type=\"arflex.JointRef\" typeVersion=\"1.0\" method=\"stream\" depth=\"8\"/>");
+        assertEquals(1, check(List.of(), List.of(stream)).size(), "refused while robot reads it");
+        assertEquals(List.of(), formats.check(List.of(traj, corr, robot), wires, List.of(), List.of(stream),
+                java.util.Set.of("robot")));
+        // a new component naming an uninstalled peer is told so
+        Contract mon = contract("mon", "1.0.0", null, "<in name=\"ref\" type=\"arflex.JointRef\" typeVersion=\"1.0\" "
+                + "method=\"state\"><bind component=\"corr\" port=\"corrected\"/></in>");
+        assertEquals(List.of(), check(List.of(mon), List.of()));
+        assertEquals(List.of("install mon 1.0.0: input 'ref' (arflex.JointRef 1.0 state) names its peer corr.corrected, "
+                + "but the set uninstalls corr"), formats.check(List.of(traj, corr, robot), wires, List.of(mon), List.of(),
+                java.util.Set.of("corr")));
+        // a required input by type: an uninstalled provider in another format is not listed as a peer
+        Contract byType = contract("mon", "1.0.0", null, "<in name=\"ref\" type=\"arflex.JointRef\" typeVersion=\"1.0\" "
+                + "method=\"stream\"/>");
+        List<String> p = formats.check(List.of(traj, corr, robot), wires, List.of(byType), List.of(), java.util.Set.of("corr"));
+        assertEquals(1, p.size(), p::toString);
+        assertTrue(p.get(0).contains("traj.joint_ref writes") && !p.get(0).contains("corr.corrected"), p.get(0));
     }
 }
