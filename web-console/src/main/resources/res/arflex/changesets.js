@@ -57,10 +57,17 @@
       (p.wiring || []).length ? el('div', {}, el('h4', {}, 'Wiring after the set'),
         el('ul', {id: prefix + '-wiring'}, p.wiring.map(w => el('li', {}, w)))) : '',
       (p.cpus || []).length ? el('div', {}, el('h4', {}, 'Admission per CPU'),
-        table(prefix + '-cpus', ['cpu', 'utilisation', 'cap', 'test', 'tasks'], p.cpus.map(c =>
-          el('tr', {'data-cpu': c.cpu, class: c.utilisation > c.cap ? 'arflex-bad' : ''},
-            el('td', {}, c.cpu), el('td', {}, c.utilisation.toFixed(2)), el('td', {}, c.cap.toFixed(2)),
-            el('td', {}, c.test), el('td', {}, (c.tasks || []).join(', ')))), '')) : '',
+        table(prefix + '-cpus', ['cpu', 'utilisation', 'cap', 'test', 'tasks', 'while both halves of an update run'],
+          p.cpus.map(c =>
+            el('tr', {'data-cpu': c.cpu, class: c.utilisation > c.cap
+                || (c.transient || []).some(t => t.test === 'not schedulable') ? 'arflex-bad' : ''},
+              el('td', {}, c.cpu), el('td', {}, c.utilisation.toFixed(2)), el('td', {}, c.cap.toFixed(2)),
+              el('td', {}, c.test), el('td', {}, (c.tasks || []).join(', ')),
+              el('td', {}, (c.transient || []).map(t => el('div', {'data-phase': t.phase},
+                t.phase + ' (' + t.cycles + ' cycles): U=' + t.utilisation.toFixed(2) + ', ' + t.test
+                + ' (' + (t.tasks || []).join(', ') + ')'))))), ''),
+          (p.transientRefusals || []).length ? el('ul', {id: prefix + '-transient-refusals', class: 'arflex-bad'},
+            p.transientRefusals.map(r => el('li', {}, r))) : '') : '',
       p.memory ? el('p', {}, 'Memory: ', p.memory) : '',
       (p.notActive || []).length ? el('div', {}, el('h4', {}, 'Not active after the set'),
         table(prefix + '-inactive', ['component', 'why'], p.notActive.map(n =>

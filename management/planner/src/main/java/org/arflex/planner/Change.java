@@ -38,6 +38,29 @@ public final class Change {
     private final SortedMap<String, Long> measuredWcetNs;
     private final SortedMap<String, String> blocks;
     private final SortedSet<String> unblocks;
+    private final SortedMap<String, Overlap> overlaps;
+
+    /**
+     * An update whose old and new RT halves run side by side for a while (docs/DECISIONS.md D51):
+     * a change set's update runs its new half in a shadow run before the switch (D42) and keeps
+     * the old half running for a rollback window after it (D38). The plan then counts both halves
+     * on their CPUs in each phase ({@link Plan#transients()}).
+     *
+     * @param component    the replaced component
+     * @param shadowCycles cycles of the shadow run, 0 for none
+     * @param windowCycles cycles of the rollback window, 0 for none
+     */
+    public record Overlap(String component, long shadowCycles, long windowCycles) {
+
+        /** @throws IllegalArgumentException naming the component when a number of cycles is negative */
+        public Overlap {
+            Objects.requireNonNull(component, "component");
+            if (shadowCycles < 0 || windowCycles < 0) {
+                throw new IllegalArgumentException("overlap '" + component + "': cycles must not be negative (shadow "
+                        + shadowCycles + ", window " + windowCycles + ")");
+            }
+        }
+    }
 
     private Change(Builder b) {
         installs = List.copyOf(b.installs);
@@ -48,6 +71,7 @@ public final class Change {
         measuredWcetNs = Collections.unmodifiableSortedMap(new TreeMap<>(b.measuredWcetNs));
         blocks = Collections.unmodifiableSortedMap(new TreeMap<>(b.blocks));
         unblocks = Collections.unmodifiableSortedSet(new TreeSet<>(b.unblocks));
+        overlaps = Collections.unmodifiableSortedMap(new TreeMap<>(b.overlaps));
     }
 
     /** The empty change: planning it reconciles the Active set with what should run. */
@@ -156,10 +180,19 @@ public final class Change {
         return unblocks;
     }
 
+    /**
+     * Replaced components whose old and new halves run side by side for a while, by name (a
+     * change set's update: D51). Empty for every other change.
+     */
+    public SortedMap<String, Overlap> overlaps() {
+        return overlaps;
+    }
+
     /** True when the change has no part at all. */
     public boolean isEmpty() {
         return installs.isEmpty() && replaces.isEmpty() && puts.isEmpty() && uninstalls.isEmpty()
-                && capacities.isEmpty() && measuredWcetNs.isEmpty() && blocks.isEmpty() && unblocks.isEmpty();
+                && capacities.isEmpty() && measuredWcetNs.isEmpty() && blocks.isEmpty() && unblocks.isEmpty()
+                && overlaps.isEmpty();
     }
 
     /**
@@ -192,6 +225,12 @@ public final class Change {
         if (!unblocks.isEmpty()) {
             parts.add("unblock " + String.join(", ", unblocks));
         }
+        if (!overlaps.isEmpty()) {
+            List<String> o = new ArrayList<>();
+            overlaps.values().forEach(v -> o.add(v.component() + " (shadow " + v.shadowCycles() + ", window "
+                    + v.windowCycles() + " cycles)"));
+            parts.add("both halves " + String.join(", ", o));
+        }
         return parts.isEmpty() ? "no change" : String.join("; ", parts);
     }
 
@@ -218,6 +257,7 @@ public final class Change {
         private final Map<String, Long> measuredWcetNs = new LinkedHashMap<>();
         private final Map<String, String> blocks = new LinkedHashMap<>();
         private final List<String> unblocks = new ArrayList<>();
+        private final Map<String, Overlap> overlaps = new LinkedHashMap<>();
 
         private Builder() {
         }
@@ -270,6 +310,20 @@ public final class Change {
         /** Unblocks a component. */
         public Builder unblock(String name) {
             unblocks.add(Objects.requireNonNull(name, "name"));
+            return this;
+        }
+
+        /**
+         * Says that the old and the new half of a component this change replaces run side by
+         * side: {@code shadowCycles} of the new one's shadow run before the switch, then
+         * {@code windowCycles} of the old one's rollback window after it (0: none). The plan
+         * counts both halves in each phase ({@link Plan#transients()}).
+         *
+         * @throws IllegalArgumentException naming the component when a number is negative
+         */
+        public Builder overlap(String component, long shadowCycles, long windowCycles) {
+            overlaps.put(Objects.requireNonNull(component, "component"),
+                    new Overlap(component, shadowCycles, windowCycles));
             return this;
         }
 

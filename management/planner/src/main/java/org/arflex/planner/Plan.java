@@ -71,9 +71,10 @@ public final class Plan {
     private final AdmissionResult admission;
     private final List<List<String>> cycles;
     private final List<String> notes;
+    private final List<TransientLoad> transients;
 
     /**
-     * Creates a plan; the {@link Planner} is its only intended author.
+     * Creates a plan without transient loads; the {@link Planner} is its only intended author.
      *
      * @param change        the change planned
      * @param title         one-line description with versions
@@ -92,6 +93,31 @@ public final class Plan {
             List<List<String>> startGroups, SortedSet<String> activeBefore, SortedSet<String> activeAfter,
             SortedMap<String, String> inactiveAfter, List<Wire> wiring, AdmissionResult admission,
             List<List<String>> cycles, List<String> notes) {
+        this(change, title, actions, stopOrder, startGroups, activeBefore, activeAfter, inactiveAfter, wiring, admission,
+                cycles, notes, List.of());
+    }
+
+    /**
+     * Creates a plan; the {@link Planner} is its only intended author.
+     *
+     * @param change        the change planned
+     * @param title         one-line description with versions
+     * @param actions       every action (any order; kept sorted by op, then name)
+     * @param stopOrder     names to stop, in execution order
+     * @param startGroups   groups of names to start, in execution order
+     * @param activeBefore  Active before the change
+     * @param activeAfter   Active after the change
+     * @param inactiveAfter installed but not Active after, with the reason
+     * @param wiring        wires between components Active after
+     * @param admission     the admission run behind this plan
+     * @param cycles        cycles of required inputs among the components Active after
+     * @param notes         remarks that are not actions (for example a measured WCET noted)
+     * @param transients    the loads while both halves of an update run (the change's overlaps)
+     */
+    public Plan(Change change, String title, List<Action> actions, List<String> stopOrder,
+            List<List<String>> startGroups, SortedSet<String> activeBefore, SortedSet<String> activeAfter,
+            SortedMap<String, String> inactiveAfter, List<Wire> wiring, AdmissionResult admission,
+            List<List<String>> cycles, List<String> notes, List<TransientLoad> transients) {
         this.change = change;
         this.title = title;
         List<Action> sorted = new ArrayList<>(actions);
@@ -114,6 +140,7 @@ public final class Plan {
         }
         this.cycles = List.copyOf(cyc);
         this.notes = List.copyOf(notes);
+        this.transients = List.copyOf(transients);
     }
 
     /** The wires sorted without duplicates; in one pass when they already are. */
@@ -245,6 +272,28 @@ public final class Plan {
         return notes;
     }
 
+    /**
+     * The CPU loads while both halves of an update run (docs/DECISIONS.md D51): the shadow phase,
+     * then the window phase, each only when the change's {@link Change#overlaps() overlaps} put a
+     * second half on some CPU in it. Empty for a change without overlaps.
+     */
+    public List<TransientLoad> transients() {
+        return transients;
+    }
+
+    /**
+     * Why a phase of {@link #transients()} is not schedulable, one sentence per CPU, naming the
+     * update, the phase, the CPU and the figures; empty when every phase fits. The final cell of
+     * the plan may be admitted all the same: whoever runs both halves refuses the change.
+     */
+    public List<String> transientRefusals() {
+        List<String> all = new ArrayList<>();
+        for (TransientLoad t : transients) {
+            all.addAll(t.refusals());
+        }
+        return Collections.unmodifiableList(all);
+    }
+
     /** True when the plan starts, stops and restarts nothing. */
     public boolean isEmpty() {
         return actions.isEmpty();
@@ -271,6 +320,11 @@ public final class Plan {
      * </pre>
      *
      * Sections {@code cycles:}, {@code not active:} and {@code notes:} appear only when not empty.
+     * When both halves of an update run for a while ({@link #transients()}), each CPU a second
+     * half runs on has one more line per phase under its own, for example
+     * {@code    shadow (200 cycles)  U=0.60/0.90  hyperbolic bound  sampler, sampler (new)}, and a
+     * phase that is not schedulable is said in a last section,
+     * {@code not schedulable while both halves run:}.
      * </pre>
      */
     public String toText() {
@@ -323,6 +377,17 @@ public final class Plan {
                     sb.append("  ").append(String.join(", ", l.tasks()));
                 }
                 sb.append('\n');
+                for (TransientLoad t : transients) {
+                    for (CpuLoad x : t.cpus()) {
+                        if (x.cpu() == l.cpu()) {
+                            sb.append("    ").append(t.phase().label()).append(" (").append(t.cycles())
+                                    .append(t.cycles() == 1 ? " cycle)" : " cycles)").append("  U=")
+                                    .append(Text.util(x.utilisation())).append('/').append(Text.util(x.utilisationCap()))
+                                    .append("  ").append(x.test()).append("  ").append(String.join(", ", x.tasks()))
+                                    .append('\n');
+                        }
+                    }
+                }
             }
         }
         Capacities caps = admission.capacities();
@@ -343,6 +408,13 @@ public final class Plan {
             sb.append("notes:\n");
             for (String n : notes) {
                 sb.append("  ").append(n).append('\n');
+            }
+        }
+        List<String> refusals = transientRefusals();
+        if (!refusals.isEmpty()) {
+            sb.append("not schedulable while both halves run:\n");
+            for (String r : refusals) {
+                sb.append("  ").append(r).append('\n');
             }
         }
         return sb.toString();

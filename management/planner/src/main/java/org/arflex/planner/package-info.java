@@ -20,7 +20,12 @@
  *
  * <p>1.0.0 (from 0.1.0): the engine types (Resolver, Admission, Schedulability, ResolveDelta,
  * Graphs, Text) left this package, and CpuAdmissionTest came in (docs/DECISIONS.md D18).
+ *
+ * <p>1.1.0 (additions): {@link org.arflex.planner.Change.Overlap} and
+ * {@code Change.Builder.overlap}, {@link org.arflex.planner.TransientLoad},
+ * {@code Plan.transients()}, {@code Plan.transientRefusals()} and the plan constructor that takes
+ * them: the load while both halves of a change set's update run (docs/DECISIONS.md D51).
  */
 @org.osgi.annotation.bundle.Export
-@org.osgi.annotation.versioning.Version("1.0.0")
+@org.osgi.annotation.versioning.Version("1.1.0")
 package org.arflex.planner;

@@ -12,7 +12,8 @@ import java.util.regex.Pattern;
  * read into the parts the Change sets page shows (D46): the outcome line, then the planner's
  * plan of the whole set (steps START/STOP/RESTART/REBIND/HOLD with their reasons, stop and
  * start order, wiring, the admission per CPU, memory and network, what is not active after and
- * why, notes), and the lines the apply added after the plan (bundles started or stopped, shadow
+ * why, notes; per CPU its load while both halves of an update run, in the shadow run and the
+ * rollback window, and why such a phase is not schedulable: D51), and the lines the apply added after the plan (bundles started or stopped, shadow
  * runs, the verdicts of update windows, warnings). A line it does not know is kept in
  * {@code after}, and the page shows the text as the DRCR wrote it beside the parts, so nothing
  * the DRCR says is lost to this reading.
@@ -20,6 +21,9 @@ import java.util.regex.Pattern;
 final class ChangeSetText {
     private static final Pattern STEP = Pattern.compile("^  (START|STOP|RESTART|REBIND|HOLD)\\s+(\\S+)\\s+(.*)$");
     private static final Pattern CPU = Pattern.compile("^  cpu (\\S+)\\s+U=([0-9.]+)/([0-9.]+)\\s+(.*?)(?:  (.*))?$");
+    /** A CPU's load while both halves of an update run, under its own line (D51). */
+    private static final Pattern TRANSIENT = Pattern.compile(
+            "^    (shadow|window) \\((\\d+) cycles?\\)\\s+U=([0-9.]+)/([0-9.]+)\\s+(.*?)(?:  (.*))?$");
     private static final Pattern NOT_ACTIVE = Pattern.compile("^  (\\S+)\\s+(.*)$");
 
     private ChangeSetText() {
@@ -36,6 +40,7 @@ final class ChangeSetText {
         List<Map<String, Object>> cpus = new ArrayList<>();
         List<Map<String, String>> notActive = new ArrayList<>();
         List<String> notes = new ArrayList<>();
+        List<String> transientRefusals = new ArrayList<>();
         List<String> after = new ArrayList<>();
         String stopOrder = null;
         String startOrder = null;
@@ -69,7 +74,20 @@ final class ChangeSetText {
                             c.put("cap", Double.parseDouble(m.group(3)));
                             c.put("test", m.group(4).strip());
                             c.put("tasks", m.group(5) == null ? List.of() : List.of(m.group(5).strip().split(", ")));
+                            c.put("transient", new ArrayList<Map<String, Object>>());
                             cpus.add(c);
+                        } else if ((m = TRANSIENT.matcher(line)).matches() && !cpus.isEmpty()) {
+                            Map<String, Object> t = new LinkedHashMap<>();
+                            t.put("phase", m.group(1));
+                            t.put("cycles", Long.parseLong(m.group(2)));
+                            t.put("utilisation", Double.parseDouble(m.group(3)));
+                            t.put("cap", Double.parseDouble(m.group(4)));
+                            t.put("test", m.group(5).strip());
+                            t.put("tasks", m.group(6) == null ? List.of() : List.of(m.group(6).strip().split(", ")));
+                            @SuppressWarnings("unchecked")
+                            List<Map<String, Object>> l = (List<Map<String, Object>>) cpus.get(cpus.size() - 1)
+                                    .get("transient");
+                            l.add(t);
                         } else {
                             after.add(line.strip());
                         }
@@ -81,6 +99,7 @@ final class ChangeSetText {
                         }
                     }
                     case "notes" -> notes.add(line.strip());
+                    case "not schedulable while both halves run" -> transientRefusals.add(line.strip());
                     default -> after.add(line.strip());
                 }
                 continue;
@@ -105,7 +124,8 @@ final class ChangeSetText {
                 startOrder = line.substring("start order: ".length());
                 plan.append(line).append('\n');
             } else if (inPlan && (line.startsWith("wiring:") || line.startsWith("cycles:") || line.startsWith("cpus:")
-                    || line.startsWith("not active:") || line.startsWith("notes:"))) {
+                    || line.startsWith("not active:") || line.startsWith("notes:")
+                    || line.startsWith("not schedulable while both halves run:"))) {
                 section = line.substring(0, line.indexOf(':'));
                 plan.append(line).append('\n');
             } else if (inPlan && line.startsWith("memory: ")) {
@@ -130,6 +150,7 @@ final class ChangeSetText {
         m.put("memory", memory);
         m.put("notActive", notActive);
         m.put("notes", notes);
+        m.put("transientRefusals", transientRefusals);
         m.put("after", after);
         m.put("planText", plan.toString());
         return m;

@@ -23,6 +23,7 @@ import org.arflex.planner.Change;
 import org.arflex.planner.CpuAdmissionTest;
 import org.arflex.planner.Plan;
 import org.arflex.planner.Satisfaction;
+import org.arflex.planner.TransientLoad;
 import org.arflex.planner.Wire;
 
 /**
@@ -216,6 +217,12 @@ public final class PlanEngine {
             }
             uninstalled.put(n, resolver.contract(n).get());
         }
+        for (Change.Overlap o : change.overlaps().values()) {
+            if (!puts.containsKey(o.component()) || installed.contains(o.component())) {
+                throw new IllegalArgumentException("overlap '" + o.component() + "': the change does not replace it "
+                        + "(an overlap is the old and the new half of an update)");
+            }
+        }
         // Identical replacements change nothing.
         replaced.entrySet().removeIf(e -> e.getValue().equals(puts.get(e.getKey())));
         TreeMap<String, String> newBlocked = new TreeMap<>(blocked);
@@ -251,7 +258,7 @@ public final class PlanEngine {
 
         if (incremental && trace == null && installed.size() == 1 && puts.size() == 1 && uninstalled.isEmpty()
                 && change.blocks().isEmpty() && change.unblocks().isEmpty() && change.measuredWcetNs().isEmpty()
-                && change.capacities().isEmpty()) {
+                && change.capacities().isEmpty() && change.overlaps().isEmpty()) {
             Plan p = derive(change, puts.values().iterator().next(), commit, newBlocked, newMeasured);
             if (p != null) {
                 return p;
@@ -510,8 +517,13 @@ public final class PlanEngine {
         for (List<String> c : cycles) {
             notes.add("cycle {" + String.join(", ", c) + "}: its port segments are created before any member starts");
         }
+        // While both halves of an update run (D51): counted only when the change says so.
+        List<TransientLoad> transients = change.overlaps().isEmpty() ? List.of()
+                : Transients.of(change, cpuOf, n -> oldContracts.containsKey(n) ? oldContracts.get(n)
+                        : resolver.contract(n).orElseThrow(), measured, capacities, adm,
+                        n -> resolver.contract(n).orElseThrow(), cpuTest);
         return new Plan(change, title(change, installed, replaced, uninstalled, newCaps), actions, stopOrder,
-                startGroups, active, target, inactive, wiring, adm, cycles, notes);
+                startGroups, active, target, inactive, wiring, adm, cycles, notes, transients);
     }
 
     private static List<String> providers(List<Wire> ws) {

@@ -74,7 +74,7 @@ final class SetAdmission {
                     problems.add(s.text() + ": " + why);
                 } else {
                     updates.add(n);
-                    b.replace(u.contract());
+                    b.replace(u.contract()).overlap(n, u.shadow(), u.window()); // both halves run meanwhile (D51)
                 }
             } else if (s instanceof ChangeSet.Uninstall) {
                 if (inst == null || !inst.planned) {
@@ -145,6 +145,7 @@ final class SetAdmission {
                 }
             }
         }
+        refused.addAll(plan.transientRefusals()); // the old and the new half side by side do not fit (D51)
         return new Checked(change, plan, refused.isEmpty() ? null : String.join("; ", refused));
     }
 

@@ -201,6 +201,9 @@ final class SwitchTurn {
         if (!shown.cpuAssignment().equals(now.cpuAssignment())) {
             return "cpus " + now.cpuAssignment();
         }
+        if (!shown.transientRefusals().equals(now.transientRefusals())) {
+            return "while both halves run: " + now.transientRefusals();
+        }
         return null;
     }
 }
