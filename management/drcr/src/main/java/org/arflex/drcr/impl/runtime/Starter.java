@@ -267,6 +267,15 @@ final class Starter {
      * @return true when it runs
      */
     boolean activate(Instance inst, RtHalf half, int cpu, long[] params, List<Wire> wiring, long t0, long tLaunched) {
+        return activate(inst, half, cpu, params, wiring, t0, tLaunched, e -> fail(inst, e));
+    }
+
+    /**
+     * As above; a refused command stops the half and goes to {@code refused} instead of the
+     * fault policy (an update's new half at its switch: the old half takes it back, D55).
+     */
+    boolean activate(Instance inst, RtHalf half, int cpu, long[] params, List<Wire> wiring, long t0, long tLaunched,
+                     java.util.function.Consumer<Exception> refused) {
         try {
             inst.bound.clear();
             for (Wire w : wiring) {
@@ -285,7 +294,7 @@ final class Starter {
         } catch (IOException | RuntimeException e) {
             // stopped and reaped on a stop thread; a restart of the name waits for it
             stops.submit(List.of(new Stops.Going(inst, half, List.of(), 0, "start failed")));
-            fail(inst, e);
+            refused.accept(e);
             changed.run();
             return false;
         }

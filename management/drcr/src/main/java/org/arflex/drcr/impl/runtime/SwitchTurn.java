@@ -102,6 +102,12 @@ final class SwitchTurn {
             if (run.shadows.containsKey(inst)) { // bound and started by its shadow run (D42)
                 starter.adopt(inst, Objects.requireNonNull(half), plan.cpuAssignment().getOrDefault(inst.name, -1),
                         "bound and started by its shadow run");
+            } else if (run.nexts.get(inst.name) == inst) {
+                // an update's new half that dies before its START, or refuses it: the old half,
+                // still running and read by its consumers until step 2, keeps the component (D55)
+                starter.activate(inst, Objects.requireNonNull(half), plan.cpuAssignment().getOrDefault(inst.name, -1),
+                        inst.params.clone(), plan.wiringOf(inst.name), run.t0, ts,
+                        e -> handBack(inst, olds.get(inst.name), run.oldHalves.get(inst.name), e));
             } else {
                 starter.activate(inst, Objects.requireNonNull(half), plan.cpuAssignment().getOrDefault(inst.name, -1),
                         inst.params.clone(), plan.wiringOf(inst.name), run.t0, ts);
@@ -187,6 +193,27 @@ final class SwitchTurn {
                 : java.util.concurrent.CompletableFuture.allOf(verdicts.toArray(java.util.concurrent.CompletableFuture[]::new))
                 .thenApply(v -> String.join("\n", verdicts.stream().map(java.util.concurrent.CompletableFuture::join).toList()));
         run.done.accept(new SetOutcome(true, null, plan, ts - run.t0, switchNs, verdict));
+    }
+
+    /**
+     * An update's new half was refused at its START in the switch turn (D55): the old half is the
+     * component's again before any consumer follows, the planner takes the old contract back, the
+     * new instance goes once its half has stopped (the refusal stopped it). Its window then
+     * reports the rollback ({@link UpdateWindow#begin}).
+     */
+    private void handBack(Instance next, Instance old, RtHalf oldHalf, Exception e) {
+        next.bound.clear();
+        next.life.target(State.DESTROYED);
+        next.destroyReason = "its START was refused (" + e.getMessage() + ")";
+        cell.swap(next, old);
+        old.half = oldHalf;
+        try {
+            cell.planner().apply(org.arflex.planner.Change.replace(old.contract));
+        } catch (RuntimeException ex) {
+            log.accept("arflex: " + next.name + ": the planner refused the old contract back: " + ex.getMessage());
+        }
+        log.accept("arflex: " + next.name + ": the new version's START was refused at the switch (" + e.getMessage()
+                + "); pid " + oldHalf.pid() + " keeps running it");
     }
 
     /** Null when {@code now} does what {@code shown} said, else what differs. */

@@ -63,8 +63,18 @@ final class UpdateWindow {
     }
 
     void begin() {
-        if (nextHalf == null) { // its START was refused: Failures restarts the new version
+        if (nextHalf == null) {
             done = true;
+            if (cell.find(next.name) == old && old.half == oldHalf) { // handed back in the switch turn (D55)
+                String v = "update " + next.name + ": rolled back at the switch: " + next.destroyReason + "; pid "
+                        + oldHalf.pid() + " (" + old.objectId + ") runs it again";
+                old.life.reason(null);
+                cell.problem("change set " + set.describe() + ": " + v);
+                log.accept("arflex: " + v);
+                cell.changed();
+                verdict.complete(v);
+                return;
+            }
             end("the new version did not start", 0);
             return;
         }

@@ -124,7 +124,7 @@ class CellConcurrencyTest {
         @Override public void unbind(String port) { h.unbind(port); }
         @Override public long cycles() { return h.cycles(); }
         @Override public boolean awaitCycles(long since, int n, long timeoutMs) { return h.awaitCycles(since, n, timeoutMs); }
-        @Override public void start() { command("START"); h.start(); }
+        @Override public void start() throws java.io.IOException { command("START"); h.start(); }
         @Override public void reset() { command("RESET"); h.reset(); }
         @Override public long setParam(int index, long bits) { command("SET_PARAM"); return h.setParam(index, bits); }
         @Override public long paramValue(int index) { return h.paramValue(index); }

@@ -6,6 +6,7 @@ import static org.junit.jupiter.api.Assertions.assertNotNull;
 import static org.junit.jupiter.api.Assertions.assertTrue;
 
 import java.nio.file.Path;
+import java.util.List;
 import java.util.Set;
 import java.util.concurrent.CompletableFuture;
 import org.arflex.contract.Contract;
@@ -188,6 +189,47 @@ class CellUpdateSetTest {
         oldHalf.crash(139, "killed by signal 11");
         actor.advance(200);
         rig.stepUntil("stage restarted", () -> fake.running.containsKey("stage") && rig.state("stage") == State.ACTIVE);
+    }
+
+    /**
+     * The new half dies (or refuses its START) in the switch turn itself: the old half, still
+     * running and still bound, stays the component's; nothing is restarted or held. It was
+     * stopped, and the new version restarted by the fault policy (a moving one then waited for
+     * an operator reset).
+     */
+    @Test
+    void aNewVersionWhoseStartIsRefusedAtTheSwitchHandsBackToTheOldHalf() throws Exception {
+        runningCell();
+        FakeLauncher.FakeHalf oldHalf = fake.running.get("stage");
+        FakeLauncher.FakeHalf src = fake.running.get("src");
+        FakeLauncher.FakeHalf user = fake.running.get("user");
+        fake.refuseStart.add("1-stage");
+        int mark = fake.events.size();
+        ChangeSetResult r = apply(update(1000));
+        assertTrue(r.applied(), r.text());
+        rig.stepUntil("the verdict", () -> r.verdict().isDone());
+        String v = r.verdict().join();
+        assertTrue(v.startsWith("update stage: rolled back at the switch: its START was refused"), v);
+        assertTrue(v.contains("pid " + oldHalf.pid + " (stage) runs it again"), v);
+        assertEquals(oldHalf.pid, cell.instance("stage").orElseThrow().half.pid());
+        assertEquals("1.0.0", cell.instance("stage").orElseThrow().contract().version().toString());
+        assertEquals(State.ACTIVE, rig.state("stage"));
+        assertEquals(State.ACTIVE, rig.state("user"));
+        assertFalse(cell.instance("stage").orElseThrow().awaitingReset, "nothing waits for a reset");
+        rig.stepUntil("the new half stopped and its segment gone", () -> !fake.running.containsKey("1-stage")
+                && !fake.openOutputs.containsKey("/arflex.t.1-stage.out.y"));
+        actor.advance(1000); // past any restart backoff
+        rig.stepUntil("settled", () -> true);
+        List<String> after = fake.events.subList(mark, fake.events.size());
+        assertFalse(after.contains("user BIND x /arflex.t.1-stage.out.y"), "the consumer never moved: " + after);
+        assertFalse(after.contains("stage SHUTDOWN"), "the old half runs on: " + after);
+        assertEquals(1, after.stream().filter(e -> e.endsWith(" LAUNCH")).count(), "no restart: " + after);
+        assertEquals(oldHalf, fake.running.get("stage"));
+        assertEquals(src, fake.running.get("src"));
+        assertEquals(user, fake.running.get("user"));
+        assertEquals(0, cell.instance("stage").orElseThrow().restarts);
+        assertEquals(Set.of("src", "stage", "user"), cell.planner().active());
+        assertTrue(cell.problems().stream().anyMatch(p -> p.contains("rolled back at the switch")), cell.problems()::toString);
     }
 
     @Test

@@ -5,6 +5,7 @@ import java.util.ArrayList;
 import java.util.HashMap;
 import java.util.List;
 import java.util.Map;
+import java.util.Set;
 import java.util.concurrent.CompletableFuture;
 import org.arflex.drcr.impl.abi.ControlBlock;
 import org.arflex.drcr.impl.supervisor.RtHalf;
@@ -25,6 +26,8 @@ final class FakeLauncher implements RtLauncher {
     final Map<String, byte[]> values = new java.util.concurrent.ConcurrentHashMap<>();
     /** Instance id -> why its ADOPT is refused (tests set it). */
     final Map<String, String> refuseAdopt = new java.util.concurrent.ConcurrentHashMap<>();
+    /** Instances whose START is refused (the half died before it, say); tests set it. */
+    final Set<String> refuseStart = java.util.concurrent.ConcurrentHashMap.newKeySet();
     /** Instances whose next launches fail. */
     final Map<String, Integer> failLaunches = new java.util.concurrent.ConcurrentHashMap<>();
     private final java.util.concurrent.atomic.AtomicLong nextPid = new java.util.concurrent.atomic.AtomicLong(1000);
@@ -111,7 +114,11 @@ final class FakeLauncher implements RtLauncher {
         }
 
         @Override
-        public void start() {
+        public void start() throws java.io.IOException {
+            if (refuseStart.contains(inst)) {
+                events.add(inst + " START refused");
+                throw new java.io.IOException("START (seq 3): the RT half exited before it answered");
+            }
             started = true;
             events.add(inst + " START");
         }
