@@ -8,6 +8,10 @@
 # (`arflex:summary`: RT halves running, robot cycles, the vision-measured and the TRUE TCP
 # error). Headless: `arflex:list`, `arflex:stats sim-robot` and the summary every 5 s, then the
 # runtime stops cleanly HEADLESS_SECONDS after the start.
+# ARFLEX_SHIELD_CPUS (./arflex run --shield CPUS): every other process is kept off those CPUs
+# while the runtime runs, and the runtime's JVM (with it the non-real-time threads of the RT
+# halves) runs on the others; ARFLEX_SHIELD_POLL=true (--poll) keeps them from idling
+# (scripts/rt-shield.sh, docs/DECISIONS.md D59).
 # The runtime runs as an evaluation run (-Darflex.evaluation=true): sim-robot publishes the
 # simulator's ground truth (the true TCP), which only the summary reads (simulator/README.md,
 # "Ground truth"). ARFLEX_EVALUATION=false turns it off.
@@ -79,6 +83,13 @@ while IFS= read -r line; do
   case "$line" in "#"*|"") ;; *=*) SYSPROPS+=("-D$line") ;; esac
 done < conf/system.properties
 trap 'rm -f "$CONF" ${CREDS_TMP:+"$CREDS_TMP"} ${TLS_PASS:+"$TLS_PASS"}' EXIT
+TASKSET=()
+if [ -n "${ARFLEX_SHIELD_CPUS:-}" ]; then
+  SHIELD="$(dirname "${BASH_SOURCE[0]}")/rt-shield.sh"
+  TASKSET=(taskset -c "$("$SHIELD" rest --cpus "$ARFLEX_SHIELD_CPUS")")
+  "$SHIELD" on --cpus "$ARFLEX_SHIELD_CPUS" --keep $$ $([ "${ARFLEX_SHIELD_POLL:-}" = true ] && echo --poll)
+  trap 'rm -f "$CONF" ${CREDS_TMP:+"$CREDS_TMP"} ${TLS_PASS:+"$TLS_PASS"}; "$SHIELD" off' EXIT
+fi
 
 # What is typed into the console (our shell bundle, docs/DECISIONS.md D28): it reads its first
 # line once the framework has started every bundle, so the DRCR's arflex:* commands exist by then;
@@ -140,6 +151,6 @@ if nice -n -10 true 2>/dev/null && [ "$(nice -n -10 nice)" = "-10" ]; then NICE=
 # G1's default pause goal is 200 ms, twice the 100 ms runtime heartbeat timeout of the 1 kHz
 # components: a collection during the cell's start-up put sim-robot into safe mode now and then.
 JVM_OPTS=(-XX:+UseG1GC -XX:MaxGCPauseMillis=20)
-commands | "${NICE[@]}" java "${JVM_OPTS[@]}" "${SYSPROPS[@]}" -Dfelix.config.properties="file:$CONF" \
+commands | "${TASKSET[@]}" "${NICE[@]}" java "${JVM_OPTS[@]}" "${SYSPROPS[@]}" -Dfelix.config.properties="file:$CONF" \
   -Dfelix.system.properties="file:$CREDS" -Darflex.console.bundles="$console_bundles" \
   -Darflex.home="$ARFLEX_HOME" -Darflex.evaluation="${ARFLEX_EVALUATION:-true}" -jar bin/felix.jar 2>&1

@@ -14,20 +14,32 @@ ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 cd "$ROOT"
 sets=3
 mlock=false
+shield=""
+poll=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --sets) sets="${2:?--sets needs a number}"; shift 2 ;;
     --mlock) mlock=true; shift ;;
-    *) echo "arflex bench reconfig: unknown option '$1' (--sets N, --mlock)" >&2; exit 2 ;;
+    --shield) shield="${2:?--shield needs a CPU list}"; shift 2 ;;
+    --poll) poll=--poll; shift ;;
+    *) echo "arflex bench reconfig: unknown option '$1' (--sets N, --mlock, --shield CPUS, --poll)" >&2; exit 2 ;;
   esac
 done
 [[ "$sets" =~ ^[1-9][0-9]*$ ]] || { echo "arflex bench reconfig: --sets '$sets' is not a whole number above 0" >&2; exit 2; }
+[ -n "$shield" ] || [ -z "$poll" ] || { echo "arflex bench reconfig: --poll needs --shield" >&2; exit 2; }
 log=$(mktemp)
 trap 'rm -f "$log"' EXIT
+jvmcpus=""
+if [ -n "$shield" ]; then
+  # the runtime's JVM on the CPUs the shield leaves to the rest of the machine
+  jvmcpus=$(bash scripts/rt-shield.sh rest --cpus "$shield")
+  bash scripts/rt-shield.sh on --cpus "$shield" --keep $$ $poll
+  trap 'rm -f "$log"; bash scripts/rt-shield.sh off' EXIT
+fi
 set +e
 mvn -B -o -Darflex.native.skip=true -Darflex.native.tests.skip=true -pl tests verify \
   -Dtest=none -Dsurefire.failIfNoSpecifiedTests=false -Dit.test=ReconfigBench -Dfailsafe.failIfNoSpecifiedTests=false \
-  -Darflex.bench.sets="$sets" -Darflex.it.mlock="$mlock" -Darflex.bench.out="$ROOT/target/bench/reconfig.json" >"$log" 2>&1
+  -Darflex.bench.sets="$sets" -Darflex.it.mlock="$mlock" -Darflex.it.jvmcpus="$jvmcpus" -Darflex.bench.out="$ROOT/target/bench/reconfig.json" >"$log" 2>&1
 status=$?
 set -e
 grep -E '^(reconfig:|JSON:)' "$log" | grep -v '^reconfig: [0-9]* sets, ' || true
@@ -35,5 +47,6 @@ if ! grep -q '^reconfig: [0-9]* sets, missed cycles' "$log"; then
   tail -40 "$log" >&2
   exit 1
 fi
+[ -z "$shield" ] || echo "reconfig: every other process kept off CPUs $shield (scripts/rt-shield.sh)"
 grep '^reconfig: [0-9]* sets, missed cycles' "$log" | tail -1
 exit $status

@@ -86,14 +86,30 @@ class ReconfigBench {
                 CellRig.Operator operator, int[] counted) {
     }
 
+    /** The CPU admission gave sim-robot, as the DRCR reports it. */
+    @SuppressWarnings("unchecked")
+    static Object simRobotCpu(Runtime rt) throws Exception {
+        for (Map<String, Object> i : (List<Map<String, Object>>) rt.dto().get("instances")) {
+            if ("sim-robot".equals(i.get("name"))) {
+                return i.get("cpu");
+            }
+        }
+        throw new AssertionError("no sim-robot in the cell");
+    }
+
     @Test
     void reconfigureTheMovingCell() throws Exception {
         int n = Math.max(1, Integer.getInteger("arflex.bench.sets", 3));
         CellRig.assertBuilt(CellRig.SIM_ROBOT, CellRig.TRAJECTORY, CellRig.FORCE_GUARD, CellRig.TEACH,
                 CellRig.TCP_CORRECTION);
         List<Row> rows = new ArrayList<>();
-        try (Runtime rt = new Runtime("reconfig-bench")) {
+        // --shield: the runtime's JVM (and with it the non-real-time threads of every RT half it
+        // spawns) runs on the CPUs outside the shield (D59)
+        String jvmCpus = System.getProperty("arflex.it.jvmcpus", "");
+        try (Runtime rt = jvmCpus.isEmpty() ? new Runtime("reconfig-bench") : Runtime.pinned("reconfig-bench", jvmCpus)) {
             List<String> arm = FailSafeIT.movingCell(rt);
+            System.out.println("reconfig: sim-robot's RT thread runs on CPU " + simRobotCpu(rt)
+                    + (jvmCpus.isEmpty() ? "" : ", the runtime's JVM on CPUs " + jvmCpus));
             assertTrue(arm.contains("tcp-correction"), arm.toString());
             CellRig.installOnly(rt, CellRig.TEACH, "teach");
             Path dir = Files.createDirectories(rt.dir.resolve("versions"));
