@@ -33,8 +33,8 @@ jvmcpus=""
 if [ -n "$shield" ]; then
   # the runtime's JVM on the CPUs the shield leaves to the rest of the machine
   jvmcpus=$(bash scripts/rt-shield.sh rest --cpus "$shield")
-  bash scripts/rt-shield.sh on --cpus "$shield" --keep $$ $poll
-  trap 'rm -f "$log"; bash scripts/rt-shield.sh off' EXIT
+  bash scripts/rt-shield.sh on --cpus "$shield" --keep $$ $poll >&2
+  trap 'rm -f "$log"; bash scripts/rt-shield.sh off >&2' EXIT
 fi
 set +e
 mvn -B -o -Darflex.native.skip=true -Darflex.native.tests.skip=true -pl tests verify \
@@ -42,6 +42,11 @@ mvn -B -o -Darflex.native.skip=true -Darflex.native.tests.skip=true -pl tests ve
   -Darflex.bench.sets="$sets" -Darflex.it.mlock="$mlock" -Darflex.it.jvmcpus="$jvmcpus" -Darflex.bench.out="$ROOT/target/bench/reconfig.json" >"$log" 2>&1
 status=$?
 set -e
+if [ -n "$shield" ]; then
+  # off before the table: the last line stays the bench's
+  bash scripts/rt-shield.sh off >&2
+  trap 'rm -f "$log"' EXIT
+fi
 grep -E '^(reconfig:|JSON:)' "$log" | grep -v '^reconfig: [0-9]* sets, ' || true
 if ! grep -q '^reconfig: [0-9]* sets, missed cycles' "$log"; then
   tail -40 "$log" >&2
