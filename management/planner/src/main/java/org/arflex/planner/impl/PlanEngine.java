@@ -217,12 +217,7 @@ public final class PlanEngine {
             }
             uninstalled.put(n, resolver.contract(n).get());
         }
-        for (Change.Overlap o : change.overlaps().values()) {
-            if (!puts.containsKey(o.component()) || installed.contains(o.component())) {
-                throw new IllegalArgumentException("overlap '" + o.component() + "': the change does not replace it "
-                        + "(an overlap is the old and the new half of an update)");
-            }
-        }
+        Transients.checkOverlaps(change, puts.keySet(), installed);
         // Identical replacements change nothing.
         replaced.entrySet().removeIf(e -> e.getValue().equals(puts.get(e.getKey())));
         TreeMap<String, String> newBlocked = new TreeMap<>(blocked);

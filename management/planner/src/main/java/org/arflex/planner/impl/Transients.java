@@ -43,6 +43,23 @@ final class Transients {
     private Transients() {
     }
 
+    /**
+     * Refuses an overlap of a component that {@code change} does not replace: an overlap is the
+     * old and the new half of an update, so its component is one the change puts
+     * ({@code put}) and that was installed before it (not in {@code installed}, the change's
+     * new components).
+     *
+     * @throws IllegalArgumentException naming the first such overlap
+     */
+    static void checkOverlaps(Change change, Set<String> put, Set<String> installed) {
+        for (Change.Overlap o : change.overlaps().values()) {
+            if (!put.contains(o.component()) || installed.contains(o.component())) {
+                throw new IllegalArgumentException("overlap '" + o.component() + "': the change does not replace it "
+                        + "(an overlap is the old and the new half of an update)");
+            }
+        }
+    }
+
     /** How the tasks of one phase are placed: the base configuration plus the second halves. */
     private record Extra(String component, int cpu, Task task, long cycles) {
     }

@@ -175,16 +175,4 @@ final class ChangeSetExecutor {
         }
     }
 
-    static org.arflex.drcr.impl.abi.ControlBlock.Stats stats(RtHalf half, Instance inst) {
-        try {
-            return half.exit().isDone() ? null : half.stats(inst.contract.timing().wcetNs());
-        } catch (RuntimeException e) {
-            return null;
-        }
-    }
-
-    static long bad(org.arflex.drcr.impl.abi.ControlBlock.Stats s) {
-        return s == null ? 0 : s.overruns() + s.deadlineMisses();
-    }
-
 }

@@ -270,6 +270,16 @@ final class Starter {
         return activate(inst, half, cpu, params, wiring, t0, tLaunched, e -> fail(inst, e));
     }
 
+    /** Binds {@code half}'s inputs as {@code wiring} says, from scratch, and records them in {@code inst.bound}. */
+    static void bind(Segments segments, Instance inst, RtHalf half, List<Wire> wiring) throws IOException {
+        inst.bound.clear();
+        for (Wire w : wiring) {
+            String seg = segments.name(w.provider(), w.outPort());
+            half.bind(w.inPort(), seg);
+            inst.bound.put(w.inPort(), seg);
+        }
+    }
+
     /**
      * As above; a refused command stops the half and goes to {@code refused} instead of the
      * fault policy (an update's new half at its switch: the old half takes it back, D55).
@@ -277,12 +287,7 @@ final class Starter {
     boolean activate(Instance inst, RtHalf half, int cpu, long[] params, List<Wire> wiring, long t0, long tLaunched,
                      java.util.function.Consumer<Exception> refused) {
         try {
-            inst.bound.clear();
-            for (Wire w : wiring) {
-                String seg = segments.name(w.provider(), w.outPort());
-                half.bind(w.inPort(), seg);
-                inst.bound.put(w.inPort(), seg);
-            }
+            bind(segments, inst, half, wiring);
             long[] now = inst.params;
             for (int i = 0; i < now.length && i < params.length; i++) {
                 if (now[i] != params[i]) { // written while it started

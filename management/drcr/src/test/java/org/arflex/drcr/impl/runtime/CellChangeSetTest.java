@@ -90,10 +90,7 @@ class CellChangeSetTest {
     }
 
     private void install(String xml) throws Exception {
-        Contract c = parse(xml);
-        assertTrue(actor.call(() -> cell.install(c, c.name().hashCode(), Path.of("/nonexistent/" + c.name())), 0),
-                rig.log::toString);
-        rig.stepUntil(c.name() + " ACTIVE", () -> rig.state(c.name()) == State.ACTIVE);
+        rig.install(parse(xml));
     }
 
     /** Known to the cell, not started: what an installed, not started bundle gives. */
@@ -111,18 +108,6 @@ class CellChangeSetTest {
 
     private static ChangeSet replaceOldByNew() {
         return ChangeSet.builder().install("new", Path.of("/nonexistent/new")).uninstall("old").build();
-    }
-
-    private ChangeSetResult apply(ChangeSet set) {
-        CompletableFuture<ChangeSetResult> f = actor.call(() -> cell.applyChangeSet(set), 0);
-        rig.stepUntil("the change set's outcome", f::isDone);
-        return f.join();
-    }
-
-    private int index(String event) {
-        int i = fake.events.indexOf(event);
-        assertTrue(i >= 0, "no event '" + event + "' in " + fake.events);
-        return i;
     }
 
     @Test
@@ -172,10 +157,10 @@ class CellChangeSetTest {
         rig.stepUntil("old stopped and its segment gone", () -> cell.instance("old").isEmpty()
                 && !fake.running.containsKey("old") && !fake.openOutputs.containsKey("/arflex.t.old.out.y"));
         // order: spawned and READY, then started and bound, then the consumer moved, then the old one stops
-        int launched = index("new LAUNCH");
-        int started = index("new START");
-        int moved = index("user BIND x /arflex.t.new.out.y");
-        int stopped = index("old SHUTDOWN");
+        int launched = rig.index("new LAUNCH");
+        int started = rig.index("new START");
+        int moved = rig.index("user BIND x /arflex.t.new.out.y");
+        int stopped = rig.index("old SHUTDOWN");
         assertTrue(launched < started && started < moved && moved < stopped, fake.events.toString());
         assertFalse(fake.events.contains("user UNBIND x"), "a BIND replaces the binding, no gap: " + fake.events);
         assertEquals(1, fake.events.stream().filter(e -> e.equals("user SET_PARAM 0")).count(), fake.events::toString);
@@ -194,18 +179,18 @@ class CellChangeSetTest {
         int before = fake.events.size();
         ChangeSet set = ChangeSet.builder().install("new", Path.of("/nonexistent/new"))
                 .install("lonely", Path.of("/nonexistent/lonely")).uninstall("old").build();
-        ChangeSetResult r = apply(set);
+        ChangeSetResult r = rig.apply(set);
         assertFalse(r.applied());
         assertFalse(r.admitted());
         assertTrue(r.refusal().startsWith("install lonely: not admitted: input 'x' of 'lonely'"), r.refusal());
         assertTrue(r.text().contains("START    new"), "the plan is shown with the refusal: " + r.text());
         // a set naming what the cell does not have is refused before planning
-        ChangeSetResult unknown = apply(ChangeSet.builder().uninstall("ghost").set("user", "mode", "2")
+        ChangeSetResult unknown = rig.apply(ChangeSet.builder().uninstall("ghost").set("user", "mode", "2")
                 .set("user", "speed", "1").build());
         assertEquals("uninstall ghost: 'ghost' is not installed; set user mode 2: user.mode is immutable while it runs "
                 + "(mutable=false); set user speed 1: user: no parameter 'speed' (has [gain, mode])", unknown.refusal());
         // a set that stops what it does not name is refused (uninstalling the only provider)
-        ChangeSetResult sideEffect = apply(ChangeSet.builder().uninstall("old").build());
+        ChangeSetResult sideEffect = rig.apply(ChangeSet.builder().uninstall("old").build());
         assertTrue(sideEffect.refusal().startsWith("the set would stop 'user'"), sideEffect.refusal());
         actor.runAll();
         assertEquals(before, fake.events.size(), "nothing launched, bound or stopped: " + fake.events);
@@ -221,14 +206,14 @@ class CellChangeSetTest {
                 + "<bind component=\"new\" port=\"y\"/></in>" + OUT.replace("\"y\"", "\"w\""), "50us"));
         fake.failLaunches.put("new2", 1);
         long oldPid = fake.running.get("old").pid;
-        ChangeSetResult r = apply(ChangeSet.builder().install("new", Path.of("/nonexistent/new"))
+        ChangeSetResult r = rig.apply(ChangeSet.builder().install("new", Path.of("/nonexistent/new"))
                 .install("new2", Path.of("/nonexistent/new2")).uninstall("old").set("new", "gain", "5").build());
         assertFalse(r.applied());
         assertTrue(r.refusal().startsWith("preparation failed, nothing changed: preparing 'new2': RT half new2 exited"),
                 r.refusal());
         rig.stepUntil("new's prepared half stopped and the segments gone", () -> !fake.running.containsKey("new")
                 && !fake.openOutputs.containsKey("/arflex.t.new.out.y") && !fake.openOutputs.containsKey("/arflex.t.new2.out.w"));
-        assertTrue(index("new LAUNCH") < index("new SHUTDOWN"), fake.events.toString());
+        assertTrue(rig.index("new LAUNCH") < rig.index("new SHUTDOWN"), fake.events.toString());
         assertFalse(fake.events.contains("new START"), fake.events::toString);
         assertFalse(fake.events.stream().anyMatch(e -> e.startsWith("user BIND x /arflex.t.new")), fake.events::toString);
         assertFalse(fake.events.stream().anyMatch(e -> e.startsWith("old ") && !e.equals("old LAUNCH") && !e.equals("old START")
@@ -239,7 +224,7 @@ class CellChangeSetTest {
         assertEquals(State.INSTALLED, rig.state("new2"));
         assertEquals("2", actor.call(() -> cell.getParam("new", "gain"), 0).replace(".0", ""), "the set's write undone");
         // and the same set applies once the spawn works
-        ChangeSetResult again = apply(ChangeSet.builder().install("new", Path.of("/nonexistent/new"))
+        ChangeSetResult again = rig.apply(ChangeSet.builder().install("new", Path.of("/nonexistent/new"))
                 .install("new2", Path.of("/nonexistent/new2")).uninstall("old").build());
         assertTrue(again.applied(), again.text());
         rig.stepUntil("new2 ACTIVE", () -> rig.state("new2") == State.ACTIVE && !fake.running.containsKey("old"));

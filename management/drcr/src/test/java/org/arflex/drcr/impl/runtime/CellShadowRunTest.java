@@ -1,22 +1,23 @@
 package org.arflex.drcr.impl.runtime;
 
+import static org.arflex.drcr.impl.runtime.UpdateRig.IN_SRC;
+import static org.arflex.drcr.impl.runtime.UpdateRig.NEW_Y;
+import static org.arflex.drcr.impl.runtime.UpdateRig.OLD_Y;
+import static org.arflex.drcr.impl.runtime.UpdateRig.OUT;
+import static org.arflex.drcr.impl.runtime.UpdateRig.cycles;
+import static org.arflex.drcr.impl.runtime.UpdateRig.parse;
+import static org.arflex.drcr.impl.runtime.UpdateRig.sample;
 import static org.junit.jupiter.api.Assertions.assertEquals;
 import static org.junit.jupiter.api.Assertions.assertFalse;
 import static org.junit.jupiter.api.Assertions.assertNotNull;
 import static org.junit.jupiter.api.Assertions.assertTrue;
 
-import java.nio.ByteBuffer;
-import java.nio.ByteOrder;
 import java.nio.file.Path;
 import java.util.List;
 import java.util.Set;
 import java.util.concurrent.CompletableFuture;
 import org.arflex.contract.Contract;
-import org.arflex.contract.ContractParser;
-import org.arflex.contract.PortTypes;
-import org.arflex.drcr.impl.abi.ControlBlock;
 import org.arflex.drcr.impl.lifecycle.ManualActor;
-import org.arflex.drcr.impl.lifecycle.State;
 import org.junit.jupiter.api.AfterEach;
 import org.junit.jupiter.api.Test;
 
@@ -32,16 +33,8 @@ import org.junit.jupiter.api.Test;
  */
 class CellShadowRunTest {
 
-    private static final String IN_SRC = "<in name=\"x\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\">"
-            + "<bind filter=\"(role=src)\"/></in>";
-    private static final String OUT = "<out name=\"y\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\"/>";
-    private static final String IN_STAGE = "<in name=\"x\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\">"
-            + "<bind filter=\"(role=stage)\"/></in>";
-    private static final String OLD_Y = "/arflex.t.stage.out.y";
-    private static final String NEW_Y = "/arflex.t.1-stage.out.y";
-
-    private final FakeLauncher fake = new FakeLauncher();
-    private final SteppedCell rig = new SteppedCell(fake, fake, true);
+    private final UpdateRig rig = new UpdateRig();
+    private final FakeLauncher fake = rig.fake;
     private final ManualActor actor = rig.actor;
     private final Cell cell = rig.cell;
 
@@ -50,58 +43,18 @@ class CellShadowRunTest {
         rig.close();
     }
 
-    private static Contract parse(String name, String role, String ports, String version, String rollout) throws Exception {
-        String xml = CellChangeSetTest.contract(name, role, ports, "50us").replace("version=\"1.0.0\"",
-                "version=\"" + version + "\"").replace("</component>", rollout + "</component>");
-        return ContractParser.create(PortTypes.builtin()).parse(xml, "test.xml");
-    }
-
-    private void install(Contract c) {
-        assertTrue(actor.call(() -> cell.install(c, c.name().hashCode(), Path.of("/nonexistent/" + c.name())), 0),
-                rig.log::toString);
-        rig.stepUntil(c.name() + " ACTIVE", () -> rig.state(c.name()) == State.ACTIVE);
-    }
-
-    private void runningCell() throws Exception {
-        install(parse("src", "src", OUT, "1.0.0", ""));
-        install(parse("stage", "stage", IN_SRC + OUT, "1.0.0", ""));
-        install(parse("user", null, IN_STAGE, "1.0.0", ""));
-        assertTrue(fake.events.contains("user BIND x " + OLD_Y), fake.events::toString);
-    }
-
     private ChangeSet update(long shadow, long window, List<ChangeSet.Tolerance> tolerances) throws Exception {
-        return ChangeSet.builder().update("stage", parse("stage", "stage", IN_SRC + OUT, "1.1.0", ""),
-                Path.of("/nonexistent/stage-1.1"), "file:/x/stage-1.1.jar", window, List.of(), shadow, tolerances).build();
+        return UpdateRig.update(parse("stage", "stage", IN_SRC + OUT, "1.1.0", ""), window, shadow, tolerances);
     }
 
     /** Applies {@code set} and steps until the shadow run has begun (the new half STARTed). */
     private CompletableFuture<ChangeSetResult> applyIntoShadow(ChangeSet set) {
-        CompletableFuture<ChangeSetResult> f = actor.call(() -> cell.applyChangeSet(set), 0);
-        rig.stepUntil("the new half started in shadow", () -> fake.events.contains("1-stage START") || f.isDone());
-        return f;
-    }
-
-    private static ControlBlock.Stats cycles(long n, long overruns) {
-        return new ControlBlock.Stats(n, overruns, 0, 0, 0, 0, 0, 0, 0, 0);
-    }
-
-    /** An arflex.Sample payload: seq, t_ns, value. */
-    private static byte[] sample(long seq, long tNs, double value) {
-        return ByteBuffer.allocate(24).order(ByteOrder.LITTLE_ENDIAN).putLong(seq).putLong(tNs).putDouble(value).array();
-    }
-
-    private void look() {
-        actor.advance(ChangeSetExecutor.WATCH_MS);
-        actor.runAll();
-    }
-
-    private List<String> since(int mark) {
-        return fake.events.subList(mark, fake.events.size());
+        return rig.applyIntoShadow(set, () -> { });
     }
 
     @Test
     void aVersionThatPassesItsShadowRunIsSwitchedWithoutASecondStartAndKeptInItsWindow() throws Exception {
-        runningCell();
+        rig.boundCell();
         FakeLauncher.FakeHalf oldHalf = fake.running.get("stage");
         CompletableFuture<ChangeSetResult> f = applyIntoShadow(update(100, 50,
                 List.of(new ChangeSet.Tolerance("y", "value", 0.01))));
@@ -116,24 +69,24 @@ class CellShadowRunTest {
         fake.values.put(OLD_Y, sample(500, 7_000, 1.000));
         fake.values.put(NEW_Y, sample(3, 7_000, 1.004));
         newHalf.stats = cycles(40, 0);
-        look();
+        rig.look();
         assertFalse(f.isDone(), "40 of 100 cycles");
         assertFalse(fake.events.contains("user BIND x " + NEW_Y));
         // a value of another source cycle is not compared (it differs by more than the tolerance)
         fake.values.put(NEW_Y, sample(4, 8_000, 1.5));
         newHalf.stats = cycles(100, 0);
         int mark = fake.events.size();
-        look();
+        rig.look();
         rig.stepUntil("the switch", f::isDone);
         ChangeSetResult r = f.join();
         assertTrue(r.applied(), r.text());
         // the switch: the consumer's BIND, and no second BIND or START of the new half
-        assertTrue(since(mark).contains("user BIND x " + NEW_Y), fake.events::toString);
-        assertFalse(since(mark).stream().anyMatch(e -> e.startsWith("1-stage ")), fake.events::toString);
+        assertTrue(rig.since(mark).contains("user BIND x " + NEW_Y), fake.events::toString);
+        assertFalse(rig.since(mark).stream().anyMatch(e -> e.startsWith("1-stage ")), fake.events::toString);
         assertEquals(newHalf.pid, cell.instance("stage").orElseThrow().half.pid());
         // then the window, as without a shadow run
         newHalf.stats = cycles(160, 0);
-        look();
+        rig.look();
         rig.stepUntil("the verdict", () -> r.verdict().isDone());
         String v = r.verdict().join();
         assertTrue(v.startsWith("update stage: passed its shadow run of 100 cycles (0 overruns or deadline misses, the "
@@ -146,7 +99,7 @@ class CellShadowRunTest {
 
     @Test
     void aVersionThatCrashesInShadowIsRejectedAndItsConsumersAreNeverRebound() throws Exception {
-        runningCell();
+        rig.boundCell();
         FakeLauncher.FakeHalf oldHalf = fake.running.get("stage");
         FakeLauncher.FakeHalf src = fake.running.get("src");
         FakeLauncher.FakeHalf user = fake.running.get("user");
@@ -154,7 +107,7 @@ class CellShadowRunTest {
         CompletableFuture<ChangeSetResult> f = applyIntoShadow(update(200, 1000, List.of()));
         FakeLauncher.FakeHalf newHalf = fake.running.get("1-stage");
         newHalf.stats = cycles(50, 0);
-        look();
+        rig.look();
         newHalf.crash(139, "killed by signal 11");
         rig.stepUntil("the outcome", f::isDone);
         ChangeSetResult r = f.join();
@@ -181,7 +134,7 @@ class CellShadowRunTest {
 
     @Test
     void anOutputBeyondItsToleranceRejectsTheUpdateNamingIt() throws Exception {
-        runningCell();
+        rig.boundCell();
         FakeLauncher.FakeHalf oldHalf = fake.running.get("stage");
         CompletableFuture<ChangeSetResult> f = applyIntoShadow(update(200, 1000,
                 List.of(new ChangeSet.Tolerance("y", "value", 0.01))));
@@ -189,7 +142,7 @@ class CellShadowRunTest {
         fake.values.put(OLD_Y, sample(900, 42_000, 2.0));
         fake.values.put(NEW_Y, sample(30, 42_000, 2.5));
         newHalf.stats = cycles(30, 0);
-        look();
+        rig.look();
         rig.stepUntil("the outcome", f::isDone);
         ChangeSetResult r = f.join();
         assertFalse(r.applied(), r.text());
@@ -205,16 +158,16 @@ class CellShadowRunTest {
 
     @Test
     void extraOverrunsInShadowRejectTheUpdate() throws Exception {
-        runningCell();
+        rig.boundCell();
         FakeLauncher.FakeHalf oldHalf = fake.running.get("stage");
         oldHalf.stats = cycles(9000, 4);
         CompletableFuture<ChangeSetResult> f = applyIntoShadow(update(200, 1000, List.of()));
         FakeLauncher.FakeHalf newHalf = fake.running.get("1-stage");
         newHalf.stats = cycles(20, 0);
-        look();
+        rig.look();
         oldHalf.stats = cycles(9080, 5); // one more for the running version in the same time
         newHalf.stats = cycles(80, 1 + 1 + ChangeSetExecutor.OVERRUN_ALLOWANCE);
-        look();
+        rig.look();
         rig.stepUntil("the outcome", f::isDone);
         ChangeSetResult r = f.join();
         assertEquals("update stage: rejected in shadow after 80 cycles: it overran or missed its deadline in "
@@ -251,7 +204,7 @@ class CellShadowRunTest {
 
     @Test
     void aToleranceOnAnUnknownOutputOrFieldOrWithoutAShadowRunIsRefused() throws Exception {
-        runningCell();
+        rig.boundCell();
         int before = fake.events.size();
         ChangeSetResult port = actor.call(() -> cell.planChangeSet(update(10, 10,
                 List.of(new ChangeSet.Tolerance("z", "value", 1)))), 0);
@@ -270,16 +223,16 @@ class CellShadowRunTest {
 
     @Test
     void aVersionThatStopsCyclingInShadowIsRejectedAfterItsHeartbeatTimeout() throws Exception {
-        runningCell();
+        rig.boundCell();
         CompletableFuture<ChangeSetResult> f = applyIntoShadow(update(200, 1000, List.of()));
         FakeLauncher.FakeHalf newHalf = fake.running.get("1-stage");
         newHalf.stats = cycles(10, 0);
-        look();
+        rig.look();
         for (int i = 0; i < 9; i++) { // 90 ms without a cycle: the contracts' heartbeat timeout is 100 ms
-            look();
+            rig.look();
         }
         assertFalse(f.isDone(), "rejected before its heartbeat timeout: " + rig.log);
-        look();
+        rig.look();
         rig.stepUntil("the outcome", f::isDone);
         assertTrue(f.join().refusal().startsWith("update stage: rejected in shadow after 10 cycles: it ran no cycle for "
                 + "100 ms (heartbeat timeout 100 ms); nothing changed"), f.join().text());
@@ -289,17 +242,17 @@ class CellShadowRunTest {
 
     @Test
     void aVersionTooSlowForItsShadowCyclesIsRejectedAfterFourTimesTheirPeriodsAndASecond() throws Exception {
-        runningCell();
+        rig.boundCell();
         CompletableFuture<ChangeSetResult> f = applyIntoShadow(update(200, 1000, List.of()));
         FakeLauncher.FakeHalf newHalf = fake.running.get("1-stage");
         // one cycle per look (10 ms): 200 cycles of 1 ms would take 2 s; the limit is 4 x 200 ms + 1 s
         for (int i = 1; i < 180; i++) {
             newHalf.stats = cycles(i, 0);
-            look();
+            rig.look();
         }
         assertFalse(f.isDone(), "rejected before its time: " + rig.log);
         newHalf.stats = cycles(180, 0);
-        look();
+        rig.look();
         rig.stepUntil("the outcome", f::isDone);
         assertTrue(f.join().refusal().startsWith("update stage: rejected in shadow after 180 cycles: it ran only 180 of "
                 + "its 200 shadow cycles in 1800 ms; nothing changed"), f.join().text());
@@ -307,14 +260,14 @@ class CellShadowRunTest {
 
     @Test
     void toleranceWithoutAnyValueOfTheSameSourceCycleFailsClosed() throws Exception {
-        runningCell();
+        rig.boundCell();
         CompletableFuture<ChangeSetResult> f = applyIntoShadow(update(100, 1000,
                 List.of(new ChangeSet.Tolerance("y", "value", 0.01))));
         FakeLauncher.FakeHalf newHalf = fake.running.get("1-stage");
         fake.values.put(OLD_Y, sample(500, 7_000, 1.0));
         fake.values.put(NEW_Y, sample(3, 9_000, 1.0)); // always another source cycle
         newHalf.stats = cycles(100, 0);
-        look();
+        rig.look();
         rig.stepUntil("the outcome", f::isDone);
         assertEquals("update stage: rejected in shadow after 100 cycles: no value of the same source cycle of both "
                 + "versions could be compared in 100 cycles (tolerances [y.value +-0.01]); nothing changed (pid "

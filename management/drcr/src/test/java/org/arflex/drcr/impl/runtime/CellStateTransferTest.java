@@ -1,16 +1,19 @@
 package org.arflex.drcr.impl.runtime;
 
+import static org.arflex.drcr.impl.runtime.UpdateRig.IN_SRC;
+import static org.arflex.drcr.impl.runtime.UpdateRig.IN_STAGE;
+import static org.arflex.drcr.impl.runtime.UpdateRig.OUT;
+import static org.arflex.drcr.impl.runtime.UpdateRig.parse;
 import static org.junit.jupiter.api.Assertions.assertEquals;
 import static org.junit.jupiter.api.Assertions.assertFalse;
 import static org.junit.jupiter.api.Assertions.assertTrue;
 
 import java.nio.file.Path;
-import java.util.concurrent.CompletableFuture;
+import java.util.List;
 import org.arflex.contract.Contract;
 import org.arflex.contract.ContractParser;
 import org.arflex.contract.PortTypes;
 import org.arflex.drcr.impl.abi.ControlBlock;
-import org.arflex.drcr.impl.lifecycle.ManualActor;
 import org.arflex.drcr.impl.lifecycle.State;
 import org.junit.jupiter.api.AfterEach;
 import org.junit.jupiter.api.Test;
@@ -24,19 +27,13 @@ import org.junit.jupiter.api.Test;
  */
 class CellStateTransferTest {
 
-    private static final String IN_SRC = "<in name=\"x\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\">"
-            + "<bind filter=\"(role=src)\"/></in>";
-    private static final String OUT = "<out name=\"y\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\"/>";
-    private static final String IN_STAGE = "<in name=\"x\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\">"
-            + "<bind filter=\"(role=stage)\"/></in>";
     private static final String TRAJ = "<state type=\"arflex.TrajectoryState\" typeVersion=\"1.0\"/>";
     private static final String TCP = "<state type=\"arflex.TcpCorrectionState\" typeVersion=\"1.0\"/>";
     private static final String TCP_FROM_TRAJ = "<state type=\"arflex.TcpCorrectionState\" typeVersion=\"1.0\">"
             + "<convertsFrom type=\"arflex.TrajectoryState\" typeVersion=\"1.0\"/></state>";
 
-    private final FakeLauncher fake = new FakeLauncher();
-    private final SteppedCell rig = new SteppedCell(fake, fake, true);
-    private final ManualActor actor = rig.actor;
+    private final UpdateRig rig = new UpdateRig();
+    private final FakeLauncher fake = rig.fake;
     private final Cell cell = rig.cell;
 
     @AfterEach
@@ -44,46 +41,12 @@ class CellStateTransferTest {
         rig.close(); // fails on any half or segment (state segments included) left behind
     }
 
-    private static Contract parse(String name, String role, String ports, String version, String state)
-            throws Exception {
-        String xml = CellChangeSetTest.contract(name, role, ports, "50us")
-                .replace("version=\"1.0.0\"", "version=\"" + version + "\"")
-                .replace("</component>", state + "</component>");
-        return ContractParser.create(PortTypes.builtin()).parse(xml, "test.xml");
-    }
-
-    private void install(Contract c) {
-        assertTrue(actor.call(() -> cell.install(c, c.name().hashCode(), Path.of("/nonexistent/" + c.name())), 0),
-                rig.log::toString);
-        rig.stepUntil(c.name() + " ACTIVE", () -> rig.state(c.name()) == State.ACTIVE);
-    }
-
     private void runningCell(String stageState) throws Exception {
-        install(parse("src", "src", OUT, "1.0.0", ""));
-        install(parse("stage", "stage", IN_SRC + OUT, "1.0.0", stageState));
-        install(parse("user", null, IN_STAGE, "1.0.0", ""));
+        rig.runningCell("50us", stageState);
     }
 
     private ChangeSet update(String state) throws Exception {
-        return ChangeSet.builder().update("stage", parse("stage", "stage", IN_SRC + OUT, "1.1.0", state),
-                Path.of("/nonexistent/stage-1.1"), "file:/x/stage-1.1.jar", 100).build();
-    }
-
-    private ChangeSetResult apply(ChangeSet set) {
-        CompletableFuture<ChangeSetResult> f = actor.call(() -> cell.applyChangeSet(set), 0);
-        rig.stepUntil("the change set's outcome", f::isDone);
-        return f.join();
-    }
-
-    private int index(String event) {
-        int i = fake.events.indexOf(event);
-        assertTrue(i >= 0, "no event '" + event + "' in " + fake.events);
-        return i;
-    }
-
-    private void watch() {
-        actor.advance(ChangeSetExecutor.WATCH_MS);
-        actor.runAll();
+        return UpdateRig.update(parse("stage", "stage", IN_SRC + OUT, "1.1.0", state), 100, 0, List.of());
     }
 
     @Test
@@ -92,17 +55,17 @@ class CellStateTransferTest {
         assertTrue(fake.openOutputs.containsKey("/arflex.t.stage.state"), fake.openOutputs::toString);
         assertTrue(fake.events.stream().anyMatch(e -> e.startsWith("CREATE /arflex.t.stage.state arflex.TrajectoryState ")),
                 fake.events::toString);
-        ChangeSetResult r = apply(update(TRAJ));
+        ChangeSetResult r = rig.apply(update(TRAJ));
         assertTrue(r.applied(), r.text());
-        int launched = index("1-stage LAUNCH");
-        int adopt = index("1-stage ADOPT /arflex.t.stage.state");
-        int started = index("1-stage START");
-        int moved = index("user BIND x /arflex.t.1-stage.out.y");
+        int launched = rig.index("1-stage LAUNCH");
+        int adopt = rig.index("1-stage ADOPT /arflex.t.stage.state");
+        int started = rig.index("1-stage START");
+        int moved = rig.index("user BIND x /arflex.t.1-stage.out.y");
         assertTrue(launched < adopt && adopt < started && started < moved, fake.events.toString());
         assertTrue(fake.openOutputs.containsKey("/arflex.t.1-stage.state"), "the new half publishes its own");
         assertTrue(fake.openOutputs.containsKey("/arflex.t.stage.state"), "the old half still publishes in the window");
         fake.running.get("1-stage").stats = new ControlBlock.Stats(100, 0, 0, 0, 0, 0, 0, 0, 0, 0);
-        watch();
+        rig.look();
         rig.stepUntil("the verdict", () -> r.verdict().isDone());
         assertTrue(r.verdict().join().startsWith("update stage: committed"), r.verdict().join());
         rig.stepUntil("the old state segment gone with the old half", () -> !fake.running.containsKey("stage")
@@ -112,11 +75,11 @@ class CellStateTransferTest {
     @Test
     void aDeclaredConversionIsAdmittedAndAdopts() throws Exception {
         runningCell(TRAJ);
-        ChangeSetResult r = apply(update(TCP_FROM_TRAJ));
+        ChangeSetResult r = rig.apply(update(TCP_FROM_TRAJ));
         assertTrue(r.applied(), r.text());
-        index("1-stage ADOPT /arflex.t.stage.state");
+        rig.index("1-stage ADOPT /arflex.t.stage.state");
         fake.running.get("1-stage").stats = new ControlBlock.Stats(100, 0, 0, 0, 0, 0, 0, 0, 0, 0);
-        watch();
+        rig.look();
         rig.stepUntil("the verdict", () -> r.verdict().isDone());
     }
 
@@ -124,12 +87,12 @@ class CellStateTransferTest {
     void aNewVersionWithAnotherStateTypeOrNoneIsRefusedByThePlanNamingBoth() throws Exception {
         runningCell(TRAJ);
         int before = fake.events.size();
-        ChangeSetResult other = apply(update(TCP));
+        ChangeSetResult other = rig.apply(update(TCP));
         assertFalse(other.applied());
         assertTrue(other.refusal().contains("update stage file:/x/stage-1.1.jar: state block: the running version 1.0.0 "
                 + "hands over arflex.TrajectoryState 1.0, the new version 1.1.0 takes arflex.TcpCorrectionState 1.0 and "
                 + "declares no conversion from arflex.TrajectoryState 1.0"), other.text());
-        ChangeSetResult none = apply(update(""));
+        ChangeSetResult none = rig.apply(update(""));
         assertFalse(none.applied());
         assertTrue(none.refusal().contains("state block: the running version 1.0.0 hands over arflex.TrajectoryState "
                 + "1.0, the new version 1.1.0 declares no state and would start from nothing"), none.text());
@@ -141,12 +104,12 @@ class CellStateTransferTest {
     void aVersionWithoutStateGetsNoAdoptAndAStatelessOneMayGainAState() throws Exception {
         runningCell("");
         assertFalse(fake.openOutputs.keySet().stream().anyMatch(n -> n.endsWith(".state")), fake.openOutputs::toString);
-        ChangeSetResult r = apply(update(TRAJ));
+        ChangeSetResult r = rig.apply(update(TRAJ));
         assertTrue(r.applied(), r.text());
         assertTrue(fake.events.stream().noneMatch(e -> e.contains(" ADOPT ")), "nothing to adopt: " + fake.events);
         assertTrue(fake.openOutputs.containsKey("/arflex.t.1-stage.state"));
         fake.running.get("1-stage").stats = new ControlBlock.Stats(100, 0, 0, 0, 0, 0, 0, 0, 0, 0);
-        watch();
+        rig.look();
         rig.stepUntil("the verdict", () -> r.verdict().isDone());
     }
 
@@ -161,17 +124,17 @@ class CellStateTransferTest {
         runningCell("");
         fake.running.get("stage").flags = ControlBlock.FLAG_RESET_REQUIRED;
         int before = fake.events.size();
-        ChangeSetResult r = apply(update(TRAJ));
+        ChangeSetResult r = rig.apply(update(TRAJ));
         assertFalse(r.applied(), r.text());
         assertTrue(r.refusal().contains("update stage file:/x/stage-1.1.jar: 'stage' awaits an operator reset and its "
                 + "running version 1.0.0 hands over no state block: a new half would start without the stop; reset it "
                 + "first, or update it outside a change set"), r.text());
         assertEquals(before, fake.events.size(), "nothing launched, created or bound: " + fake.events);
         fake.running.get("stage").flags = 0;
-        ChangeSetResult ok = apply(update(TRAJ));
+        ChangeSetResult ok = rig.apply(update(TRAJ));
         assertTrue(ok.applied(), "once reset it may be updated: " + ok.text());
         fake.running.get("1-stage").stats = new ControlBlock.Stats(100, 0, 0, 0, 0, 0, 0, 0, 0, 0);
-        watch();
+        rig.look();
         rig.stepUntil("the verdict", () -> ok.verdict().isDone());
     }
 
@@ -179,11 +142,11 @@ class CellStateTransferTest {
     void aLatchedRunningHalfWithStateIsUpdatedAndToldItsState() throws Exception {
         runningCell(TRAJ);
         fake.running.get("stage").flags = ControlBlock.FLAG_RESET_REQUIRED;
-        ChangeSetResult r = apply(update(TRAJ));
+        ChangeSetResult r = rig.apply(update(TRAJ));
         assertTrue(r.applied(), r.text());
-        index("1-stage ADOPT /arflex.t.stage.state");
+        rig.index("1-stage ADOPT /arflex.t.stage.state");
         fake.running.get("1-stage").stats = new ControlBlock.Stats(100, 0, 0, 0, 0, 0, 0, 0, 0, 0);
-        watch();
+        rig.look();
         rig.stepUntil("the verdict", () -> r.verdict().isDone());
     }
 
@@ -202,6 +165,14 @@ class CellStateTransferTest {
         return ContractParser.create(PortTypes.builtin()).parse(xml, "test.xml");
     }
 
+    /** src, guard, the moving stage 1.0.0 ({@code through}, {@code state}) and user, running. */
+    private void movingCell(String through, String state) throws Exception {
+        rig.install(parse("src", "src", OUT, "1.0.0", ""));
+        rig.install(parse("guard", "guard", OUT_SAFETY, "1.0.0", ""));
+        rig.install(moving("1.0.0", through, state));
+        rig.install(parse("user", null, IN_STAGE, "1.0.0", ""));
+    }
+
     /**
      * A component that moves hardware runs two halves side by side in an update's window only
      * when both versions send their motion through their outputs and both continue it from a
@@ -210,12 +181,9 @@ class CellStateTransferTest {
      */
     @Test
     void aMovingComponentThatDoesNotSayWhereItsMotionGoesDrivesItsDeviceAndIsNotUpdatedBesideIt() throws Exception {
-        install(parse("src", "src", OUT, "1.0.0", ""));
-        install(parse("guard", "guard", OUT_SAFETY, "1.0.0", ""));
-        install(moving("1.0.0", null, TRAJ));
-        install(parse("user", null, IN_STAGE, "1.0.0", ""));
+        movingCell(null, TRAJ);
         int before = fake.events.size();
-        ChangeSetResult device = apply(ChangeSet.builder().update("stage", moving("1.1.0", "outputs", TRAJ),
+        ChangeSetResult device = rig.apply(ChangeSet.builder().update("stage", moving("1.1.0", "outputs", TRAJ),
                 Path.of("/nonexistent/stage-1.1"), "file:/x/stage-1.1.jar", 100).build());
         assertFalse(device.applied(), device.text());
         assertTrue(device.refusal().contains("'stage' moves hardware: version 1.0.0 drives its device itself "
@@ -227,37 +195,31 @@ class CellStateTransferTest {
     @Test
     void aMovingComponentsNewVersionThatDrivesADeviceOrHasNoStateIsRefusedThroughOutputsWithStateIsCommitted()
             throws Exception {
-        install(parse("src", "src", OUT, "1.0.0", ""));
-        install(parse("guard", "guard", OUT_SAFETY, "1.0.0", ""));
-        install(moving("1.0.0", "outputs", TRAJ));
-        install(parse("user", null, IN_STAGE, "1.0.0", ""));
+        movingCell("outputs", TRAJ);
         int before = fake.events.size();
-        ChangeSetResult device = apply(ChangeSet.builder().update("stage", moving("1.1.0", "device", TRAJ),
+        ChangeSetResult device = rig.apply(ChangeSet.builder().update("stage", moving("1.1.0", "device", TRAJ),
                 Path.of("/nonexistent/stage-1.1"), "file:/x/stage-1.1.jar", 100).build());
         assertFalse(device.applied(), device.text());
         assertTrue(device.refusal().contains("version 1.1.0 drives its device itself"), device.text());
-        ChangeSetResult unsaid = apply(ChangeSet.builder().update("stage", moving("1.1.0", null, TRAJ),
+        ChangeSetResult unsaid = rig.apply(ChangeSet.builder().update("stage", moving("1.1.0", null, TRAJ),
                 Path.of("/nonexistent/stage-1.1"), "file:/x/stage-1.1.jar", 100).build());
         assertFalse(unsaid.applied(), unsaid.text());
         assertTrue(unsaid.refusal().contains("version 1.1.0 drives its device itself"), unsaid.text());
         assertEquals(before, fake.events.size(), "nothing launched, created or bound: " + fake.events);
-        ChangeSetResult through = apply(ChangeSet.builder().update("stage", moving("1.1.0", "outputs", TRAJ),
+        ChangeSetResult through = rig.apply(ChangeSet.builder().update("stage", moving("1.1.0", "outputs", TRAJ),
                 Path.of("/nonexistent/stage-1.1"), "file:/x/stage-1.1.jar", 100).build());
         assertTrue(through.applied(), through.text());
-        index("1-stage ADOPT /arflex.t.stage.state");
+        rig.index("1-stage ADOPT /arflex.t.stage.state");
         fake.running.get("1-stage").stats = new ControlBlock.Stats(100, 0, 0, 0, 0, 0, 0, 0, 0, 0);
-        watch();
+        rig.look();
         rig.stepUntil("the verdict", () -> through.verdict().isDone());
         assertTrue(through.verdict().join().startsWith("update stage: committed"), through.verdict().join());
     }
 
     @Test
     void aMovingComponentWithoutStateIsNotUpdatedBesideItsOldHalf() throws Exception {
-        install(parse("src", "src", OUT, "1.0.0", ""));
-        install(parse("guard", "guard", OUT_SAFETY, "1.0.0", ""));
-        install(moving("1.0.0", "outputs", ""));
-        install(parse("user", null, IN_STAGE, "1.0.0", ""));
-        ChangeSetResult r = apply(ChangeSet.builder().update("stage", moving("1.1.0", "outputs", ""),
+        movingCell("outputs", "");
+        ChangeSetResult r = rig.apply(ChangeSet.builder().update("stage", moving("1.1.0", "outputs", ""),
                 Path.of("/nonexistent/stage-1.1"), "file:/x/stage-1.1.jar", 100).build());
         assertFalse(r.applied(), r.text());
         assertTrue(r.refusal().contains("'stage' moves hardware: version 1.0.0 declares no state block (§12.1): a new "
@@ -269,7 +231,7 @@ class CellStateTransferTest {
         runningCell(TRAJ);
         FakeLauncher.FakeHalf old = fake.running.get("stage");
         fake.refuseAdopt.put("1-stage", "ADOPT refused by 1-stage: status -95");
-        ChangeSetResult r = apply(update(TRAJ));
+        ChangeSetResult r = rig.apply(update(TRAJ));
         assertFalse(r.applied());
         assertTrue(r.refusal().startsWith("preparation failed, nothing changed: preparing 'stage': its state block: "
                 + "ADOPT refused by 1-stage: status -95"), r.text());
@@ -284,7 +246,7 @@ class CellStateTransferTest {
     void aRollbackHandsNothingBackTheOldHalfKeptPublishing() throws Exception {
         runningCell(TRAJ);
         FakeLauncher.FakeHalf old = fake.running.get("stage");
-        ChangeSetResult r = apply(update(TRAJ));
+        ChangeSetResult r = rig.apply(update(TRAJ));
         assertTrue(r.applied(), r.text());
         int mark = fake.events.size();
         fake.running.get("1-stage").crash(139, "killed by signal 11");

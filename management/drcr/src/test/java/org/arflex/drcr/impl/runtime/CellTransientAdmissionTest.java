@@ -1,18 +1,15 @@
 package org.arflex.drcr.impl.runtime;
 
+import static org.arflex.drcr.impl.runtime.UpdateRig.IN_SRC;
+import static org.arflex.drcr.impl.runtime.UpdateRig.OUT;
 import static org.junit.jupiter.api.Assertions.assertEquals;
 import static org.junit.jupiter.api.Assertions.assertFalse;
 import static org.junit.jupiter.api.Assertions.assertNotNull;
 import static org.junit.jupiter.api.Assertions.assertTrue;
 
-import java.nio.file.Path;
 import java.util.List;
-import java.util.concurrent.CompletableFuture;
 import org.arflex.contract.Contract;
-import org.arflex.contract.ContractParser;
-import org.arflex.contract.PortTypes;
 import org.arflex.drcr.impl.lifecycle.ManualActor;
-import org.arflex.drcr.impl.lifecycle.State;
 import org.junit.jupiter.api.AfterEach;
 import org.junit.jupiter.api.Test;
 
@@ -28,14 +25,8 @@ import org.junit.jupiter.api.Test;
  */
 class CellTransientAdmissionTest {
 
-    private static final String IN_SRC = "<in name=\"x\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\">"
-            + "<bind filter=\"(role=src)\"/></in>";
-    private static final String OUT = "<out name=\"y\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\"/>";
-    private static final String IN_STAGE = "<in name=\"x\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\">"
-            + "<bind filter=\"(role=stage)\"/></in>";
-
-    private final FakeLauncher fake = new FakeLauncher();
-    private final SteppedCell rig = new SteppedCell(fake, fake, true);
+    private final UpdateRig rig = new UpdateRig();
+    private final FakeLauncher fake = rig.fake;
     private final ManualActor actor = rig.actor;
     private final Cell cell = rig.cell;
 
@@ -45,22 +36,12 @@ class CellTransientAdmissionTest {
     }
 
     private static Contract parse(String name, String role, String ports, String version, String wcet) throws Exception {
-        String xml = CellChangeSetTest.contract(name, role, ports, wcet).replace("version=\"1.0.0\"",
-                "version=\"" + version + "\"");
-        return ContractParser.create(PortTypes.builtin()).parse(xml, "test.xml");
-    }
-
-    private void install(Contract c) {
-        assertTrue(actor.call(() -> cell.install(c, c.name().hashCode(), Path.of("/nonexistent/" + c.name())), 0),
-                rig.log::toString);
-        rig.stepUntil(c.name() + " ACTIVE", () -> rig.state(c.name()) == State.ACTIVE);
+        return UpdateRig.parse(name, role, ports, version, wcet, "");
     }
 
     /** src and user take 50 us each, stage {@code wcet}: stage has a CPU of its own (worst fit). */
     private int runningCell(String wcet) throws Exception {
-        install(parse("src", "src", OUT, "1.0.0", "50us"));
-        install(parse("stage", "stage", IN_SRC + OUT, "1.0.0", wcet));
-        install(parse("user", null, IN_STAGE, "1.0.0", "50us"));
+        rig.runningCell(wcet, "");
         int cpu = cell.planner().cpuAssignment().get("stage");
         assertNotEquals(cell.planner().cpuAssignment().get("src"), cpu);
         assertNotEquals(cell.planner().cpuAssignment().get("user"), cpu);
@@ -72,9 +53,7 @@ class CellTransientAdmissionTest {
     }
 
     private ChangeSet update(String wcet, long window, long shadow) throws Exception {
-        return ChangeSet.builder().update("stage", parse("stage", "stage", IN_SRC + OUT, "1.1.0", wcet),
-                Path.of("/nonexistent/stage-1.1"), "file:/x/stage-1.1.jar", window, List.of(), shadow, List.of())
-                .build();
+        return UpdateRig.update(parse("stage", "stage", IN_SRC + OUT, "1.1.0", wcet), window, shadow, List.of());
     }
 
     @Test
@@ -93,9 +72,7 @@ class CellTransientAdmissionTest {
                 + "    shadow (50 cycles)  U=1.20/1.00  not schedulable  stage, stage (new)\n"
                 + "    window (100 cycles)  U=1.20/1.00  not schedulable  stage, stage (old)\n"), dry.text());
         // applied: refused the same, nothing spawned, bound or created, the old half runs on
-        CompletableFuture<ChangeSetResult> f = actor.call(() -> cell.applyChangeSet(update("600us", 100, 50)), 0);
-        rig.stepUntil("the change set's outcome", f::isDone);
-        ChangeSetResult r = f.join();
+        ChangeSetResult r = rig.apply(update("600us", 100, 50));
         assertFalse(r.applied(), r.text());
         assertEquals(shadow + "; " + window, r.refusal());
         assertEquals(before, fake.events.size(), fake.events::toString);

@@ -1,5 +1,9 @@
 package org.arflex.drcr.impl.runtime;
 
+import static org.arflex.drcr.impl.runtime.UpdateRig.IN_SRC;
+import static org.arflex.drcr.impl.runtime.UpdateRig.OUT;
+import static org.arflex.drcr.impl.runtime.UpdateRig.cycles;
+import static org.arflex.drcr.impl.runtime.UpdateRig.parse;
 import static org.junit.jupiter.api.Assertions.assertEquals;
 import static org.junit.jupiter.api.Assertions.assertFalse;
 import static org.junit.jupiter.api.Assertions.assertNotNull;
@@ -8,11 +12,7 @@ import static org.junit.jupiter.api.Assertions.assertTrue;
 import java.nio.file.Path;
 import java.util.List;
 import java.util.Set;
-import java.util.concurrent.CompletableFuture;
 import org.arflex.contract.Contract;
-import org.arflex.contract.ContractParser;
-import org.arflex.contract.PortTypes;
-import org.arflex.drcr.impl.abi.ControlBlock;
 import org.arflex.drcr.impl.lifecycle.ManualActor;
 import org.arflex.drcr.impl.lifecycle.State;
 import org.junit.jupiter.api.AfterEach;
@@ -31,14 +31,8 @@ import org.junit.jupiter.api.Test;
  */
 class CellUpdateSetTest {
 
-    private static final String IN_SRC = "<in name=\"x\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\">"
-            + "<bind filter=\"(role=src)\"/></in>";
-    private static final String OUT = "<out name=\"y\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\"/>";
-    private static final String IN_STAGE = "<in name=\"x\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\">"
-            + "<bind filter=\"(role=stage)\"/></in>";
-
-    private final FakeLauncher fake = new FakeLauncher();
-    private final SteppedCell rig = new SteppedCell(fake, fake, true);
+    private final UpdateRig rig = new UpdateRig();
+    private final FakeLauncher fake = rig.fake;
     private final ManualActor actor = rig.actor;
     private final Cell cell = rig.cell;
 
@@ -47,55 +41,13 @@ class CellUpdateSetTest {
         rig.close();
     }
 
-    private static Contract parse(String name, String role, String ports, String version) throws Exception {
-        String xml = CellChangeSetTest.contract(name, role, ports, "50us").replace("version=\"1.0.0\"",
-                "version=\"" + version + "\"");
-        return ContractParser.create(PortTypes.builtin()).parse(xml, "test.xml");
-    }
-
-    private void install(Contract c) {
-        assertTrue(actor.call(() -> cell.install(c, c.name().hashCode(), Path.of("/nonexistent/" + c.name())), 0),
-                rig.log::toString);
-        rig.stepUntil(c.name() + " ACTIVE", () -> rig.state(c.name()) == State.ACTIVE);
-    }
-
-    private void runningCell() throws Exception {
-        install(parse("src", "src", OUT, "1.0.0"));
-        install(parse("stage", "stage", IN_SRC + OUT, "1.0.0"));
-        install(parse("user", null, IN_STAGE, "1.0.0"));
-        assertTrue(fake.events.contains("user BIND x /arflex.t.stage.out.y"), fake.events::toString);
-    }
-
     private ChangeSet update(long window) throws Exception {
-        return ChangeSet.builder().update("stage", parse("stage", "stage", IN_SRC + OUT, "1.1.0"),
-                Path.of("/nonexistent/stage-1.1"), "file:/x/stage-1.1.jar", window).build();
-    }
-
-    private ChangeSetResult apply(ChangeSet set) {
-        CompletableFuture<ChangeSetResult> f = actor.call(() -> cell.applyChangeSet(set), 0);
-        rig.stepUntil("the change set's outcome", f::isDone);
-        return f.join();
-    }
-
-    private int index(String event) {
-        int i = fake.events.indexOf(event);
-        assertTrue(i >= 0, "no event '" + event + "' in " + fake.events);
-        return i;
-    }
-
-    private static ControlBlock.Stats cycles(long n, long overruns) {
-        return new ControlBlock.Stats(n, overruns, 0, 0, 0, 0, 0, 0, 0, 0);
-    }
-
-    /** Lets the window's watch run: the actor's clock advances and its timers fire. */
-    private void watch() {
-        actor.advance(ChangeSetExecutor.WATCH_MS);
-        actor.runAll();
+        return UpdateRig.update(parse("stage", "stage", IN_SRC + OUT, "1.1.0"), window, 0, List.of());
     }
 
     @Test
     void theDryRunOfAnUpdateIsAdmittedAndLaunchesNothing() throws Exception {
-        runningCell();
+        rig.boundCell();
         int before = fake.events.size();
         ChangeSetResult r = actor.call(() -> cell.planChangeSet(update(100)), 0);
         assertTrue(r.admitted(), r.text());
@@ -105,19 +57,19 @@ class CellUpdateSetTest {
 
     @Test
     void anUpdateRunsBesideTheOldHalfSwitchesWithBindsAndStopsTheOldAfterTheWindow() throws Exception {
-        runningCell();
+        rig.boundCell();
         FakeLauncher.FakeHalf oldHalf = fake.running.get("stage");
-        ChangeSetResult r = apply(update(100));
+        ChangeSetResult r = rig.apply(update(100));
         assertTrue(r.applied(), r.text());
         assertNotNull(r.verdict());
         // the new version runs under its generation's id, beside the old one
         FakeLauncher.FakeHalf newHalf = fake.running.get("1-stage");
         assertNotNull(newHalf, () -> "new half under 1-stage: " + fake.running.keySet() + "\n" + rig.log + "\n" + fake.events);
         assertTrue(fake.running.containsKey("stage"), "the old half is kept warm");
-        int launched = index("1-stage LAUNCH");
-        int bound = index("1-stage BIND x /arflex.t.src.out.y");
-        int started = index("1-stage START");
-        int moved = index("user BIND x /arflex.t.1-stage.out.y");
+        int launched = rig.index("1-stage LAUNCH");
+        int bound = rig.index("1-stage BIND x /arflex.t.src.out.y");
+        int started = rig.index("1-stage START");
+        int moved = rig.index("user BIND x /arflex.t.1-stage.out.y");
         assertTrue(launched < bound && bound < started && started < moved, fake.events.toString());
         assertFalse(fake.events.contains("user UNBIND x"), fake.events::toString);
         assertFalse(fake.events.contains("stage SHUTDOWN"), "the old half is not stopped in the window");
@@ -129,22 +81,22 @@ class CellUpdateSetTest {
         assertTrue(during.refusal().contains("is in its rollback window"), during.text());
         // the window: 100 cycles of the new half
         newHalf.stats = cycles(60, 0);
-        watch();
+        rig.look();
         assertFalse(r.verdict().isDone());
         newHalf.stats = cycles(100, 0);
-        watch();
+        rig.look();
         rig.stepUntil("the verdict", () -> r.verdict().isDone());
         assertTrue(r.verdict().join().startsWith("update stage: committed: the new version ran 100 cycles"),
                 r.verdict().join());
         rig.stepUntil("the old half stopped and its segment gone", () -> !fake.running.containsKey("stage")
                 && !fake.openOutputs.containsKey("/arflex.t.stage.out.y"));
         assertTrue(oldHalf.cleaned);
-        assertTrue(index("stage SHUTDOWN") > moved);
+        assertTrue(rig.index("stage SHUTDOWN") > moved);
         assertEquals(oldHalf.pid == newHalf.pid ? -1 : newHalf.pid, cell.instance("stage").orElseThrow().half.pid());
         assertEquals(Set.of("src", "stage", "user"), cell.planner().active());
         assertEquals(State.ACTIVE, rig.state("user"));
         // a second update takes the next generation
-        ChangeSetResult again = apply(update(0));
+        ChangeSetResult again = rig.apply(update(0));
         assertTrue(again.applied(), again.text());
         rig.stepUntil("the second verdict", () -> again.verdict().isDone());
         assertTrue(fake.events.contains("user BIND x /arflex.t.2-stage.out.y"), fake.events::toString);
@@ -154,15 +106,15 @@ class CellUpdateSetTest {
 
     @Test
     void aNewVersionThatCrashesInItsWindowIsRolledBackWithoutARestart() throws Exception {
-        runningCell();
+        rig.boundCell();
         FakeLauncher.FakeHalf oldHalf = fake.running.get("stage");
         FakeLauncher.FakeHalf src = fake.running.get("src");
         FakeLauncher.FakeHalf user = fake.running.get("user");
-        ChangeSetResult r = apply(update(1000));
+        ChangeSetResult r = rig.apply(update(1000));
         assertTrue(r.applied(), r.text());
         FakeLauncher.FakeHalf newHalf = fake.running.get("1-stage");
         newHalf.stats = cycles(50, 0);
-        watch();
+        rig.look();
         int mark = fake.events.size();
         newHalf.crash(139, "killed by signal 11");
         rig.stepUntil("the verdict", () -> r.verdict().isDone());
@@ -199,13 +151,13 @@ class CellUpdateSetTest {
      */
     @Test
     void aNewVersionWhoseStartIsRefusedAtTheSwitchHandsBackToTheOldHalf() throws Exception {
-        runningCell();
+        rig.boundCell();
         FakeLauncher.FakeHalf oldHalf = fake.running.get("stage");
         FakeLauncher.FakeHalf src = fake.running.get("src");
         FakeLauncher.FakeHalf user = fake.running.get("user");
         fake.refuseStart.add("1-stage");
         int mark = fake.events.size();
-        ChangeSetResult r = apply(update(1000));
+        ChangeSetResult r = rig.apply(update(1000));
         assertTrue(r.applied(), r.text());
         rig.stepUntil("the verdict", () -> r.verdict().isDone());
         String v = r.verdict().join();
@@ -234,16 +186,16 @@ class CellUpdateSetTest {
 
     @Test
     void aNewVersionThatOverrunsInItsWindowIsRolledBackAndStopped() throws Exception {
-        runningCell();
+        rig.boundCell();
         FakeLauncher.FakeHalf oldHalf = fake.running.get("stage");
         oldHalf.stats = cycles(5000, 1);
-        ChangeSetResult r = apply(update(1000));
+        ChangeSetResult r = rig.apply(update(1000));
         FakeLauncher.FakeHalf newHalf = fake.running.get("1-stage");
         newHalf.stats = cycles(10, 0);
-        watch();
+        rig.look();
         oldHalf.stats = cycles(5030, 1);
         newHalf.stats = cycles(40, 3 + ChangeSetExecutor.OVERRUN_ALLOWANCE);
-        watch();
+        rig.look();
         rig.stepUntil("the verdict", () -> r.verdict().isDone());
         assertTrue(r.verdict().join().contains("the new version overran or missed its deadline in "
                 + (3 + ChangeSetExecutor.OVERRUN_ALLOWANCE) + " of its first 40 cycles (the old one, on the same inputs: 0)"),
@@ -252,45 +204,44 @@ class CellUpdateSetTest {
                 && !fake.openOutputs.containsKey("/arflex.t.1-stage.out.y"));
         assertTrue(fake.events.contains("1-stage SHUTDOWN"), fake.events::toString);
         assertEquals(oldHalf.pid, cell.instance("stage").orElseThrow().half.pid());
-        assertTrue(index("user BIND x /arflex.t.stage.out.y") < index("1-stage SHUTDOWN"),
+        assertTrue(rig.index("user BIND x /arflex.t.stage.out.y") < rig.index("1-stage SHUTDOWN"),
                 "the consumer is back on the old half before the new one stops: " + fake.events);
     }
 
     /** An arflex.Sample payload: seq, t_ns, value. */
     private static byte[] sample(double value) {
-        return java.nio.ByteBuffer.allocate(24).order(java.nio.ByteOrder.LITTLE_ENDIAN).putLong(7).putLong(1000)
-                .putDouble(value).array();
+        return UpdateRig.sample(7, 1000, value);
     }
 
     @Test
     void aNewVersionWhoseOutputLeavesItsEnvelopeIsRolledBack() throws Exception {
-        runningCell();
+        rig.boundCell();
         FakeLauncher.FakeHalf oldHalf = fake.running.get("stage");
         ChangeSet set = ChangeSet.builder().update("stage", parse("stage", "stage", IN_SRC + OUT, "1.1.0"),
                 Path.of("/nonexistent/stage-1.1"), "file:/x/stage-1.1.jar", 1000,
                 java.util.List.of(new ChangeSet.Envelope("y", "value", -1, 1))).build();
-        ChangeSetResult r = apply(set);
+        ChangeSetResult r = rig.apply(set);
         assertTrue(r.applied(), r.text());
         FakeLauncher.FakeHalf newHalf = fake.running.get("1-stage");
         newHalf.stats = cycles(20, 0);
         fake.values.put("/arflex.t.1-stage.out.y", sample(0.5));
-        watch();
+        rig.look();
         assertFalse(r.verdict().isDone(), "inside its envelope: " + rig.log);
         newHalf.stats = cycles(30, 0);
         fake.values.put("/arflex.t.1-stage.out.y", sample(5.0));
-        watch();
+        rig.look();
         rig.stepUntil("the verdict", () -> r.verdict().isDone());
         assertTrue(r.verdict().join().contains("rolled back after 30 cycles of the new version (file:/x/stage-1.1.jar): "
                 + "output y.value = 5.0 left the envelope [-1.0, 1.0] declared for the update;"), r.verdict().join());
         assertEquals(oldHalf.pid, cell.instance("stage").orElseThrow().half.pid());
         rig.stepUntil("the new half stopped", () -> !fake.running.containsKey("1-stage")
                 && !fake.openOutputs.containsKey("/arflex.t.1-stage.out.y"));
-        assertTrue(index("user BIND x /arflex.t.stage.out.y") < index("1-stage SHUTDOWN"), fake.events::toString);
+        assertTrue(rig.index("user BIND x /arflex.t.stage.out.y") < rig.index("1-stage SHUTDOWN"), fake.events::toString);
     }
 
     @Test
     void anEnvelopeOnAnUnknownOutputOrFieldIsRefused() throws Exception {
-        runningCell();
+        rig.boundCell();
         Contract next = parse("stage", "stage", IN_SRC + OUT, "1.1.0");
         ChangeSetResult port = actor.call(() -> cell.planChangeSet(ChangeSet.builder().update("stage", next, Path.of("/x"),
                 "file:/x.jar", 10, java.util.List.of(new ChangeSet.Envelope("z", "value", 0, 1))).build()), 0);
@@ -304,8 +255,8 @@ class CellUpdateSetTest {
 
     @Test
     void anUninstallInTheWindowStopsBothHalves() throws Exception {
-        runningCell();
-        ChangeSetResult r = apply(update(1000));
+        rig.boundCell();
+        ChangeSetResult r = rig.apply(update(1000));
         assertTrue(r.applied(), r.text());
         actor.call(() -> cell.uninstall("stage", "test"), 0);
         rig.stepUntil("the verdict", () -> r.verdict().isDone());
@@ -314,7 +265,7 @@ class CellUpdateSetTest {
 
     @Test
     void anUpdateWhoseContractIsOfAnotherComponentIsRefused() throws Exception {
-        runningCell();
+        rig.boundCell();
         int before = fake.events.size();
         ChangeSetResult r = actor.call(() -> cell.planChangeSet(ChangeSet.builder().update("stage",
                 parse("other", "stage", IN_SRC + OUT, "1.1.0"), Path.of("/x"), "file:/x.jar", 10).build()), 0);

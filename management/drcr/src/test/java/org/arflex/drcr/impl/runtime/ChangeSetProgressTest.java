@@ -1,25 +1,25 @@
 package org.arflex.drcr.impl.runtime;
 
+import static org.arflex.drcr.impl.runtime.UpdateRig.IN_SRC;
+import static org.arflex.drcr.impl.runtime.UpdateRig.NEW_Y;
+import static org.arflex.drcr.impl.runtime.UpdateRig.OLD_Y;
+import static org.arflex.drcr.impl.runtime.UpdateRig.OUT;
+import static org.arflex.drcr.impl.runtime.UpdateRig.parse;
+import static org.arflex.drcr.impl.runtime.UpdateRig.sample;
 import static org.junit.jupiter.api.Assertions.assertArrayEquals;
 import static org.junit.jupiter.api.Assertions.assertEquals;
 import static org.junit.jupiter.api.Assertions.assertFalse;
 import static org.junit.jupiter.api.Assertions.assertNull;
 import static org.junit.jupiter.api.Assertions.assertTrue;
 
-import java.nio.ByteBuffer;
-import java.nio.ByteOrder;
 import java.nio.file.Path;
 import java.util.ArrayList;
 import java.util.List;
 import java.util.concurrent.CompletableFuture;
 import java.util.concurrent.atomic.AtomicLong;
-import org.arflex.contract.Contract;
-import org.arflex.contract.ContractParser;
-import org.arflex.contract.PortTypes;
 import org.arflex.drcr.dto.ChangeSetProgressDTO;
 import org.arflex.drcr.impl.abi.ControlBlock;
 import org.arflex.drcr.impl.lifecycle.ManualActor;
-import org.arflex.drcr.impl.lifecycle.State;
 import org.junit.jupiter.api.AfterEach;
 import org.junit.jupiter.api.Test;
 
@@ -32,16 +32,8 @@ import org.junit.jupiter.api.Test;
  */
 class ChangeSetProgressTest {
 
-    private static final String IN_SRC = "<in name=\"x\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\">"
-            + "<bind filter=\"(role=src)\"/></in>";
-    private static final String OUT = "<out name=\"y\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\"/>";
-    private static final String IN_STAGE = "<in name=\"x\" type=\"arflex.Sample\" typeVersion=\"1.0\" method=\"state\">"
-            + "<bind filter=\"(role=stage)\"/></in>";
-    private static final String OLD_Y = "/arflex.t.stage.out.y";
-    private static final String NEW_Y = "/arflex.t.1-stage.out.y";
-
-    private final FakeLauncher fake = new FakeLauncher();
-    private final SteppedCell rig = new SteppedCell(fake, fake, true);
+    private final UpdateRig rig = new UpdateRig();
+    private final FakeLauncher fake = rig.fake;
     private final ManualActor actor = rig.actor;
     private final Cell cell = rig.cell;
     /** Every distinct snapshot seen between steps, in order. */
@@ -52,36 +44,17 @@ class ChangeSetProgressTest {
         rig.close();
     }
 
-    private static Contract parse(String name, String role, String ports, String version) throws Exception {
-        String xml = CellChangeSetTest.contract(name, role, ports, "50us").replace("version=\"1.0.0\"",
-                "version=\"" + version + "\"");
-        return ContractParser.create(PortTypes.builtin()).parse(xml, "test.xml");
-    }
-
-    private void install(Contract c) {
-        assertTrue(actor.call(() -> cell.install(c, c.name().hashCode(), Path.of("/nonexistent/" + c.name())), 0),
-                rig.log::toString);
-        rig.stepUntil(c.name() + " ACTIVE", () -> rig.state(c.name()) == State.ACTIVE);
-    }
-
     private void runningCell() throws Exception {
-        install(parse("src", "src", OUT, "1.0.0"));
-        install(parse("stage", "stage", IN_SRC + OUT, "1.0.0"));
-        install(parse("user", null, IN_STAGE, "1.0.0"));
+        rig.runningCell("50us", "");
     }
 
     private ChangeSet update(long shadow, long window) throws Exception {
-        return ChangeSet.builder().update("stage", parse("stage", "stage", IN_SRC + OUT, "1.1.0"),
-                Path.of("/nonexistent/stage-1.1"), "file:/x/stage-1.1.jar", window, List.of(), shadow,
-                List.of(new ChangeSet.Tolerance("y", "value", 0.01))).build();
+        return UpdateRig.update(parse("stage", "stage", IN_SRC + OUT, "1.1.0"), window, shadow,
+                List.of(new ChangeSet.Tolerance("y", "value", 0.01)));
     }
 
     private static ControlBlock.Stats cycles(long n) {
-        return new ControlBlock.Stats(n, 0, 0, 0, 0, 0, 0, 0, 0, 0);
-    }
-
-    private static byte[] sample(long seq, long tNs, double value) {
-        return ByteBuffer.allocate(24).order(ByteOrder.LITTLE_ENDIAN).putLong(seq).putLong(tNs).putDouble(value).array();
+        return UpdateRig.cycles(n, 0);
     }
 
     /** The snapshot now, as a reader off the actor gets it; recorded when it moved. */
@@ -95,17 +68,12 @@ class ChangeSetProgressTest {
     }
 
     private void look() {
-        actor.advance(ChangeSetExecutor.WATCH_MS);
-        actor.runAll();
+        rig.look();
         now();
     }
 
     private CompletableFuture<ChangeSetResult> applyIntoShadow(ChangeSet set) {
-        CompletableFuture<ChangeSetResult> f = actor.call(() -> cell.applyChangeSet(set), 0);
-        rig.stepUntil("the new half started in shadow", () -> {
-            now();
-            return fake.events.contains("1-stage START") || f.isDone();
-        });
+        CompletableFuture<ChangeSetResult> f = rig.applyIntoShadow(set, this::now);
         now();
         return f;
     }

@@ -23,9 +23,11 @@ import org.arflex.planner.Planner;
 /**
  * A cell on the steppable actor with real stop threads and, when asked, real launch threads
  * (issue 17: what runs off the actor). Tests step the actor until a condition holds, with a
- * deadline, and end with {@link #close}, which checks that nothing was left behind.
+ * deadline, and end with {@link #close}, which checks that nothing was left behind. Its helpers
+ * install, apply a change set, let the actor's timers fire and find the fake's events, as the
+ * cell tests do; {@link UpdateRig} is the cell of the update tests on it.
  */
-final class SteppedCell implements AutoCloseable {
+class SteppedCell implements AutoCloseable {
 
     final ManualActor actor = new ManualActor();
     final FakeLauncher fake;
@@ -43,11 +45,44 @@ final class SteppedCell implements AutoCloseable {
                 launches != null ? launches : Runnable::run);
     }
 
+    /** Installs {@code name} with CellTest's contract of {@code ports} and runs the actor. */
     void install(String name, String ports) throws Exception {
         Contract c = ContractParser.create(PortTypes.builtin()).parse(
                 CellTest.contract(name, ports, CellTest.PERMANENT, false, 5, "50us"), "test.xml");
         assertTrue(actor.call(() -> cell.install(c, name.hashCode(), Path.of("/nonexistent/" + name)), 0), log::toString);
         actor.runAll();
+    }
+
+    /** Installs {@code c} and steps until it is ACTIVE. */
+    void install(Contract c) {
+        assertTrue(actor.call(() -> cell.install(c, c.name().hashCode(), Path.of("/nonexistent/" + c.name())), 0),
+                log::toString);
+        stepUntil(c.name() + " ACTIVE", () -> state(c.name()) == State.ACTIVE);
+    }
+
+    /** Applies {@code set} and steps until its outcome. */
+    ChangeSetResult apply(ChangeSet set) {
+        CompletableFuture<ChangeSetResult> f = actor.call(() -> cell.applyChangeSet(set), 0);
+        stepUntil("the change set's outcome", f::isDone);
+        return f.join();
+    }
+
+    /** Lets a shadow run's look or a window's watch run: the actor's clock advances and its timers fire. */
+    void look() {
+        actor.advance(ChangeSetExecutor.WATCH_MS);
+        actor.runAll();
+    }
+
+    /** Where {@code event} is in the fake's events; fails when it is not there. */
+    int index(String event) {
+        int i = fake.events.indexOf(event);
+        assertTrue(i >= 0, "no event '" + event + "' in " + fake.events);
+        return i;
+    }
+
+    /** The fake's events since {@code mark}. */
+    List<String> since(int mark) {
+        return fake.events.subList(mark, fake.events.size());
     }
 
     State state(String n) {
