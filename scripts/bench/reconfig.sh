@@ -39,7 +39,7 @@ fi
 set +e
 mvn -B -o -Darflex.native.skip=true -Darflex.native.tests.skip=true -pl tests verify \
   -Dtest=none -Dsurefire.failIfNoSpecifiedTests=false -Dit.test=ReconfigBench -Dfailsafe.failIfNoSpecifiedTests=false \
-  -Darflex.bench.sets="$sets" -Darflex.it.mlock="$mlock" -Darflex.it.jvmcpus="$jvmcpus" -Darflex.bench.out="$ROOT/target/bench/reconfig.json" >"$log" 2>&1
+  -Darflex.bench.sets="$sets" -Darflex.it.mlock="$mlock" -Darflex.it.jvmcpus="$jvmcpus" -Darflex.bench.shield="$shield" -Darflex.bench.poll="$([ -n "$poll" ] && echo true || echo false)" -Darflex.bench.out="$ROOT/target/bench/reconfig.json" >"$log" 2>&1
 status=$?
 set -e
 if [ -n "$shield" ]; then

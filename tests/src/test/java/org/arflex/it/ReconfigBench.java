@@ -459,10 +459,13 @@ class ReconfigBench {
         for (Row r : rows) {
             sb.append(sb.length() == 0 ? "" : ",\n").append(r.json(rate));
         }
-        Files.writeString(out, String.format(Locale.ROOT, "{\"mlock\":%b,\"sets\":%d,\"missed_cycles\":%d,\"safe_stops\":%d,"
+        Files.writeString(out, String.format(Locale.ROOT, "{\"mlock\":%b,\"shield_cpus\":\"%s\",\"poll\":%b,"
+                + "\"jvm_cpus\":\"%s\",\"sets\":%d,\"missed_cycles\":%d,\"safe_stops\":%d,"
                 + "\"resets\":%d,\"restarts\":%d,\"max_jump_rad\":%.6g,\"jump_bound_rad\":%.6g,\"quiet_releases\":%d,"
                 + "\"quiet_missed\":%d,\"switch_releases\":%d,\"switch_missed\":%d,\"missed_per_set_floored_sum\":%d,"
-                + "\"spurious_rollbacks\":%d,\"rows\":[\n%s]}%n", Boolean.getBoolean("arflex.it.mlock"), rows.size(), m, x,
+                + "\"spurious_rollbacks\":%d,\"rows\":[\n%s]}%n", Boolean.getBoolean("arflex.it.mlock"),
+                System.getProperty("arflex.bench.shield", ""), Boolean.getBoolean("arflex.bench.poll"),
+                System.getProperty("arflex.it.jvmcpus", ""), rows.size(), m, x,
                 resets, restarts, j, ChangeSetIT.JUMP_BOUND, qr, qm, releases, missedRaw, perSet, spurious.size(), sb));
         System.out.println("JSON: " + out.toAbsolutePath());
         System.out.println("reconfig: RT halves " + (Boolean.getBoolean("arflex.it.mlock") ? "with" : "without")
