@@ -69,7 +69,7 @@ def blame(events, tid, gap_s):
                 holder += f' (process {events[run][4].strip()})'
         tw = events[wake][0] if wake is not None else None
         wait = events[run][0] - tw if (run is not None and tw is not None) else None
-        quiet = [e[0] for e in events[a:(wake if wake is not None else b)] if e[1] == cpu]
+        quiet = [e[0] for e in events[a:(wake + 1 if wake is not None else b)] if e[1] == cpu]
         silence = max((y - x for x, y in zip(quiet, quiet[1:])), default=0.0)
         ran_for = tb - events[run][0] if run is not None else 0.0
         kind = ('long-run' if ran_for > 1e-3 else
@@ -97,7 +97,7 @@ def main():
             rs = f'{1e3 * wait:6.2f}' if wait is not None else '     ?'
             print(f'  {ta:.6f} +{1e3 * g:6.2f} ms  woken +{ws} ms  ran +{rs} ms after  cpu{cpu}  '
                   f'silent {1e3 * sil:5.2f} ms  {kind:9s} {holder if kind == "held" else ""}')
-            counts[kind if kind == 'late-wake' else f'held by {re.sub(r"-[0-9]+ .*$|-[0-9]+$", "", holder)}'] += 1
+            counts[kind if kind != 'held' else f'held by {re.sub(r"-[0-9]+ .*$|-[0-9]+$", "", holder)}'] += 1
     print('rt-blame: ' + (', '.join(f'{k} {v}' for k, v in counts.most_common()) or 'no late runs'))
 
 
