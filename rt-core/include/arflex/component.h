@@ -120,6 +120,14 @@ struct arflex_component_ops {
 	 *  understood. Must not block, allocate or print. < 0 refuses the START (its reply
 	 *  carries the error). Without this hook the manager's ADOPT is refused (-EOPNOTSUPP). */
 	int (*adopt)(struct arflex_component *c, void *user, const struct arflex_adopted_state *s);
+	/** OPTIONAL (D57), mailbox thread, when an ADOPT arrives (before START), with the newest
+	 *  value the old half has published by then (not called when it has published none): a
+	 *  half that needs more than the state block to take over (teach's recording in a file)
+	 *  reads it here, off the RT thread; it may block, allocate and print. The adopt hook at
+	 *  START still gets the newest value then and decides. < 0 refuses the ADOPT (its reply
+	 *  carries the error; the manager tears the new half down, nothing changed). */
+	int (*adopt_prepare)(struct arflex_component *c, void *user,
+			     const struct arflex_adopted_state *s);
 };
 
 /** Runs an RT half. Returns an enum arflex_exit code for main() to return. */
