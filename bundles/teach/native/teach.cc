@@ -279,6 +279,8 @@ void Save() {
   }
 }
 
+int AdoptPrepare(struct arflex_component*, void*, const struct arflex_adopted_state* s);
+
 int Configure(struct arflex_component* c, void*) {
   static const struct arflex_port_type js_t = {ARFLEX_TYPE_JOINT_STATE_NAME, 1, 0,
                                                sizeof(struct arflex_joint_state)};
@@ -313,6 +315,7 @@ int Configure(struct arflex_component* c, void*) {
                                                sizeof(struct arflex_teach_state)};
   r = arflex_component_state(c, &st_t, nullptr);
   if (r < 0 && r != -ENOENT) return r;
+  arflex_component_adopt_prepare(c, AdoptPrepare);  // the journal is read off the RT thread
   g.dir = arflex::cellkin::DataDir();
   g.pid = (uint32_t)getpid();
   if (getrandom(g.st.rec_key, sizeof(g.st.rec_key), 0) != (ssize_t)sizeof(g.st.rec_key) ||
@@ -605,11 +608,11 @@ int Adopt(struct arflex_component*, void*, const struct arflex_adopted_state* s)
     return -EINVAL;
   }
   int r;
-  if (!g.preloaded) {
-    snprintf(g.why, sizeof(g.why), "the recording's journal was not read at the ADOPT");
-    r = -ENODATA;
-  } else {
+  {
+    // Without a journal read at the ADOPT only a recording that is all in the tail can be taken
+    // (teach_rec_join refuses the rest: -ENODATA).
     struct teach_rec_loaded l = Loaded();
+    if (!g.preloaded) l.count = 0;
     r = teach_rec_join(&l, &claim, g.why, sizeof(g.why));
     if (r == 0) {
       g.count = l.count;
@@ -650,7 +653,7 @@ int Adopt(struct arflex_component*, void*, const struct arflex_adopted_state* s)
 }
 
 const struct arflex_component_ops kOps = {
-    "teach", nullptr, Configure, Start, Update, nullptr, Cleanup, Safe, Adopt, AdoptPrepare,
+    "teach", nullptr, Configure, Start, Update, nullptr, Cleanup, Safe, Adopt,
 };
 
 }  // namespace

@@ -46,6 +46,14 @@ int arflex_component_state_publish(struct arflex_component *c, const void *val, 
 	return arflex_state_write_at(&c->state.own, val, len, stamp_ns);
 }
 
+int arflex_component_adopt_prepare(struct arflex_component *c, arflex_adopt_prepare_fn fn)
+{
+	if (!c->configuring)
+		return -EINVAL;
+	c->state.prepare = fn;
+	return 0;
+}
+
 bool arflex_component_state_open(const struct arflex_component *c)
 {
 	return c->state.open;
@@ -96,7 +104,7 @@ int arflex_comp_adopt_cmd(struct arflex_component *c, const struct arflex_msg *m
 	c->state.src = p;
 	c->state.buf = buf;
 	c->state.result = NOT_TRIED;
-	if (c->ops->adopt_prepare) {
+	if (c->state.prepare) {
 		/* D57: the hook reads what does not fit a state block, here off the RT thread */
 		struct arflex_adopted_state s;
 		uint64_t age = 0;
@@ -114,7 +122,7 @@ int arflex_comp_adopt_cmd(struct arflex_component *c, const struct arflex_msg *m
 			s.data = buf;
 			s.length = p->elem_size;
 			s.age_ns = age;
-			r = c->ops->adopt_prepare(c, c->ops->user, &s);
+			r = c->state.prepare(c, c->ops->user, &s);
 			if (r < 0) {
 				arflex_comp_log(c, "ADOPT %s: refused: %s", b->shm_name, strerror(-r));
 				release_src(c);
