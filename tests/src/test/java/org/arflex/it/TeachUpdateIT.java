@@ -295,8 +295,8 @@ class TeachUpdateIT {
             List<String> log = rt.logSince(logMark);
             System.out.println("TeachUpdateIT: a forged waypoint in the journal:\n" + forged + "\n" + String.join("\n",
                     log.stream().filter(l -> l.contains("teach")).toList()));
-            assertTrue(forged.contains("preparation failed, nothing changed") && forged.contains("its state block"),
-                    forged);
+            assertTrue(forged.contains("preparation failed, nothing changed") && forged.contains("its state block")
+                    && forged.contains("(EBADMSG: what the old half hands over does not check"), forged);
             assertTrue(log.stream().anyMatch(l -> l.contains("cannot take over the recording of ")
                     && l.contains("does not match the state block's checksum over its first")), String.join("\n", log));
 
