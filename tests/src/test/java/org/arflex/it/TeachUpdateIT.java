@@ -90,13 +90,14 @@ class TeachUpdateIT {
             long guardPid = rt.pid("force-guard");
             long oldPid = rt.pid("teach");
 
-            // teach mode; a hand pulls the tool 0.2 m along +y over 8 s; a waypoint every 0.2 mrad
+            // teach mode; a hand pulls the tool 0.35 m along +y over 14 s (the arm still moves at the
+            // switch however long the machine takes to get there); a waypoint every 0.2 mrad
             CellRig.set(rt, "teach", "record_step", "0.0002");
             CellRig.set(rt, "teach", "teach", "true");
             CellRig.set(rt, "sim-robot", "guide_dx", "0");
-            CellRig.set(rt, "sim-robot", "guide_dy", "0.2");
+            CellRig.set(rt, "sim-robot", "guide_dy", "0.35");
             CellRig.set(rt, "sim-robot", "guide_dz", "0");
-            CellRig.set(rt, "sim-robot", "guide_duration_ms", "8000");
+            CellRig.set(rt, "sim-robot", "guide_duration_ms", "14000");
             CellRig.set(rt, "sim-robot", "guide_force_n", "60");
 
             CellRig.Trace<CellRig.Ref> oldOut = new CellRig.Trace<>();
@@ -175,6 +176,9 @@ class TeachUpdateIT {
                     CellRig.Ref prior = bySeq.get(first.seq() - 1);
                     assertTrue(prior != null, "the old half's value of seq " + (first.seq() - 1));
                     double firstStep = ChangeSetIT.perSourceCycle(prior, first);
+                    // the arm moving at the switch: the old half's last 20 values before the new half's first
+                    CellRig.Ref back = bySeq.get(first.seq() - 21);
+                    double atSwitch = back == null ? 0 : CellRig.maxDiff(back.q(), prior.q());
                     double before0 = 0;
                     for (int i = Math.max(1, mark - 1000); i < mark; i++) {
                         before0 = Math.max(before0, ChangeSetIT.perSourceCycle(o.get(i - 1), o.get(i)));
@@ -198,13 +202,15 @@ class TeachUpdateIT {
                     Map<String, Object> robot1 = ChangeSetIT.stats(rt, "sim-robot");
                     System.out.printf(Locale.ROOT, "TeachUpdateIT: the new half's first seq %d, %.3f mrad per source "
                             + "cycle from the old half's value of seq %d (teach's own motion before the apply: up to "
-                            + "%.3f); %d values under the same seq, largest difference %.3g rad; the robot's reference "
+                            + "%.3f; over its last 20 cycles before the switch %.3f mrad); %d values under the same seq, largest difference %.3g rad; the robot's reference "
                             + "from the apply on %.3f mrad per source cycle (%.3f before); bound %.3f; largest force "
                             + "%.1f N; sim-robot %d safe cycles; command %d ms%n", first.seq(), firstStep * 1e3,
-                            prior.seq(), before0 * 1e3, same, sameDiff, robotAfter * 1e3, robotBefore * 1e3,
+                            prior.seq(), before0 * 1e3, atSwitch * 1e3, same, sameDiff, robotAfter * 1e3, robotBefore * 1e3,
                             ChangeSetIT.JUMP_BOUND * 1e3, worst.forceNorm(), ChangeSetIT.delta(robot0, robot1,
                             "safeCycles"), tookMs);
                     assertTrue(before0 > 1e-6, "the arm moved under teach before the apply: " + before0);
+                    assertTrue(atSwitch > 20 * 1e-6, "the arm moving at the switch: " + atSwitch
+                            + " rad over the old half's last 20 cycles");
                     assertTrue(firstStep <= ChangeSetIT.JUMP_BOUND, "teach's reference stepped " + firstStep
                             + " rad per source cycle at the switch");
                     assertTrue(same > 100, "values under the same seq: " + same);
