@@ -108,7 +108,6 @@ int arflex_comp_adopt_cmd(struct arflex_component *c, const struct arflex_msg *m
 		/* D57: the hook reads what does not fit a state block, here off the RT thread */
 		struct arflex_adopted_state s;
 		uint64_t age = 0;
-
 		uint64_t seen = p->last_seq;
 
 		r = arflex_state_read(p, buf, p->elem_size, NULL);
