@@ -19,6 +19,8 @@ struct probe_out {
 	uint64_t adopt_calls;   /* D41 */
 	uint64_t adopted;
 	uint64_t state_value;
+	uint64_t prepare_calls; /* D57: the ADOPT's prepare hook */
+	uint64_t prepared;      /* the value it saw */
 };
 
 static const struct arflex_port_type out_type = { "test.ProbeOut", 1, 0,
@@ -42,6 +44,23 @@ static void note(const char *what)
 		fprintf(pr.log, "%s\n", what);
 		fflush(pr.log);
 	}
+}
+
+/* D57: ARFLEX_PROBE_PREPARE=refuse refuses the ADOPT (-EBADMSG); any other value counts the
+ * calls and keeps the value seen (mailbox thread; the probe is not running then). */
+static int prepare(struct arflex_component *c, void *user, const struct arflex_adopted_state *s)
+{
+	uint64_t v = 0;
+
+	(void)c;
+	(void)user;
+	if (!strcmp(getenv("ARFLEX_PROBE_PREPARE"), "refuse"))
+		return -EBADMSG;
+	if (s->length >= sizeof(v))
+		memcpy(&v, s->data, sizeof(v));
+	pr.o.prepared = v;
+	pr.o.prepare_calls++;
+	return 0;
 }
 
 static int configure(struct arflex_component *c, void *user)
@@ -69,6 +88,11 @@ static int configure(struct arflex_component *c, void *user)
 	if (pr.gain < 0) {
 		r = pr.gain;
 		goto out_fail;
+	}
+	if (getenv("ARFLEX_PROBE_PREPARE")) {
+		r = arflex_component_adopt_prepare(c, prepare);
+		if (r)
+			goto out_fail;
 	}
 	if (getenv("ARFLEX_PROBE_REQUIRE_RESET_AT"))
 		pr.require_reset_at = strtoull(getenv("ARFLEX_PROBE_REQUIRE_RESET_AT"), NULL, 10);

@@ -18,6 +18,7 @@ struct probe_out {
 	uint64_t torn, in_value, in_reads, in_bound, in_binding;
 	uint64_t adopt_calls, adopted; /* D41: adopt hook calls, the (converted) value adopted */
 	uint64_t state_value;          /* what it publishes as its state block (adopted + updates) */
+	uint64_t prepare_calls, prepared; /* D57: the ADOPT's prepare hook, the value it saw */
 };
 /* The probe's state block (D41): test.ProbeState 1.0, one uint64. It converts
  * test.OldProbeState 0.x (value x 10) and refuses any other type. */

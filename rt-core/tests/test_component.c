@@ -417,6 +417,59 @@ static void state_published_and_adopted_once(void **state)
 	th_assert_clean(rid);
 }
 
+/* D57: arflex_component_adopt_prepare: the hook runs at the ADOPT with the value published
+ * then; the START still adopts the newest value, also when nothing was published after the
+ * ADOPT (the hook's read does not consume it); a refusing hook refuses the ADOPT and nothing is
+ * adopted. */
+static void adopt_prepare_runs_at_the_adopt(void **state)
+{
+	struct arflex_host a, b, c;
+	struct probe_out o;
+	uint64_t at_adopt;
+
+	(void)state;
+	setup_ids("prep");
+	make_env("ARFLEX_PROBE_PREPARE=count");
+	probe_state = true;
+	assert_int_equal(probe_host(&a, "old", 0, 0, true), 0);
+	assert_int_equal(probe_host(&b, "1-old", 0, 0, true), 0);
+	assert_int_equal(probe_host(&c, "2-old", 0, 0, true), 0);
+	probe_state = false;
+	spawn_ready(&a);
+	spawn_ready(&b);
+	assert_int_equal(arflex_host_start(&a, T_CALL), 0);
+	assert_true(wait_out(&a, updates_above, 50, false));
+	assert_int_equal(arflex_host_stop(&a, T_CALL), 0); /* nothing published after this */
+	at_adopt = state_of(arflex_host_state(&a));
+	assert_int_equal(arflex_host_adopt(&b, arflex_host_state(&a)->name, T_CALL), 0);
+	assert_int_equal(arflex_host_start(&b, T_CALL), 0);
+	assert_true(wait_out(&b, updates_above, 5, false));
+	assert_true(read_out(&b, &o));
+	assert_int_equal(o.prepare_calls, 1);
+	assert_int_equal(o.prepared, at_adopt);
+	assert_int_equal(o.adopt_calls, 1); /* the same value, taken again at the START */
+	assert_int_equal(o.adopted, at_adopt);
+	assert_int_equal(arflex_host_stop(&b, T_CALL), 0);
+
+	make_env("ARFLEX_PROBE_PREPARE=refuse");
+	spawn_ready(&c);
+	assert_int_equal(arflex_host_adopt(&c, arflex_host_state(&a)->name, T_CALL), -EBADMSG);
+	assert_int_equal(arflex_host_start(&c, T_CALL), 0);
+	assert_true(wait_out(&c, updates_above, 5, false));
+	assert_true(read_out(&c, &o));
+	assert_int_equal(o.adopt_calls, 0);
+	assert_int_equal(o.prepare_calls, 0);
+
+	shutdown_ok(&a);
+	shutdown_ok(&b);
+	shutdown_ok(&c);
+	arflex_host_destroy(&a);
+	arflex_host_destroy(&b);
+	arflex_host_destroy(&c);
+	unlink(logpath);
+	th_assert_clean(rid);
+}
+
 static void sigterm_stops_cleanly(void **state)
 {
 	struct arflex_host h;
@@ -549,6 +602,7 @@ int main(void)
 		cmocka_unit_test(failing_start_is_refused),
 		cmocka_unit_test(bind_and_unbind_while_running),
 		cmocka_unit_test(state_published_and_adopted_once),
+		cmocka_unit_test(adopt_prepare_runs_at_the_adopt),
 		cmocka_unit_test(sigterm_stops_cleanly),
 		cmocka_unit_test(killed_mid_cycle_leaves_nothing),
 		cmocka_unit_test(restart_reuses_objects_and_waits_for_reset),

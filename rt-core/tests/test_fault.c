@@ -118,8 +118,8 @@ static void component_attach_every_call_fails(void **state)
 	(void)state;
 	th_rid(rid, sizeof(rid), "fcomp");
 	fill_opts(&o, &p, &out, "probe");
-	/* the probe's output must match its type exactly (tests/probe.c, struct probe_out: 12 x 8 B) */
-	out.spec.type.elem_size = 96;
+	/* the probe's output must match its type exactly (tests/probe.c, struct probe_out: 14 x 8 B) */
+	out.spec.type.elem_size = 112;
 	for (n = 1; n <= 16; n++) {
 		struct arflex_host h;
 		int r, st;

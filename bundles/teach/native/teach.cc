@@ -11,9 +11,19 @@
 // file is written by a non-RT writer thread woken with sem_post (async-signal-safe, never
 // blocks) to <data dir>/program-<save_slot>.arp (cellkin::DataDir(): $ARFLEX_DATA_DIR, else
 // ./data, created 0700 if missing), atomically (temporary file + rename).
+//
+// Update in a change set (docs/DECISIONS.md D57): the state block arflex.TeachState carries the
+// motion and what identifies the recording (count, a keyed checksum chain, the newest
+// TEACH_REC_TAIL waypoints); the writer thread keeps the recording in a journal file in the data
+// folder (teach_rec.h). A new half reads the journal when the ADOPT arrives (adopt_prepare,
+// mailbox thread) and joins it with the state block's tail at its START (adopt, RT thread, no
+// I/O); it takes the recording only whole and refuses the ADOPT or the START otherwise.
+#include <fcntl.h>
 #include <pthread.h>
 #include <semaphore.h>
+#include <sys/random.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -28,13 +38,18 @@
 #include "arflex_types/joint_ref.h"
 #include "arflex_types/joint_state.h"
 #include "arflex_types/safety_state.h"
+#include "arflex_types/teach_state.h"
 #include "arflex_types/wrench.h"
 #include "cellkin.h"
+#include "teach_rec.h"
 
 namespace {
 
 using arflex::cellkin::Q;
-constexpr size_t kMaxPoints = 20000;
+static_assert(sizeof(Q) == 6 * sizeof(double), "a waypoint is 6 doubles, contiguous");
+constexpr size_t kMaxPoints = TEACH_REC_MAX;
+static_assert(TEACH_REC_TAIL == ARFLEX_TEACH_STATE_TAIL_MAX, "the tail of arflex.TeachState");
+static_assert(sizeof(((struct arflex_teach_state*)nullptr)->tail) == TEACH_REC_TAIL * 48, "tail");
 // Taking over a moving arm (docs/DECISIONS.md D35: teach replaces trajectory while the arm
 // moves): the reference starts at the measured joints and, from the measured joint speeds,
 // ramps the speed down to zero over kTakeoverStopS (trajectory's default stop_time), along the
@@ -75,17 +90,153 @@ struct State {
   pthread_t writer;
   bool writer_started = false;
   std::string dir;
+  // D57: the state block, the recording's chain and journal
+  struct arflex_teach_state st{};  // RT: the recording's part is kept up to date, published
+  uint64_t* chain = nullptr;       // chain[i]: over the first i waypoints (teach_rec.h)
+  uint32_t pid = 0;
+  std::atomic<uint32_t> pub_count{0};  // waypoints the writer may copy
+  std::atomic<uint32_t> episode{0};    // changes when the recording starts over
+  int journal_fd = -1;                 // writer thread
+  std::string journal;                 // its path
+  uint32_t journal_count = 0, journal_episode = ~0u;
+  uint64_t journal_nonce = 0;
+  bool journal_failed = false;
+  bool preloaded = false;          // mailbox: the old half's journal read (adopt_prepare)
+  uint32_t preload_count = 0;
+  char why[512] = {0};             // RT: why the adopt hook refused (printed by the writer)
+  std::atomic<bool> why_pending{false};
 } g;
+
+// ---- the recording (RT thread) --------------------------------------------------------------
+
+void RecReset() {
+  g.count = 0;
+  const uint64_t seed = teach_rec_seed(g.st.rec_key, g.st.rec_nonce);
+  g.chain[0] = seed;
+  g.st.rec_count = 0;
+  g.st.rec_hash = seed;
+  g.st.tail_hash = seed;
+  g.st.tail_first = 0;
+  g.st.tail_count = 0;
+  g.pub_count.store(0, std::memory_order_release);
+  g.episode.fetch_add(1, std::memory_order_acq_rel);
+  sem_post(&g.sem);
+}
+
+void RecAppend(const Q& q) {
+  const size_t k = g.count;
+  for (int j = 0; j < 6; ++j) g.points[k][j] = q[j];
+  double p[6];
+  for (int j = 0; j < 6; ++j) p[j] = q[j];
+  g.chain[k + 1] = teach_rec_next(g.st.rec_key, g.chain[k], p);
+  g.count = k + 1;
+  if (g.st.tail_count == TEACH_REC_TAIL) {
+    memmove(g.st.tail, g.st.tail + 6, (TEACH_REC_TAIL - 1) * 6 * sizeof(double));
+    g.st.tail_count--;
+    g.st.tail_first++;
+    g.st.tail_hash = g.chain[g.st.tail_first];
+  }
+  memcpy(g.st.tail + 6 * g.st.tail_count, p, sizeof(p));
+  g.st.tail_count++;
+  g.st.rec_count = (uint32_t)g.count;
+  g.st.rec_hash = g.chain[g.count];
+  g.pub_count.store((uint32_t)g.count, std::memory_order_release);
+  sem_post(&g.sem);  // the writer brings the journal up to date
+}
+
+// ---- the journal (writer thread) ------------------------------------------------------------
+
+bool WriteAll(int fd, const void* buf, size_t len, off_t off) {
+  const char* p = static_cast<const char*>(buf);
+  while (len) {
+    const ssize_t n = pwrite(fd, p, len, off);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    p += n;
+    len -= (size_t)n;
+    off += n;
+  }
+  return true;
+}
+
+void JournalFail(const char* what) {
+  if (!g.journal_failed)
+    fprintf(stderr, "teach: the recording's journal %s: %s: %s (an update in a change set will be refused)\n",
+            g.journal.c_str(), what, strerror(errno));
+  g.journal_failed = true;
+}
+
+// Brings the journal file up to the recording: the waypoints first, then the header's count,
+// so a reader never finds a count beyond what the file holds (teach_rec_load refuses a size
+// that is not header + count waypoints, and the new half retries for a while).
+void CloseJournal();
+
+void SyncJournal() {
+  // An adopted recording brings its nonce (Adopt writes it before it bumps the episode): the
+  // journal is then named after it.
+  (void)g.episode.load(std::memory_order_acquire);
+  const uint64_t nonce = g.st.rec_nonce;
+  if (g.journal_fd >= 0 && nonce != g.journal_nonce) CloseJournal();
+  if (g.journal_fd < 0) {
+    if (g.journal_failed) return;
+    char name[64];
+    teach_rec_name(name, sizeof(name), g.pid, nonce);
+    g.journal_nonce = nonce;
+    g.journal = g.dir + "/" + name;
+    if (mkdir(g.dir.c_str(), 0700) != 0 && errno != EEXIST) return JournalFail("its folder");
+    g.journal_fd = open(g.journal.c_str(), O_RDWR | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0600);
+    if (g.journal_fd < 0) return JournalFail("create");
+    if (fchmod(g.journal_fd, 0600) != 0) return JournalFail("chmod");
+    g.journal_count = 0;
+    g.journal_episode = ~0u;
+  }
+  for (int attempt = 0; attempt < 4; ++attempt) {
+    const uint32_t ep = g.episode.load(std::memory_order_acquire);
+    const uint32_t n = g.pub_count.load(std::memory_order_acquire);
+    if (ep == g.journal_episode && n == g.journal_count) return;
+    uint32_t from = ep == g.journal_episode && n > g.journal_count ? g.journal_count : 0;
+    if (from == 0 && ftruncate(g.journal_fd, TEACH_REC_HEADER + (off_t)n * 48) != 0)
+      return JournalFail("truncate");
+    if (n > from && !WriteAll(g.journal_fd, g.points[from].data(), (size_t)(n - from) * 48,
+                              TEACH_REC_HEADER + (off_t)from * 48))
+      return JournalFail("write");
+    if (g.episode.load(std::memory_order_acquire) != ep) continue;  // started over meanwhile
+    unsigned char hdr[TEACH_REC_HEADER];
+    teach_rec_header(hdr, g.pid, g.journal_nonce, n);
+    if (!WriteAll(g.journal_fd, hdr, sizeof(hdr), 0)) return JournalFail("write its header");
+    g.journal_count = n;
+    g.journal_episode = ep;
+    return;
+  }
+}
+
+void CloseJournal() {
+  if (g.journal_fd >= 0) {
+    close(g.journal_fd);
+    g.journal_fd = -1;
+    unlink(g.journal.c_str());  // the next half has read it, or nothing needs it
+  }
+}
+
+void Save();
 
 void* Writer(void*) {
   for (;;) {
     while (sem_wait(&g.sem) != 0 && errno == EINTR) {
     }
+    if (g.why_pending.exchange(false)) fprintf(stderr, "teach: START refused: %s\n", g.why);
     // A save requested just before shutdown is still written; then quit.
-    if (!g.saving.load(std::memory_order_acquire)) {
-      if (g.quit.load()) return nullptr;
-      continue;
+    if (g.saving.load(std::memory_order_acquire)) Save();
+    if (g.quit.load()) {
+      CloseJournal();
+      return nullptr;
     }
+    SyncJournal();
+  }
+}
+
+void Save() {
+  {
     const size_t n = g.save_count.load();
     arflex::cellkin::Program p;
     p.origin = "teach (" + std::to_string(n) + " recorded waypoints)";
@@ -125,9 +276,10 @@ void* Writer(void*) {
       g.saved++;
     }
     g.saving.store(false, std::memory_order_release);
-    if (g.quit.load()) return nullptr;
   }
 }
+
+int AdoptPrepare(struct arflex_component*, void*, const struct arflex_adopted_state* s);
 
 int Configure(struct arflex_component* c, void*) {
   static const struct arflex_port_type js_t = {ARFLEX_TYPE_JOINT_STATE_NAME, 1, 0,
@@ -158,17 +310,38 @@ int Configure(struct arflex_component* c, void*) {
       return -ENOENT;
     }
   }
+  // D57: the state block (absent when the contract declares none: publishing is then a no-op)
+  static const struct arflex_port_type st_t = {ARFLEX_TYPE_TEACH_STATE_NAME, 1, 0,
+                                               sizeof(struct arflex_teach_state)};
+  r = arflex_component_state(c, &st_t, nullptr);
+  if (r < 0 && r != -ENOENT) return r;
+  arflex_component_adopt_prepare(c, AdoptPrepare);  // the journal is read off the RT thread
   g.dir = arflex::cellkin::DataDir();
+  g.pid = (uint32_t)getpid();
+  if (getrandom(g.st.rec_key, sizeof(g.st.rec_key), 0) != (ssize_t)sizeof(g.st.rec_key) ||
+      getrandom(&g.st.rec_nonce, sizeof(g.st.rec_nonce), 0) != (ssize_t)sizeof(g.st.rec_nonce)) {
+    fprintf(stderr, "teach: no random key for the recording's checksum: %s\n", strerror(errno));
+    return -EIO;
+  }
+  g.st.journal_pid = g.pid;
   g.points = new (std::nothrow) Q[kMaxPoints];
-  if (!g.points) return -ENOMEM;
+  g.chain = new (std::nothrow) uint64_t[kMaxPoints + 1];
+  if (!g.points || !g.chain) {
+    delete[] g.points;
+    delete[] g.chain;
+    return -ENOMEM;
+  }
   if (sem_init(&g.sem, 0, 0) != 0) {
     delete[] g.points;
+    delete[] g.chain;
     return -errno;
   }
+  RecReset();
   r = pthread_create(&g.writer, nullptr, Writer, nullptr);
   if (r != 0) {
     sem_destroy(&g.sem);
     delete[] g.points;
+    delete[] g.chain;
     return -r;
   }
   g.writer_started = true;
@@ -184,7 +357,33 @@ void Cleanup(struct arflex_component*, void*) {
   }
   sem_destroy(&g.sem);
   delete[] g.points;
+  delete[] g.chain;
   g.points = nullptr;
+  g.chain = nullptr;
+}
+
+// Publishes the state block (D57): the motion of this cycle; the recording's part is kept up
+// to date by RecReset/RecAppend. RT safe (a seqlock write).
+void Publish(struct arflex_component* c, uint64_t stamp_ns) {
+  if (!arflex_component_state_open(c)) return;
+  g.st.t_ns = (int64_t)stamp_ns;
+  g.st.seq++;
+  g.st.out_seq = g.seq;
+  g.st.flags = (g.initialized ? ARFLEX_TEACH_STATE_FLAG_INITIALIZED : 0u) |
+               (g.teach_prev ? ARFLEX_TEACH_STATE_FLAG_TEACH : 0u) |
+               (g.saving.load(std::memory_order_relaxed) ? ARFLEX_TEACH_STATE_FLAG_SAVING : 0u);
+  g.st.journal_pid = g.pid;
+  g.st.brake_t = g.brake_t;
+  for (int j = 0; j < 6; ++j) {
+    g.st.q_ref[j] = g.q_ref[j];
+    g.st.brake_v0[j] = g.brake_v0[j];
+  }
+  for (int i = 0; i < 3; ++i) {
+    g.st.x[i] = g.x[i];
+    g.st.v[i] = g.v[i];
+    for (int k = 0; k < 3; ++k) g.st.r_hold[3 * i + k] = g.r_hold(i, k);
+  }
+  arflex_component_state_publish(c, &g.st, sizeof(g.st), stamp_ns);
 }
 
 int Start(struct arflex_component* c, void*) {
@@ -206,7 +405,7 @@ void Record(struct arflex_component* c, bool force) {
     g.dropped++;
     return;
   }
-  g.points[g.count++] = g.q_ref;
+  RecAppend(g.q_ref);
 }
 
 int Update(struct arflex_component* c, void*, uint64_t release_ns) {
@@ -243,7 +442,7 @@ int Update(struct arflex_component* c, void*, uint64_t release_ns) {
     g.x = t.translation();
     g.r_hold = t.linear();
     g.v.setZero();
-    if (!g.saving.load(std::memory_order_acquire)) g.count = 0;
+    if (!g.saving.load(std::memory_order_acquire)) RecReset();
     Record(c, true);
   }
   if (!teach && g.teach_prev) Record(c, true);  // the end point
@@ -302,17 +501,159 @@ int Update(struct arflex_component* c, void*, uint64_t release_ns) {
   ref.t_ns = (int64_t)release_ns;
   ref.seq = ++g.seq;
   for (int j = 0; j < 6; ++j) ref.q[j] = g.q_ref[j];
-  return arflex_state_write(g.out, &ref, sizeof(ref));
+  const int w = arflex_state_write(g.out, &ref, sizeof(ref));
+  Publish(c, release_ns);
+  return w;
 }
 
 // rt-core safe mode: stop yielding, hold the reference.
-int Safe(struct arflex_component*, void*, enum arflex_safe_mode, bool) {
+int Safe(struct arflex_component* c, void*, enum arflex_safe_mode, bool) {
   g.v.setZero();
+  Publish(c, arflex_sys_now_ns());
+  return 0;
+}
+
+// ---- D57: handing over to a new version -----------------------------------------------------
+
+bool Claim(const struct arflex_adopted_state* s, const struct arflex_teach_state** v,
+           struct teach_rec_claim* claim) {
+  if (strcmp(s->type_name, ARFLEX_TYPE_TEACH_STATE_NAME) != 0 || s->major != 1 ||
+      s->length < sizeof(struct arflex_teach_state))
+    return false;
+  *v = static_cast<const struct arflex_teach_state*>(s->data);
+  const struct arflex_teach_state* t = *v;
+  memset(claim, 0, sizeof(*claim));
+  claim->key[0] = t->rec_key[0];
+  claim->key[1] = t->rec_key[1];
+  claim->nonce = t->rec_nonce;
+  claim->pid = t->journal_pid;
+  claim->count = t->rec_count;
+  claim->hash = t->rec_hash;
+  claim->tail_first = t->tail_first;
+  claim->tail_count = t->tail_count;
+  claim->tail_hash = t->tail_hash;
+  claim->tail = t->tail;
+  return true;
+}
+
+struct teach_rec_loaded Loaded() {
+  struct teach_rec_loaded l;
+  l.points = reinterpret_cast<double(*)[6]>(g.points);
+  l.chain = g.chain;
+  l.count = g.preload_count;
+  return l;
+}
+
+// Mailbox thread, at the ADOPT: reads the old half's journal (blocking I/O belongs here) and
+// checks it against the state block of now. Retries for up to ~200 ms: the old half's writer
+// may be between a journal's waypoints and its header.
+int AdoptPrepare(struct arflex_component*, void*, const struct arflex_adopted_state* s) {
+  const struct arflex_teach_state* t;
+  struct teach_rec_claim claim;
+  char why[512];
+  g.preloaded = false;
+  if (!Claim(s, &t, &claim)) {
+    fprintf(stderr, "teach: cannot take over the state block %s %u.%u (%u bytes): not arflex.TeachState 1.x\n",
+            s->type_name, s->major, s->minor, s->length);
+    return -EPROTOTYPE;
+  }
+  int r = teach_rec_check_claim(&claim, why, sizeof(why));
+  if (r == 0 && claim.tail_first == 0) {
+    g.preload_count = 0;  // the state block's tail holds the whole recording
+    g.preloaded = true;
+    fprintf(stderr, "teach: the recording (%u waypoints) is all in the state block\n", claim.count);
+    return 0;
+  }
+  if (r != 0) {
+    fprintf(stderr, "teach: cannot take over the recording of %u waypoints: %s\n", claim.count, why);
+    return r;
+  }
+  char name[64];
+  teach_rec_name(name, sizeof(name), claim.pid, claim.nonce);
+  const std::string path = g.dir + "/" + name;
+  for (int attempt = 0; attempt < 40; ++attempt) {
+    if (attempt) usleep(5000);
+    struct teach_rec_loaded l = Loaded();
+    r = teach_rec_load(path.c_str(), &claim, &l, why, sizeof(why));
+    if (r == 0) r = teach_rec_join(&l, &claim, why, sizeof(why));
+    if (r == 0) {
+      g.preload_count = l.count;
+      g.preloaded = true;
+      fprintf(stderr, "teach: the recording read from %s: %u waypoints, checked against the state block\n",
+              path.c_str(), l.count);
+      return 0;
+    }
+    if (r == -EPERM) break;  // nothing a wait can mend
+  }
+  fprintf(stderr, "teach: cannot take over the recording of %u waypoints: %s\n", claim.count, why);
+  return r;
+}
+
+// RT thread, at the START after an ADOPT: the motion and the recording, whole or not at all.
+// No I/O: the journal was read by AdoptPrepare; the join is O(tail).
+int Adopt(struct arflex_component*, void*, const struct arflex_adopted_state* s) {
+  const struct arflex_teach_state* t;
+  struct teach_rec_claim claim;
+  if (!Claim(s, &t, &claim)) {
+    snprintf(g.why, sizeof(g.why), "the state block %s %u.%u is not arflex.TeachState 1.x", s->type_name,
+             s->major, s->minor);
+    g.why_pending.store(true);
+    sem_post(&g.sem);
+    return -EPROTOTYPE;
+  }
+  if (!arflex_teach_state_valid(t)) {
+    snprintf(g.why, sizeof(g.why), "the state block's motion is out of its bounds (a non-finite number)");
+    g.why_pending.store(true);
+    sem_post(&g.sem);
+    return -EINVAL;
+  }
+  int r;
+  {
+    // Without a journal read at the ADOPT only a recording that is all in the tail can be taken
+    // (teach_rec_join refuses the rest: -ENODATA).
+    struct teach_rec_loaded l = Loaded();
+    if (!g.preloaded) l.count = 0;
+    r = teach_rec_join(&l, &claim, g.why, sizeof(g.why));
+    if (r == 0) {
+      g.count = l.count;
+      g.st.rec_key[0] = claim.key[0];
+      g.st.rec_key[1] = claim.key[1];
+      g.st.rec_nonce = claim.nonce;  // the chain goes on; the journal is this half's own (pid)
+      g.st.rec_count = claim.count;
+      g.st.rec_hash = claim.hash;
+      g.st.tail_first = claim.tail_first;
+      g.st.tail_count = claim.tail_count;
+      g.st.tail_hash = claim.tail_hash;
+      memcpy(g.st.tail, t->tail, sizeof(g.st.tail));
+    }
+  }
+  g.preloaded = false;
+  if (r < 0) {
+    g.why_pending.store(true);
+    sem_post(&g.sem);
+    return r;
+  }
+  for (int j = 0; j < 6; ++j) {
+    g.q_ref[j] = t->q_ref[j];
+    g.brake_v0[j] = t->brake_v0[j];
+  }
+  g.brake_t = t->brake_t;
+  for (int i = 0; i < 3; ++i) {
+    g.x[i] = t->x[i];
+    g.v[i] = t->v[i];
+    for (int k = 0; k < 3; ++k) g.r_hold(i, k) = t->r_hold[3 * i + k];
+  }
+  g.seq = t->out_seq;
+  g.initialized = (t->flags & ARFLEX_TEACH_STATE_FLAG_INITIALIZED) != 0;
+  g.teach_prev = (t->flags & ARFLEX_TEACH_STATE_FLAG_TEACH) != 0;  // the recording goes on
+  g.pub_count.store((uint32_t)g.count, std::memory_order_release);
+  g.episode.fetch_add(1, std::memory_order_acq_rel);  // the writer writes its journal whole
+  sem_post(&g.sem);
   return 0;
 }
 
 const struct arflex_component_ops kOps = {
-    "teach", nullptr, Configure, Start, Update, nullptr, Cleanup, Safe, nullptr,
+    "teach", nullptr, Configure, Start, Update, nullptr, Cleanup, Safe, Adopt,
 };
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include "sample.h"
 #include "tcp_correction_state.h"
 #include "tcp_correction_state2.h"
+#include "teach_state.h"
 #include "tool_state.h"
 #include "trajectory_state.h"
 #include "wrench.h"

@@ -164,6 +164,20 @@ ARFLEX_API int arflex_component_state(struct arflex_component *c,
  *  no blocking, no allocation. */
 ARFLEX_API int arflex_component_state_publish(struct arflex_component *c, const void *val,
 					      size_t len, uint64_t stamp_ns);
+/** The hook type of arflex_component_adopt_prepare. */
+typedef int (*arflex_adopt_prepare_fn)(struct arflex_component *c, void *user,
+				       const struct arflex_adopted_state *s);
+/**
+ * D57: registers @fn (NULL: none), called on the MAILBOX thread when an ADOPT arrives (before
+ * START) with the newest value the old half has published by then (not called when it has
+ * published none). A half that needs more than its state block to take over (teach's recording,
+ * kept in a file) reads it there, off the RT thread: @fn may block, allocate and print. The
+ * adopt hook at START still gets the newest value then and decides. A negative return refuses
+ * the ADOPT (the reply carries the error; the manager tears the new half down, nothing
+ * changed). Configure only (a function, not an ops member, so that the ops struct and every
+ * component's initializer of it stay as they are). Returns 0 or -EINVAL.
+ */
+ARFLEX_API int arflex_component_adopt_prepare(struct arflex_component *c, arflex_adopt_prepare_fn fn);
 /** True when the state segment is open (arflex_component_state returned 0). */
 ARFLEX_API bool arflex_component_state_open(const struct arflex_component *c);
 

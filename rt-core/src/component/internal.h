@@ -43,6 +43,7 @@ struct arflex_state_block {
 	struct arflex_port_type type; /* what own carries */
 	char type_name[ARFLEX_TYPE_NAME_SIZE];
 	struct arflex_port *src;      /* mailbox: the segment named by ADOPT (read-only) */
+	arflex_adopt_prepare_fn prepare; /* D57: mailbox, at the ADOPT (configure sets it) */
 	void *buf;                    /* mailbox: one value of src */
 	int result;                   /* RT at START: 1 adopted, 0 nothing published yet, < 0 */
 	uint64_t seq;                 /* RT: the adopted value's write count */

@@ -46,6 +46,14 @@ int arflex_component_state_publish(struct arflex_component *c, const void *val, 
 	return arflex_state_write_at(&c->state.own, val, len, stamp_ns);
 }
 
+int arflex_component_adopt_prepare(struct arflex_component *c, arflex_adopt_prepare_fn fn)
+{
+	if (!c->configuring)
+		return -EINVAL;
+	c->state.prepare = fn;
+	return 0;
+}
+
 bool arflex_component_state_open(const struct arflex_component *c)
 {
 	return c->state.open;
@@ -96,6 +104,31 @@ int arflex_comp_adopt_cmd(struct arflex_component *c, const struct arflex_msg *m
 	c->state.src = p;
 	c->state.buf = buf;
 	c->state.result = NOT_TRIED;
+	if (c->state.prepare) {
+		/* D57: the hook reads what does not fit a state block, here off the RT thread */
+		struct arflex_adopted_state s;
+		uint64_t age = 0;
+		uint64_t seen = p->last_seq;
+
+		r = arflex_state_read(p, buf, p->elem_size, NULL);
+		p->last_seq = seen; /* START reads the newest value again, as new */
+		if (r > 0) {
+			(void)arflex_port_age(p, arflex_sys_now_ns(), &age);
+			memset(&s, 0, sizeof(s));
+			s.type_name = p->hdr->type_name;
+			s.major = p->hdr->type_major;
+			s.minor = p->hdr->type_minor;
+			s.data = buf;
+			s.length = p->elem_size;
+			s.age_ns = age;
+			r = c->state.prepare(c, c->ops->user, &s);
+			if (r < 0) {
+				arflex_comp_log(c, "ADOPT %s: refused: %s", b->shm_name, strerror(-r));
+				release_src(c);
+				return r;
+			}
+		}
+	}
 	return 0;
 }
 

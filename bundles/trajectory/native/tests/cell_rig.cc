@@ -42,7 +42,8 @@ int Make(struct arflex_host* h, const char* inst, const char* comp, uint64_t per
       ARFLEX_HOST_TYPE(JOINT_REF),    ARFLEX_HOST_TYPE(JOINT_STATE), ARFLEX_HOST_TYPE(WRENCH),
       ARFLEX_HOST_TYPE(SAFETY_STATE), ARFLEX_HOST_TYPE(TOOL_STATE),  ARFLEX_HOST_TYPE(SAMPLE),
       ARFLEX_HOST_TYPE(TRAJECTORY_STATE), ARFLEX_HOST_TYPE(TCP_CORRECTION_STATE),
-      ARFLEX_HOST_TYPE(TCP_CORRECTION_STATE2), ARFLEX_HOST_TYPE(FORCE_GUARD_STATE)};
+      ARFLEX_HOST_TYPE(TCP_CORRECTION_STATE2), ARFLEX_HOST_TYPE(FORCE_GUARD_STATE),
+      ARFLEX_HOST_TYPE(TEACH_STATE)};
   static struct arflex_host_contract c;  // read again for each instance
   const std::string xml = bundlesdir + "/" + comp + "/src/main/resources/OSGI-INF/arflex/" + comp + ".xml";
   char err[512];

@@ -27,6 +27,7 @@
 #include "arflex_types/tcp_correction_state.h"
 #include "arflex_types/tcp_correction_state2.h"
 #include "arflex_types/trajectory_state.h"
+#include "arflex_types/teach_state.h"
 #include "arflex_types/joint_state.h"
 #include "arflex_types/safety_state.h"
 #include "arflex_types/sample.h"
@@ -139,6 +140,7 @@ void CaseStopAway();        // test_cell_stop_away.cc
 void CaseStateTransfer();   // test_cell_state_transfer.cc
 void CaseForceGuard();      // test_cell_force_guard.cc
 void CaseForceGuardState(); // test_cell_force_guard_state.cc (D52)
+void CaseTeachState();      // test_cell_teach_state.cc (D57)
 void CaseTeachReplay();     // test_cell_teach.cc
 void CaseTools();           // test_cell_tools.cc
 void CaseInvalidInput();    // test_cell_input.cc

@@ -354,7 +354,8 @@ final class CellRig {
         Port(Path segment, int valueSize) throws IOException {
             path = segment;
             ch = FileChannel.open(segment, StandardOpenOption.READ);
-            b = ch.map(FileChannel.MapMode.READ_ONLY, 0, 4096);
+            // a state block can be larger than a page (arflex.TeachState: 6456 bytes)
+            b = ch.map(FileChannel.MapMode.READ_ONLY, 0, Math.max(4096, Math.min(ch.size(), Ports.SLOT0_VALUE + valueSize)));
             b.order(ByteOrder.LITTLE_ENDIAN);
             size = valueSize;
         }
