@@ -205,6 +205,19 @@ public final class ProcessLauncher implements RtLauncher {
     }
 
 
+    /** What a refused ADOPT's errno means (D41, D57: the half's own log line says the details). */
+    static String adoptRefusal(int e) {
+        return switch (e) {
+            case 95 -> " (EOPNOTSUPP: its executable has no adopt hook)";
+            case 74 -> " (EBADMSG: what the old half hands over does not check; the new half's log says what)";
+            case 61 -> " (ENODATA: what the old half hands over is incomplete; the new half's log says what)";
+            case 1 -> " (EPERM: a file the hand-over needs is not safe to read; the new half's log says which)";
+            case 2 -> " (ENOENT: a file the hand-over needs is missing; the new half's log says which)";
+            case 91 -> " (EPROTOTYPE: a state block it cannot take)";
+            default -> "";
+        };
+    }
+
     static String errnoName(int e) {
         return switch (e) {
             case 1 -> "EPERM: not mutable while running";

@@ -139,7 +139,7 @@ final class ProcessRtHalf implements RtHalf {
         Mailbox.Reply r = mb.adopt(stateSegment, ProcessLauncher.CALL_TIMEOUT_MS);
         if (r.status() != 0) {
             throw new IOException("ADOPT of " + stateSegment + " refused by " + inst + ": status " + r.status()
-                    + (r.status() == -95 ? " (EOPNOTSUPP: its executable has no adopt hook)" : ""));
+                    + ProcessLauncher.adoptRefusal(-r.status()));
         }
     }
 
