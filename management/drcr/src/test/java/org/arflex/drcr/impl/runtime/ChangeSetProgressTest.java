@@ -311,6 +311,41 @@ class ChangeSetProgressTest {
         assertEquals("stage", now().updates[1].component);
     }
 
+    @Test
+    void whenOneUpdateOfASetIsRejectedInShadowTheOtherKeepsItsCountersWithoutAVerdict() throws Exception {
+        runningCell();
+        List<ChangeSet.Tolerance> y = List.of(new ChangeSet.Tolerance("y", "value", 0.01));
+        ChangeSet set = ChangeSet.builder()
+                .update("src", parse("src", "src", OUT, "1.1.0"), Path.of("/nonexistent/src-1.1"),
+                        "file:/x/src-1.1.jar", 40, List.of(), 100, y)
+                .update("stage", parse("stage", "stage", IN_SRC + OUT, "1.1.0"), Path.of("/nonexistent/stage-1.1"),
+                        "file:/x/stage-1.1.jar", 50, List.of(), 200, y)
+                .build();
+        CompletableFuture<ChangeSetResult> f = actor.call(() -> cell.applyChangeSet(set), 0);
+        rig.stepUntil("both new halves started in shadow", () -> {
+            now();
+            return fake.events.contains("1-src START") && fake.events.contains("1-stage START") || f.isDone();
+        });
+        FakeLauncher.FakeHalf newSrc = fake.running.get("1-src");
+        FakeLauncher.FakeHalf newStage = fake.running.get("1-stage");
+        newSrc.stats = cycles(25);
+        newStage.stats = cycles(45);
+        look();
+        newStage.crash(139, "killed by signal 11");
+        rig.stepUntil("the outcome", () -> {
+            now();
+            return f.isDone();
+        });
+        rig.stepUntil("progress done", () -> !now().running);
+        ChangeSetProgressDTO p = now();
+        assertEquals("rejected-in-shadow", p.outcome);
+        assertEntry(p.updates[0], "src", "shadow", 25, 100, 0, null);
+        assertEntry(p.updates[1], "stage", "shadow", 45, 200, 0, "rejected-in-shadow");
+        assertTrue(p.updates[1].why.startsWith("update stage: rejected in shadow after 45 cycles: the new version (pid "
+                + newStage.pid + ") exited: killed by signal 11"), p.updates[1].why);
+        assertEquals(p.why, p.updates[1].why);
+    }
+
     private static void assertEntry(UpdateProgressDTO u, String component, String phase, long cycle, long cycles,
                                     double worstDeviation, String verdict) {
         String s = component + " " + u.phase + " " + u.cycle + " of " + u.cycles + " worst " + u.worstField + " "
