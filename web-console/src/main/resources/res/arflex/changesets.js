@@ -4,7 +4,8 @@
  * or is refused when the cell changed since; then the outcome (committed, refused, rejected in
  * shadow, rolled back, torn down) and the history of the sets applied in this runtime. While a
  * set is applied, its live progress (D53) from the DRCR: the phases gone through, what it does
- * now, an update's shadow or window cycles and the worst deviation so far, then the outcome.
+ * now, an update's shadow or window cycles and the worst deviation so far, then the outcome;
+ * a set of several updates gets a row for each (D60), kept with the outcome.
  * Everything goes into the DOM through textContent and attribute setters only. */
 'use strict';
 (() => {
@@ -167,6 +168,30 @@
         rows, 'No set applied yet.'));
   }
 
+  const VERDICT_TEXT = {'committed': 'committed', 'rolled-back': 'rolled back', 'rejected-in-shadow': 'rejected in shadow'};
+
+  /**
+   * One row per update of a set of several (D60), in the set's order: its phase, a bar with cycle
+   * k of K, its shadow run's worst deviation, its verdict. Each row carries the numbers as data-*
+   * attributes for a browser test.
+   */
+  function updateRows(p) {
+    const updates = p.updates || [];
+    if (updates.length < 2) return '';
+    return table('arflex-cs-live-updates', ['update', 'phase', 'cycles', 'worst deviation in shadow', 'verdict'],
+      updates.map(u => el('tr', {'data-component': u.component, 'data-phase': u.phase || '', 'data-cycle': u.cycle,
+        'data-cycles': u.cycles, 'data-worst': u.worstField ? u.worstDeviation : '', 'data-verdict': u.verdict || '',
+        class: 'arflex-cs-live-update' + (u.verdict && u.verdict !== 'committed' ? ' arflex-bad' : '')},
+      el('td', {}, u.component),
+      el('td', {}, u.phase ? PHASE_TEXT[u.phase] || u.phase : p.running ? 'not yet' : '—'),
+      el('td', {}, u.cycles > 0 ? el('progress', {max: u.cycles, value: Math.min(u.cycle, u.cycles)}) : '',
+        u.cycles > 0 ? ' cycle ' + u.cycle + ' of ' + u.cycles : ''),
+      el('td', {}, u.worstField ? u.worstField + ' ' + Number(u.worstDeviation).toPrecision(3)
+        + ' (tolerance ' + u.tolerance + ')' : ''),
+      el('td', {title: u.why || ''}, u.verdict ? VERDICT_TEXT[u.verdict] || u.verdict
+        : p.running ? '' : 'no verdict of its own'))), 'no update');
+  }
+
   /** The DRCR's progress of the set being applied (or of the last one): phases, step, cycles, outcome. */
   function renderLive(r) {
     const p = r.progress;
@@ -186,7 +211,8 @@
         el('progress', {max: p.cycles, value: Math.min(p.cycle, p.cycles)}),
         ' cycle ' + p.cycle + ' of ' + p.cycles + (p.component ? ' (' + p.component + ')' : '')) : '',
       p.running && p.worstField ? el('div', {id: 'arflex-cs-live-worst'}, 'Worst deviation so far: ' + p.worstField + ' '
-        + Number(p.worstDeviation).toPrecision(3) + ' from the running version\'s (tolerance ' + p.tolerance + ')') : ''));
+        + Number(p.worstDeviation).toPrecision(3) + ' from the running version\'s (tolerance ' + p.tolerance + ')') : '',
+      updateRows(p)));
   }
 
   async function pollLive() {

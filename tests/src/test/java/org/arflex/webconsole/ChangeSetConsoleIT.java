@@ -3,6 +3,7 @@ package org.arflex.webconsole;
 import static org.junit.jupiter.api.Assertions.assertEquals;
 import static org.junit.jupiter.api.Assertions.assertFalse;
 import static org.junit.jupiter.api.Assertions.assertNotNull;
+import static org.junit.jupiter.api.Assertions.assertNull;
 import static org.junit.jupiter.api.Assertions.assertTrue;
 
 import java.io.IOException;
@@ -42,7 +43,9 @@ import org.junit.jupiter.api.TestMethodOrder;
  * outcomes and the refusals. Then the page in Chromium; last, an update of the scaler with a
  * shadow run and a rollback window applied from the page, whose live progress (D53) the page
  * shows going through the shadow run (its cycles) and the window to the outcome, and whose
- * progress endpoint answers no one without the console's credentials, however its path is spelt.
+ * progress endpoint answers no one without the console's credentials, however its path is spelt;
+ * then a set of two updates (the counter with a window, the scaler with a shadow run and a
+ * window), whose rows the page shows each with its own counters, kept with the outcome (D60).
  */
 @TestMethodOrder(MethodOrderer.OrderAnnotation.class)
 class ChangeSetConsoleIT {
@@ -430,9 +433,14 @@ class ChangeSetConsoleIT {
 
     /** A copy of the sample-scaler bundle whose contract says {@code version}: the same executable. */
     private static Path scalerVersion(Path dir, String version) throws IOException {
-        Path in = org.arflex.it.Components.jar("sample-scaler");
-        Path out = dir.resolve("sample-scaler-" + version + ".jar");
-        String entry = "OSGI-INF/arflex/sample-scaler.xml";
+        return version(dir, "sample-scaler", version);
+    }
+
+    /** A copy of {@code component}'s bundle whose contract says {@code version}: the same executable. */
+    private static Path version(Path dir, String component, String version) throws IOException {
+        Path in = org.arflex.it.Components.jar(component);
+        Path out = dir.resolve(component + "-" + version + ".jar");
+        String entry = "OSGI-INF/arflex/" + component + ".xml";
         boolean found = false;
         try (java.util.zip.ZipFile z = new java.util.zip.ZipFile(in.toFile());
                 java.util.zip.ZipOutputStream zo = new java.util.zip.ZipOutputStream(Files.newOutputStream(out))) {
@@ -440,8 +448,8 @@ class ChangeSetConsoleIT {
                 byte[] b = z.getInputStream(e).readAllBytes();
                 if (e.getName().equals(entry)) {
                     String xml = new String(b, StandardCharsets.UTF_8);
-                    String now = xml.replaceFirst("name=\"sample-scaler\" version=\"[^\"]+\"",
-                            "name=\"sample-scaler\" version=\"" + version + "\"");
+                    String now = xml.replaceFirst("name=\"" + component + "\" version=\"[^\"]+\"",
+                            "name=\"" + component + "\" version=\"" + version + "\"");
                     assertFalse(now.equals(xml), "the contract's version was not rewritten");
                     b = now.getBytes(StandardCharsets.UTF_8);
                     found = true;
@@ -581,5 +589,105 @@ class ChangeSetConsoleIT {
         assertTrue(rt.tail().contains("(phases checking > preparing > shadow > switching > window > bundles > done)\n"
                 + "outcome: committed: update sample-scaler: passed its shadow run of 3"),
                 rt.tail());
+    }
+
+    /** The page's row of each update (D60): component, phase, cycle, cycles, worst, verdict, as its data attributes say. */
+    @SuppressWarnings("unchecked")
+    private static List<Map<String, String>> updateRows(Browser b) {
+        return (List<Map<String, String>>) b.js("return Array.from(document.querySelectorAll("
+                + "'#arflex-cs-live-updates tr[data-component]')).map(e => ({component: e.dataset.component,"
+                + " phase: e.dataset.phase, cycle: e.dataset.cycle, cycles: e.dataset.cycles, worst: e.dataset.worst,"
+                + " verdict: e.dataset.verdict, text: e.innerText}));");
+    }
+
+    @Test
+    @Order(11)
+    @SuppressWarnings("unchecked")
+    void aSetOfTwoUpdatesShowsARowForEachToItsOutcome() throws IOException {
+        Browser.requireInstalled();
+        RuntimeUnderTest.awaitCondition("counter and scaler running", WAIT,
+                () -> "ACTIVE".equals(state("sample-counter")) && "ACTIVE".equals(state("sample-scaler")));
+        long counterPid = pid("sample-counter");
+        long scalerPid = pid("sample-scaler");
+        Path dir = Files.createDirectories(Path.of(System.getProperty("arflex.it.work", "target/it"))
+                .resolve("changeset-console").resolve("versions-two").toAbsolutePath());
+        Path counter = version(dir, "sample-counter", "1.0.1-two");
+        Path scaler = scalerVersion(dir, "1.0.2-two");
+        // the counter without a shadow run (its sine's phase is its own), the scaler with one; 10 ms cycles
+        String set = "update sample-counter " + counter.toUri() + " " + sha256(counter) + " window 200\n"
+                + "update sample-scaler " + scaler.toUri() + " " + sha256(scaler)
+                + " shadow 300 tolerance y.value 0.000001 window 200";
+        Path work = Path.of(System.getProperty("arflex.it.work", "target/it")).resolve("changeset-console").toAbsolutePath();
+        Path shots = Path.of(System.getProperty("arflex.screenshots", "target/screenshots"));
+        try (Browser b = Browser.start(work.resolve("chromedriver-two.log"))) {
+            b.cdp("Network.enable", Map.of());
+            b.cdp("Network.setExtraHTTPHeaders", Map.of("headers", Map.of("Authorization", rt.basicAuth())));
+            b.open(rt.base() + PAGE);
+            b.await("the page", WAIT, () -> textOf(b, "#arflex-cs-history-table"), b::url);
+            planInTheBrowser(b, set);
+            b.await("the plan admitted", WAIT, () -> {
+                String t = textOf(b, "#arflex-cs-admission");
+                return t != null && t.startsWith("Admitted") ? t : null;
+            }, b::source);
+            b.click(b.findAll("#arflex-cs-apply").get(0));
+            // live: the scaler's row counts its shadow cycles while the counter's waits for the switch
+            List<Map<String, String>> shadow = b.await("the scaler's shadow run in its row", WAIT, () -> {
+                List<Map<String, String>> rows = updateRows(b);
+                return rows.size() == 2 && "shadow".equals(rows.get(1).get("phase"))
+                        && Long.parseLong(rows.get(1).get("cycle")) > 0 ? rows : null;
+            }, b::source);
+            b.screenshot(shots.resolve("changesets-progress-two-shadow.png"));
+            System.out.println("ChangeSetConsoleIT: two updates, in the scaler's shadow run: " + shadow);
+            assertEquals(List.of("sample-counter", "sample-scaler"), shadow.stream().map(r -> r.get("component")).toList(),
+                    "the rows in the set's order");
+            assertEquals("", shadow.get(0).get("phase"), "the counter has no shadow run: " + shadow);
+            assertEquals("300", shadow.get(1).get("cycles"));
+            assertTrue(shadow.get(1).get("text").contains(" of 300"), shadow.toString());
+            assertEquals(counterPid, pid("sample-counter"), "nothing switched during the shadow run");
+            assertEquals(scalerPid, pid("sample-scaler"), "nothing switched during the shadow run");
+            // both windows, each in its own row
+            List<Map<String, String>> windows = b.await("both windows in their rows", WAIT, () -> {
+                List<Map<String, String>> rows = updateRows(b);
+                return rows.size() == 2 && rows.stream().allMatch(r -> "window".equals(r.get("phase"))) ? rows : null;
+            }, b::source);
+            System.out.println("ChangeSetConsoleIT: two updates, in their windows: " + windows);
+            String done = b.await("the outcome", WAIT, () -> {
+                String phase = (String) b.js("const e = document.getElementById('arflex-cs-live-box');"
+                        + " return e ? e.dataset.phase + '/' + e.dataset.outcome : null;");
+                return phase != null && phase.startsWith("done/") ? phase : null;
+            }, b::source);
+            b.screenshot(shots.resolve("changesets-progress-two-done.png"));
+            assertEquals("done/committed", done, textOf(b, "#arflex-cs-live-box"));
+            List<Map<String, String>> rows = updateRows(b);
+            System.out.println("ChangeSetConsoleIT: two updates, the outcome: " + rows);
+            assertEquals(2, rows.size(), "the rows stay with the outcome: " + rows);
+            for (Map<String, String> r : rows) {
+                assertEquals("committed", r.get("verdict"), rows.toString());
+                assertEquals("window", r.get("phase"), rows.toString());
+                assertEquals("200", r.get("cycles"), rows.toString());
+                assertTrue(Long.parseLong(r.get("cycle")) >= 200, "its last counters: " + rows);
+            }
+            assertEquals("", rows.get(0).get("worst"), "no shadow run, no deviation: " + rows);
+            assertFalse(rows.get(1).get("worst").isEmpty(), "the scaler's shadow run's worst deviation kept: " + rows);
+        }
+        // the endpoint says the same
+        Map<String, Object> p = Json.object(rt.get(PAGE + "/api/changeset-progress", true).body());
+        Map<String, Object> last = (Map<String, Object>) p.get("progress");
+        List<Map<String, Object>> updates = (List<Map<String, Object>>) last.get("updates");
+        assertEquals(List.of("sample-counter", "sample-scaler"), updates.stream().map(u -> u.get("component")).toList());
+        assertNull(updates.get(0).get("worstField"), String.valueOf(updates));
+        assertEquals("y.value", updates.get(1).get("worstField"), String.valueOf(updates));
+        assertTrue(String.valueOf(updates.get(1).get("why")).startsWith("update sample-scaler: committed: the new version ran"),
+                String.valueOf(updates));
+        RuntimeUnderTest.awaitCondition("both new versions running", WAIT,
+                () -> pid("sample-counter") != counterPid && pid("sample-scaler") != scalerPid);
+        // the shell: a line per update
+        rt.gogo("arflex:change progress");
+        RuntimeUnderTest.awaitCondition("arflex:change progress answered with a line per update", WAIT,
+                () -> rt.tail().contains("update sample-scaler: rollback window, cycle "));
+        String tail = rt.tail();
+        assertTrue(tail.matches("(?s).*\nupdate sample-counter: rollback window, cycle \\d+ of 200; committed\n"
+                + "update sample-scaler: rollback window, cycle \\d+ of 200, worst deviation in shadow y\\.value \\S+ "
+                + "\\(tolerance 1\\.0E-6\\); committed.*"), tail);
     }
 }

@@ -333,6 +333,54 @@ class ChangeSetBackendTest {
         assertEquals(2_500L, v.get("forMs"));
         assertEquals(17L, v.get("seq"));
         assertNull(v.get("outcome"));
+        assertEquals(List.of(), v.get("updates"), "a DRCR that names no update");
         assertTrue(started.isEmpty() && applied.isEmpty(), "reading the progress applies nothing");
+    }
+
+    private static org.arflex.drcr.dto.UpdateProgressDTO entry(String component, String phase, long cycle, long cycles,
+                                                              double worst, String verdict) {
+        org.arflex.drcr.dto.UpdateProgressDTO u = new org.arflex.drcr.dto.UpdateProgressDTO();
+        u.component = component;
+        u.phase = phase;
+        u.step = "update " + component + ": " + phase + " cycle " + cycle;
+        u.cycle = cycle;
+        u.cycles = cycles;
+        u.worstField = "y.value";
+        u.worstDeviation = worst;
+        u.tolerance = 0.01;
+        u.verdict = verdict;
+        u.why = verdict == null ? null : "update " + component + ": " + verdict + ": why";
+        return u;
+    }
+
+    @Test
+    @SuppressWarnings("unchecked")
+    void eachUpdateOfTheSetIsAnEntryInItsOrder() {
+        org.arflex.drcr.dto.ChangeSetProgressDTO p = new org.arflex.drcr.dto.ChangeSetProgressDTO();
+        p.actions = new String[] {"update src file:/s.jar", "update stage file:/x.jar"};
+        p.running = false;
+        p.phase = "done";
+        p.phases = new String[] {"checking", "preparing", "shadow", "switching", "window", "done"};
+        p.outcome = "committed";
+        p.updates = new org.arflex.drcr.dto.UpdateProgressDTO[] {entry("src", "window", 50, 40, 0.002, "committed"),
+                entry("stage", "window", 60, 50, 0.004, null)};
+        progressAnswer = p;
+        List<Map<String, Object>> u = (List<Map<String, Object>>) ((Map<String, Object>) backend.progress()
+                .get("progress")).get("updates");
+        assertEquals(2, u.size());
+        assertEquals(List.of("src", "stage"), u.stream().map(e -> e.get("component")).toList());
+        Map<String, Object> src = u.get(0);
+        assertEquals("window", src.get("phase"));
+        assertEquals(50L, src.get("cycle"));
+        assertEquals(40L, src.get("cycles"));
+        assertEquals("y.value", src.get("worstField"));
+        assertEquals(0.002, src.get("worstDeviation"));
+        assertEquals(0.01, src.get("tolerance"));
+        assertEquals("committed", src.get("verdict"));
+        assertEquals("update src: committed: why", src.get("why"));
+        assertEquals("update src: window cycle 50", src.get("step"));
+        assertEquals(60L, u.get(1).get("cycle"));
+        assertEquals(0.004, u.get(1).get("worstDeviation"));
+        assertNull(u.get(1).get("verdict"));
     }
 }

@@ -45,6 +45,12 @@ public class ChangeSetProgressDTO {
     public String outcome;
     /** In {@code done}: why (the refusal, or the verdict of the updates' windows), or null. */
     public String why;
+    /**
+     * Each update of the set, in the order the updates appear in it (D60): its own phase,
+     * counters and verdict; the fields above show the one whose counters moved last. Kept after
+     * the apply ends. Empty for a set without updates, and until the executor accepts the set.
+     */
+    public UpdateProgressDTO[] updates;
     /** Grows with every snapshot of this runtime: a reader sees whether anything moved. */
     public long seq;
 }

@@ -99,7 +99,8 @@ final class ChangeSetExecutor {
             then.accept(new SetOutcome(false, c.refusal(), c.plan(), 0, 0));
             return;
         }
-        p.claim();
+        p.claim(set.steps().stream().filter(ChangeSet.Update.class::isInstance)
+                .map(ChangeSet.Step::component).toList());
         SetRun run = new SetRun(tools, switchTurn, p, set, c, then, cell.config().monotonicNs().getAsLong(),
                 () -> current = null);
         current = run;

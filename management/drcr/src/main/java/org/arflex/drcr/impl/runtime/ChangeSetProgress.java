@@ -4,6 +4,7 @@ import java.util.ArrayList;
 import java.util.List;
 import java.util.function.LongSupplier;
 import org.arflex.drcr.dto.ChangeSetProgressDTO;
+import org.arflex.drcr.dto.UpdateProgressDTO;
 
 /**
  * The live progress of the change set being applied (D53): its phase, what it does in it, an
@@ -11,6 +12,10 @@ import org.arflex.drcr.dto.ChangeSetProgressDTO;
  * its {@link Apply}; {@link #snapshot} reads the last snapshot without a lock (a volatile
  * field holding a DTO that is never changed once published), so a reader never holds up the
  * actor, and publishing is a few field writes under this object's lock, no I/O.
+ *
+ * <p>Each update of the set has its own entry (D60, {@link ChangeSetProgressDTO#updates}), in
+ * the set's order, moved by the shadow run's and the window's publishing about its component and
+ * kept after the apply ends; an entry is replaced, never changed, once published.
  *
  * <p>One set is shown: an apply begun while another is shown and still running is not shown
  * (its publishing is ignored) unless the executor takes it ({@link Apply#claim}), which happens
@@ -25,6 +30,10 @@ public final class ChangeSetProgress {
     public static final String WINDOW = "window";
     public static final String BUNDLES = "bundles";
     public static final String DONE = "done";
+    /** An update's own verdicts (D60), in the outcome's words. */
+    public static final String COMMITTED = "committed";
+    public static final String ROLLED_BACK = "rolled-back";
+    public static final String REJECTED_IN_SHADOW = "rejected-in-shadow";
 
     private final LongSupplier clock;
     private volatile ChangeSetProgressDTO shown;
@@ -67,11 +76,30 @@ public final class ChangeSetProgress {
         c.worstDeviation = d.worstDeviation;
         c.tolerance = d.tolerance;
         c.phases = d.phases.clone();
+        c.updates = new UpdateProgressDTO[d.updates.length];
+        for (int i = 0; i < c.updates.length; i++) {
+            c.updates[i] = copy(d.updates[i]);
+        }
         c.startedMillis = d.startedMillis;
         c.phaseMillis = d.phaseMillis;
         c.outcome = d.outcome;
         c.why = d.why;
         c.seq = d.seq;
+        return c;
+    }
+
+    private static UpdateProgressDTO copy(UpdateProgressDTO u) {
+        UpdateProgressDTO c = new UpdateProgressDTO();
+        c.component = u.component;
+        c.phase = u.phase;
+        c.step = u.step;
+        c.cycle = u.cycle;
+        c.cycles = u.cycles;
+        c.worstField = u.worstField;
+        c.worstDeviation = u.worstDeviation;
+        c.tolerance = u.tolerance;
+        c.verdict = u.verdict;
+        c.why = u.why;
         return c;
     }
 
@@ -98,6 +126,8 @@ public final class ChangeSetProgress {
     public final class Apply {
         private final String[] actions;
         private final List<String> phases = new ArrayList<>();
+        /** Each update's last entry, in the set's order (guarded by the progress); never changed once placed. */
+        private UpdateProgressDTO[] updates = new UpdateProgressDTO[0];
         private long startedMillis;
         private long phaseMillis;
         private String phase;
@@ -107,11 +137,25 @@ public final class ChangeSetProgress {
             this.actions = actions.toArray(String[]::new);
         }
 
-        /** Shown from now on (the executor accepted this set): its phases start afresh. */
-        public void claim() {
+        /**
+         * Shown from now on (the executor accepted this set): its phases start afresh, and
+         * {@code components}, the components its updates replace in the set's order, each get
+         * an entry (D60).
+         */
+        public void claim(List<String> components) {
             synchronized (ChangeSetProgress.this) {
+                updates = new UpdateProgressDTO[components.size()];
+                for (int i = 0; i < updates.length; i++) {
+                    updates[i] = new UpdateProgressDTO();
+                    updates[i].component = components.get(i);
+                }
                 if (owner != this) {
                     take();
+                } else if (running) {
+                    ChangeSetProgressDTO d = copy(shown);
+                    d.updates = updates.clone();
+                    d.seq = ++seq;
+                    shown = d;
                 }
             }
         }
@@ -136,12 +180,59 @@ public final class ChangeSetProgress {
                 if (owner != this || !running) {
                     return;
                 }
+                int i = (SHADOW.equals(phase) || WINDOW.equals(phase)) ? indexOf(component) : -1;
+                if (i >= 0) {
+                    UpdateProgressDTO u = copy(updates[i]);
+                    u.phase = phase;
+                    u.step = step;
+                    u.cycle = cycle;
+                    u.cycles = cycles;
+                    if (worstField != null) {
+                        u.worstField = worstField;
+                        u.worstDeviation = worstDeviation;
+                        u.tolerance = tolerance;
+                    }
+                    updates[i] = u;
+                }
                 ChangeSetProgressDTO d = next(phase, step, component, cycle, cycles);
                 d.worstField = worstField;
                 d.worstDeviation = worstDeviation;
                 d.tolerance = tolerance;
                 shown = d;
             }
+        }
+
+        /**
+         * The update of {@code component} has its own verdict ({@code committed},
+         * {@code rolled-back} or {@code rejected-in-shadow}), {@code why}, after {@code cycle}
+         * cycles of its shadow run or window: its entry says so; the set's phase and step are
+         * unchanged (D60).
+         */
+        public void verdict(String component, String verdict, String why, long cycle) {
+            synchronized (ChangeSetProgress.this) {
+                int i = indexOf(component);
+                if (owner != this || !running || i < 0) {
+                    return;
+                }
+                UpdateProgressDTO u = copy(updates[i]);
+                u.verdict = verdict;
+                u.why = why;
+                u.cycle = cycle;
+                updates[i] = u;
+                ChangeSetProgressDTO d = copy(shown);
+                d.updates = updates.clone();
+                d.seq = ++seq;
+                shown = d;
+            }
+        }
+
+        private int indexOf(String component) {
+            for (int i = 0; i < updates.length; i++) {
+                if (updates[i].component.equals(component)) {
+                    return i;
+                }
+            }
+            return -1;
         }
 
         /** The outcome: shown until the next apply begins. */
@@ -183,6 +274,7 @@ public final class ChangeSetProgress {
             d.cycle = cycle;
             d.cycles = cycles;
             d.phases = phases.toArray(String[]::new);
+            d.updates = updates.clone();
             d.startedMillis = startedMillis;
             d.phaseMillis = phaseMillis;
             d.seq = ++seq;

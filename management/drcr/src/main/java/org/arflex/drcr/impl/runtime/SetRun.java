@@ -207,9 +207,11 @@ final class SetRun {
         @Override
         public void rejected(ShadowRun r, String why) {
             if (!over) {
-                abandon(String.format(java.util.Locale.ROOT, "update %s: rejected in shadow after %d cycles: %s; "
-                        + "nothing changed (pid %d runs %s on)", r.next.name, r.cycles(), why, r.oldHalf.pid(),
-                        r.next.name), "rejected in shadow: " + r.next.name);
+                String refusal = String.format(java.util.Locale.ROOT, "update %s: rejected in shadow after %d cycles: "
+                        + "%s; nothing changed (pid %d runs %s on)", r.next.name, r.cycles(), why, r.oldHalf.pid(),
+                        r.next.name);
+                progress.verdict(r.next.name, ChangeSetProgress.REJECTED_IN_SHADOW, refusal, r.cycles());
+                abandon(refusal, "rejected in shadow: " + r.next.name);
             }
         }
     };

@@ -130,7 +130,7 @@ final class UpdateWindow {
     void end(String why, long cycles) {
         close();
         handOver.retire(set, old, oldHalf);
-        report.ended(why, update.window() > 0 && nextHalf != null);
+        report.ended(why, update.window() > 0 && nextHalf != null, cycles);
     }
 
     /**

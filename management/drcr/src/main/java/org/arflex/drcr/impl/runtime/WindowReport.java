@@ -36,17 +36,22 @@ final class WindowReport {
         cell.problem("change set " + set.describe() + ": " + v);
         log.accept("arflex: " + v);
         cell.changed();
+        progress.verdict(name, ChangeSetProgress.ROLLED_BACK, v, 0);
         verdict.complete(v);
     }
 
-    /** The window is over without a rollback, for {@code why}; {@code shown}: it was shown in the progress. */
-    void ended(String why, boolean shown) {
+    /**
+     * The window is over without a rollback, for {@code why}, after {@code cycles} of the new
+     * version; {@code shown}: it was shown in the progress.
+     */
+    void ended(String why, boolean shown, long cycles) {
         String v = "update " + name + ": " + why;
         log.accept("arflex: " + v);
         cell.changed();
         if (shown) {
             progress.phase(ChangeSetProgress.WINDOW, v);
         }
+        progress.verdict(name, ChangeSetProgress.COMMITTED, v, cycles);
         verdict.complete(v);
     }
 
@@ -58,6 +63,7 @@ final class WindowReport {
         old.life.reason(null);
         cell.problem("change set " + set.describe() + ": " + v);
         progress.phase(ChangeSetProgress.WINDOW, v);
+        progress.verdict(name, ChangeSetProgress.ROLLED_BACK, v, cycles);
         verdict.complete(v);
     }
 

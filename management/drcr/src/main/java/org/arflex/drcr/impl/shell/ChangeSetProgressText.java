@@ -2,8 +2,12 @@ package org.arflex.drcr.impl.shell;
 
 import java.util.Locale;
 import org.arflex.drcr.dto.ChangeSetProgressDTO;
+import org.arflex.drcr.dto.UpdateProgressDTO;
 
-/** {@code arflex:change progress} (D53): where the set being applied is, or how the last one ended. */
+/**
+ * {@code arflex:change progress} (D53): where the set being applied is, or how the last one ended;
+ * a set of several updates gets a line for each (D60), in the set's order.
+ */
 final class ChangeSetProgressText {
 
     private ChangeSetProgressText() {
@@ -24,18 +28,47 @@ final class ChangeSetProgressText {
                     Math.max(0, nowMillis - p.phaseMillis) / 1e3, Math.max(0, p.phaseMillis - p.startedMillis) / 1e3,
                     String.join(" > ", p.phases)));
         }
+        boolean each = p.updates != null && p.updates.length > 1;
         if (p.running) {
             sb.append("now: ").append(p.step).append('\n');
-            if (p.cycles > 0) {
+            if (each) {
+                updates(sb, p);
+            } else if (p.cycles > 0) {
                 sb.append(String.format(Locale.ROOT, "cycles: %d of %d (%s)%n", p.cycle, p.cycles, p.component));
             }
-            if (p.worstField != null) {
+            if (!each && p.worstField != null) {
                 sb.append(String.format(Locale.ROOT, "worst deviation so far: %s %.3g (tolerance %s)%n", p.worstField,
                         p.worstDeviation, p.tolerance));
             }
         } else {
             sb.append("outcome: ").append(p.outcome).append(p.why == null ? "" : ": " + p.why).append('\n');
+            if (each) {
+                updates(sb, p);
+            }
         }
         return sb.toString().stripTrailing();
+    }
+
+    /** One line per update (D60): its phase, cycles, its shadow run's worst deviation, its verdict. */
+    private static void updates(StringBuilder sb, ChangeSetProgressDTO p) {
+        for (UpdateProgressDTO u : p.updates) {
+            sb.append("update ").append(u.component).append(": ");
+            if (u.phase == null) {
+                sb.append(p.running ? "not in a shadow run or window yet" : "no shadow run or window");
+            } else {
+                sb.append(String.format(Locale.ROOT, "%s, cycle %d of %d", u.phase.equals("shadow") ? "shadow run"
+                        : "rollback window", u.cycle, u.cycles));
+            }
+            if (u.worstField != null) {
+                sb.append(String.format(Locale.ROOT, ", worst deviation in shadow %s %.3g (tolerance %s)", u.worstField,
+                        u.worstDeviation, u.tolerance));
+            }
+            if (u.verdict != null) {
+                sb.append("; ").append(u.verdict);
+            } else if (!p.running) {
+                sb.append("; no verdict of its own");
+            }
+            sb.append('\n');
+        }
     }
 }

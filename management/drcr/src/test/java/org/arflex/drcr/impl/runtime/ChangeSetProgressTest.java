@@ -18,6 +18,7 @@ import java.util.List;
 import java.util.concurrent.CompletableFuture;
 import java.util.concurrent.atomic.AtomicLong;
 import org.arflex.drcr.dto.ChangeSetProgressDTO;
+import org.arflex.drcr.dto.UpdateProgressDTO;
 import org.arflex.drcr.impl.abi.ControlBlock;
 import org.arflex.drcr.impl.lifecycle.ManualActor;
 import org.junit.jupiter.api.AfterEach;
@@ -120,6 +121,10 @@ class ChangeSetProgressTest {
         assertTrue(p.step.startsWith("update stage: shadow run of pid " + newHalf.pid + ", cycle 40 of 100, 1 values "
                 + "compared, 0 overruns or deadline misses, worst y.value 0.00400 from the running version's (tolerance "
                 + "0.01)"), p.step);
+        // a set of one update: its one entry says what the fields above say (D60)
+        assertEquals(1, p.updates.length);
+        assertEntry(p.updates[0], "stage", "shadow", 40, 100, 0.004, null);
+        assertEquals(p.step, p.updates[0].step);
         assertFalse(f.isDone());
         // passed: switched, then its window of 50 cycles
         newHalf.stats = cycles(100);
@@ -144,6 +149,10 @@ class ChangeSetProgressTest {
         assertEquals("done", p.phase);
         assertEquals("committed", p.outcome);
         assertTrue(p.why.contains("update stage: committed: the new version ran 60 cycles"), p.why);
+        assertEquals(1, p.updates.length);
+        assertEntry(p.updates[0], "stage", "window", 60, 50, 0.004, "committed");
+        assertTrue(p.updates[0].why.startsWith("update stage: committed: the new version ran 60 cycles"),
+                p.updates[0].why);
         assertArrayEquals(new String[] {"checking", "preparing", "shadow", "switching", "window", "done"}, p.phases);
         // every phase was seen live too, but the executor's checks and the switch (each within one actor
         // turn, between two reads)
@@ -174,6 +183,8 @@ class ChangeSetProgressTest {
         assertTrue(p.why.startsWith("update stage: rejected in shadow after 20 cycles: the new version (pid "
                 + newHalf.pid + ") exited: killed by signal 11"), p.why);
         assertArrayEquals(new String[] {"checking", "preparing", "shadow", "done"}, p.phases);
+        assertEntry(p.updates[0], "stage", "shadow", 20, 200, 0, "rejected-in-shadow");
+        assertEquals(p.why, p.updates[0].why);
         assertFalse(phasesSeen().contains("switching"));
         assertFalse(phasesSeen().contains("window"));
     }
@@ -189,6 +200,165 @@ class ChangeSetProgressTest {
         assertEquals("refused", p.outcome);
         assertTrue(p.why.contains("no component 'nobody' is known to the cell"), p.why);
         assertArrayEquals(new String[] {"checking", "done"}, p.phases);
+        assertEquals(0, p.updates.length, "no update, refused before the executor took it");
+    }
+
+    /** src's update to 1.1.0 (new output {@code /arflex.t.1-src.out.y}), its shadow run and window. */
+    private static final String OLD_SRC_Y = "/arflex.t.src.out.y";
+    private static final String NEW_SRC_Y = "/arflex.t.1-src.out.y";
+
+    @Test
+    void eachUpdateOfASetShowsItsOwnCountersAndVerdictKeptAfterTheApply() throws Exception {
+        runningCell();
+        List<ChangeSet.Tolerance> y = List.of(new ChangeSet.Tolerance("y", "value", 0.01));
+        ChangeSet set = ChangeSet.builder()
+                .update("src", parse("src", "src", OUT, "1.1.0"), Path.of("/nonexistent/src-1.1"),
+                        "file:/x/src-1.1.jar", 40, List.of(), 100, y)
+                .update("stage", parse("stage", "stage", IN_SRC + OUT, "1.1.0"), Path.of("/nonexistent/stage-1.1"),
+                        "file:/x/stage-1.1.jar", 50, List.of(), 200, y)
+                .build();
+        CompletableFuture<ChangeSetResult> f = actor.call(() -> cell.applyChangeSet(set), 0);
+        rig.stepUntil("both new halves started in shadow", () -> {
+            now();
+            return fake.events.contains("1-src START") && fake.events.contains("1-stage START") || f.isDone();
+        });
+        assertFalse(f.isDone(), rig.log::toString);
+        ChangeSetProgressDTO p = now();
+        assertEquals("shadow", p.phase);
+        assertEquals(2, p.updates.length, "one entry per update");
+        // each shadow run said it began (cycle 0, nothing compared yet)
+        assertEntry(p.updates[0], "src", "shadow", 0, 100, 0, null);
+        assertEntry(p.updates[1], "stage", "shadow", 0, 200, 0, null);
+        assertTrue(seen.stream().anyMatch(s -> s.updates.length == 2 && s.updates[0].phase == null
+                && s.updates[1].phase == null), "neither in shadow while preparing");
+        assertTrue(seen.stream().filter(s -> "preparing".equals(s.phase)).allMatch(s -> s.updates.length == 2),
+                "the entries are there from the executor's acceptance on");
+        FakeLauncher.FakeHalf newSrc = fake.running.get("1-src");
+        FakeLauncher.FakeHalf newStage = fake.running.get("1-stage");
+        fake.values.put(OLD_SRC_Y, sample(500, 7_000, 2.000));
+        fake.values.put(NEW_SRC_Y, sample(3, 7_000, 2.002));
+        fake.values.put(OLD_Y, sample(500, 7_000, 1.000));
+        fake.values.put(NEW_Y, sample(3, 7_000, 1.004));
+        // interleaved: src moves, then stage, then src again; each entry keeps its own counters
+        newSrc.stats = cycles(30);
+        look();
+        p = now();
+        assertEquals("src", p.component, "the fields above show the one that moved last");
+        assertEntry(p.updates[0], "src", "shadow", 30, 100, 0.002, null);
+        assertTrue(p.updates[0].step.startsWith("update src: shadow run of pid " + newSrc.pid + ", cycle 30 of 100"),
+                p.updates[0].step);
+        assertEntry(p.updates[1], "stage", "shadow", 0, 200, 0, null);
+        newStage.stats = cycles(70);
+        look();
+        p = now();
+        assertEquals("stage", p.component);
+        assertEquals(70, p.cycle);
+        assertEntry(p.updates[0], "src", "shadow", 30, 100, 0.002, null);
+        assertEntry(p.updates[1], "stage", "shadow", 70, 200, 0.004, null);
+        newSrc.stats = cycles(60);
+        look();
+        p = now();
+        assertEquals("src", p.component);
+        assertEntry(p.updates[0], "src", "shadow", 60, 100, 0.002, null);
+        assertEntry(p.updates[1], "stage", "shadow", 70, 200, 0.004, null);
+        // both pass: switched, then each its own window (src 40 cycles, stage 50)
+        newSrc.stats = cycles(100);
+        newStage.stats = cycles(200);
+        look();
+        rig.stepUntil("the switch", () -> {
+            now();
+            return f.isDone();
+        });
+        assertTrue(f.join().applied(), f.join().text());
+        rig.stepUntil("both windows' baselines", () -> {
+            ChangeSetProgressDTO n = now();
+            return "window".equals(n.updates[0].phase) && n.updates[0].cycles == 40
+                    && "window".equals(n.updates[1].phase) && n.updates[1].cycles == 50;
+        });
+        newSrc.stats = cycles(120);
+        newStage.stats = cycles(230);
+        look();
+        p = now();
+        assertEquals("window", p.phase);
+        assertEntry(p.updates[0], "src", "window", 20, 40, 0.002, null);
+        assertEntry(p.updates[1], "stage", "window", 30, 50, 0.004, null);
+        assertTrue(p.updates[1].step.startsWith("update stage: rollback window, cycle 30 of 50 of pid " + newStage.pid),
+                p.updates[1].step);
+        // src's window is over: its verdict is in while stage's window goes on
+        newSrc.stats = cycles(150);
+        look();
+        rig.stepUntil("src's verdict", () -> now().updates[0].verdict != null);
+        p = now();
+        assertTrue(p.running);
+        assertEntry(p.updates[0], "src", "window", 50, 40, 0.002, "committed");
+        assertTrue(p.updates[0].why.startsWith("update src: committed: the new version ran 50 cycles"),
+                p.updates[0].why);
+        assertEntry(p.updates[1], "stage", "window", 30, 50, 0.004, null);
+        newStage.stats = cycles(260);
+        look();
+        rig.stepUntil("the set's outcome", () -> f.join().verdict().isDone() && !now().running);
+        p = now();
+        assertEquals("committed", p.outcome);
+        // after the apply, each update's last counters and its verdict are kept
+        assertEntry(p.updates[0], "src", "window", 50, 40, 0.002, "committed");
+        assertEntry(p.updates[1], "stage", "window", 60, 50, 0.004, "committed");
+        assertTrue(p.updates[1].why.startsWith("update stage: committed: the new version ran 60 cycles"),
+                p.updates[1].why);
+        // a reader's copy: changing it changes nothing shown
+        p.updates[0].cycle = -1;
+        p.updates[1] = null;
+        assertEquals(50, now().updates[0].cycle);
+        assertEquals("stage", now().updates[1].component);
+    }
+
+    @Test
+    void whenOneUpdateOfASetIsRejectedInShadowTheOtherKeepsItsCountersWithoutAVerdict() throws Exception {
+        runningCell();
+        List<ChangeSet.Tolerance> y = List.of(new ChangeSet.Tolerance("y", "value", 0.01));
+        ChangeSet set = ChangeSet.builder()
+                .update("src", parse("src", "src", OUT, "1.1.0"), Path.of("/nonexistent/src-1.1"),
+                        "file:/x/src-1.1.jar", 40, List.of(), 100, y)
+                .update("stage", parse("stage", "stage", IN_SRC + OUT, "1.1.0"), Path.of("/nonexistent/stage-1.1"),
+                        "file:/x/stage-1.1.jar", 50, List.of(), 200, y)
+                .build();
+        CompletableFuture<ChangeSetResult> f = actor.call(() -> cell.applyChangeSet(set), 0);
+        rig.stepUntil("both new halves started in shadow", () -> {
+            now();
+            return fake.events.contains("1-src START") && fake.events.contains("1-stage START") || f.isDone();
+        });
+        FakeLauncher.FakeHalf newSrc = fake.running.get("1-src");
+        FakeLauncher.FakeHalf newStage = fake.running.get("1-stage");
+        newSrc.stats = cycles(25);
+        newStage.stats = cycles(45);
+        look();
+        newStage.crash(139, "killed by signal 11");
+        rig.stepUntil("the outcome", () -> {
+            now();
+            return f.isDone();
+        });
+        rig.stepUntil("progress done", () -> !now().running);
+        ChangeSetProgressDTO p = now();
+        assertEquals("rejected-in-shadow", p.outcome);
+        assertEntry(p.updates[0], "src", "shadow", 25, 100, 0, null);
+        assertEntry(p.updates[1], "stage", "shadow", 45, 200, 0, "rejected-in-shadow");
+        assertTrue(p.updates[1].why.startsWith("update stage: rejected in shadow after 45 cycles: the new version (pid "
+                + newStage.pid + ") exited: killed by signal 11"), p.updates[1].why);
+        assertEquals(p.why, p.updates[1].why);
+    }
+
+    private static void assertEntry(UpdateProgressDTO u, String component, String phase, long cycle, long cycles,
+                                    double worstDeviation, String verdict) {
+        String s = component + " " + u.phase + " " + u.cycle + " of " + u.cycles + " worst " + u.worstField + " "
+                + u.worstDeviation + " verdict " + u.verdict + ": " + u.step;
+        assertEquals(component, u.component, s);
+        assertEquals(phase, u.phase, s);
+        assertEquals(cycle, u.cycle, s);
+        assertEquals(cycles, u.cycles, s);
+        assertEquals(worstDeviation, u.worstDeviation, 1e-9, s);
+        // every update here compares y.value (tolerance 0.01): named from its shadow run's first look on
+        assertEquals(phase == null ? null : "y.value", u.worstField, s);
+        assertEquals(phase == null ? 0 : 0.01, u.tolerance, s);
+        assertEquals(verdict, u.verdict, s);
     }
 
     @Test
@@ -209,7 +379,7 @@ class ChangeSetProgressTest {
         // the executor accepted c (a's checking was not over yet): c is shown from now on, a no more
         ChangeSetProgress.Apply c = progress.begin(List.of("install c"));
         clock.set(1_500);
-        c.claim();
+        c.claim(List.of());
         a.done("committed", null);
         p = progress.snapshot();
         assertArrayEquals(new String[] {"install c"}, p.actions);
