@@ -13,6 +13,7 @@
 #include "tcp_correction_state2.h"
 #include "tool_state.h"
 #include "trajectory_state.h"
+#include "vision_state.h"
 #include "wrench.h"
 
 #endif /* ARFLEX_TYPES_ALL_H */
