@@ -18,7 +18,7 @@ import org.junit.jupiter.api.Test;
 /**
  * docs/DECISIONS.md D58: vision's state block (arflex.VisionState) on the moving arm with the
  * four cameras and vision feeding tcp-correction, as in VisionChangeSetIT. vision is updated to
- * 1.0.1 (the built bundle under a new contract version, pinned) in a change set; the new half
+ * 1.0.1 (the built bundle under a new contract version, pinned) in a change set (window 100); the new half
  * adopts the old half's block at its START and its first measurements continue the old half's
  * estimate:
  *
@@ -28,9 +28,11 @@ import org.junit.jupiter.api.Test;
  *       same series, not a series starting at 1);
  *   <li>it measures in the old half's camera frames: its block's camera poses are the old half's
  *       (to rounding: 1e-12) and it ran no calibration of its own;
- *   <li>for every frame set both halves measured during the window (the same image stamp) its
- *       tool position lies within {@link #SAME_FRAMES_BOUND} of the old half's: what tcp-correction
- *       reads does not step when it is bound to the new half.
+ *   <li>for every frame set both halves measured during the window (the same image stamp) from
+ *       the same number of views, three or more, its tool position lies within
+ *       {@link #SAME_VIEWS_BOUND} of the old half's: the same pixels through the same camera poses
+ *       give the same estimate, so what tcp-correction reads does not step when it is bound to
+ *       the new half.
  * </ul>
  *
  * <p>Then 1.0.2 with {@code set vision calibrate 1} in the same set: the new half adopts the block
@@ -55,15 +57,17 @@ class VisionStateIT {
     static final int VS_CAM_P = 104;
     static final int VS_CAM_QUAT = 200;
     /**
-     * The bound of the difference between the tool positions the two halves measure from the
-     * same frame set, adopted calibration, in standard deviations of the less certain of the two
-     * estimates (vision's own covariance). Both halves see the same pixels through the same camera
-     * poses; they differ only where the region each searches differs (each predicts it from the
-     * joint state it read, tens of ms apart on the moving arm), so a tag can be found by one and
-     * not the other, and the fit then rests on other corners: two estimates of one quantity from
-     * largely the same data, within their uncertainty. See D58 for the figures measured.
+     * The bound of the difference between the tool positions the two halves measure from the same
+     * frame set with the same number of views, three or more, the calibration adopted (m). They
+     * see the same pixels through the same camera poses; only the fit's starting point differs
+     * (each half predicts it from the joint state it read, tens of ms apart on the moving arm),
+     * and a well-determined fit ends at the same minimum whatever its start. Measured 0 to 0.03
+     * um; the same sets after a calibration of the new half's own: 1.3 to 7.1 um (D58). Fewer
+     * views, or another number of views in the two halves (a tag found in one region searched
+     * and not in the other), are not compared: a pose from one or two views can settle on either
+     * of two minima, 10-190 mm apart on this arm, whichever the calibration.
      */
-    static final double SAME_FRAMES_SIGMAS = 3;
+    static final double SAME_VIEWS_BOUND = 1e-6;
 
     record Pose(long tNs, long seq, double[] p, double[] cov, int valid, int views) {
         static Pose of(ByteBuffer v) {
@@ -99,7 +103,7 @@ class VisionStateIT {
 
     /** What one update of vision gave. */
     record Update(String out, List<Pose> olds, List<Pose> news, List<VState> oldStates, List<VState> newStates,
-                  double sameFrames, double sameSigmas, int compared) {
+                  double sameViews, int compared) {
     }
 
     @Test
@@ -120,7 +124,9 @@ class VisionStateIT {
             long guardPid = rt.pid("force-guard");
             long corrPid = rt.pid("tcp-correction");
 
-            Update a = update(rt, "vision", "1-vision", VisionChangeSetIT.version(VISION, "vision", dir, "1.0.1"), "");
+            // a window of 100 cycles (20 s, some 40 frame sets of the 500 ms cameras): frame sets
+            // both halves measured from the same three views or more to compare
+            Update a = update(rt, "vision", "1-vision", VisionChangeSetIT.version(VISION, "vision", dir, "1.0.1"), 100, "");
             assertTrue(a.out().contains("update vision: committed"), a.out());
             // the seq goes on: the first pose is the one after the seq its block was taken at
             VState adopted = a.newStates().get(0);
@@ -138,24 +144,22 @@ class VisionStateIT {
                 assertEquals(old.calibrations(), s.calibrations(), "the new half calibrated on its own");
                 assertEquals(0xf, s.calibrated());
             }
-            assertTrue(a.compared() >= 1, "no frame set measured by both halves");
-            assertTrue(a.sameSigmas() <= SAME_FRAMES_SIGMAS, String.format(Locale.ROOT,
-                    "same frames, %.2f standard deviations apart (%.1f um; bound %.0f)", a.sameSigmas(),
-                    a.sameFrames() * 1e6, SAME_FRAMES_SIGMAS));
+            assertTrue(a.compared() >= 1, "no frame set measured by both halves from the same three views or more");
+            assertTrue(a.sameViews() <= SAME_VIEWS_BOUND, String.format(Locale.ROOT,
+                    "the same frames and views, %.3f um apart (bound %.1f um)", a.sameViews() * 1e6, SAME_VIEWS_BOUND * 1e6));
 
             // contrast: the same update with a calibration asked for, as a half without the block would
-            Update b = update(rt, "1-vision", "2-vision", VisionChangeSetIT.version(VISION, "vision", dir, "1.0.2"),
+            Update b = update(rt, "1-vision", "2-vision", VisionChangeSetIT.version(VISION, "vision", dir, "1.0.2"), 60,
                     " set vision calibrate 1");
             assertTrue(b.out().contains("update vision: committed"), b.out());
             VState before = b.oldStates().get(b.oldStates().size() - 1);
             VState after = b.newStates().get(b.newStates().size() - 1);
             assertTrue(after.calibrations() >= before.calibrations() + 4, "the asked-for calibration ran: "
                     + before.calibrations() + " -> " + after.calibrations());
-            System.out.printf(Locale.ROOT, "VisionStateIT: same frame sets measured by both halves: adopted calibration "
-                    + "%.2f um apart at most, %.2f standard deviations (%d sets); calibrated again %.2f um, %.2f standard "
-                    + "deviations (%d sets); camera poses moved by the new calibration %.3g (m, quaternion)%n",
-                    a.sameFrames() * 1e6, a.sameSigmas(), a.compared(), b.sameFrames() * 1e6, b.sameSigmas(), b.compared(),
-                    maxDiff(before.cams(), after.cams()));
+            System.out.printf(Locale.ROOT, "VisionStateIT: frame sets both halves measured from the same three views or "
+                    + "more: adopted calibration %.3f um apart at most (%d sets); calibrated again %.3f um (%d sets); camera "
+                    + "poses moved by the new calibration %.3g (m, quaternion)%n", a.sameViews() * 1e6, a.compared(),
+                    b.sameViews() * 1e6, b.compared(), maxDiff(before.cams(), after.cams()));
 
             assertEquals(List.of(), CellRig.awaitingReset(rt));
             assertEquals(List.of(), CellRig.awaitingCommand(rt));
@@ -176,11 +180,11 @@ class VisionStateIT {
     }
 
     /**
-     * Applies {@code update vision <jar> <pin> window 25<extra>} while the arm moves, recording
+     * Applies {@code update vision <jar> <pin> window <window><extra>} while the arm moves, recording
      * both halves' poses and state blocks ({@code oldId}, {@code newId}: their object ids),
      * tcp-correction's measurements, the guard and the arm; checks the arm (no stop, no safe cycle).
      */
-    static Update update(Runtime rt, String oldId, String newId, Path jar, String extra) throws Exception {
+    static Update update(Runtime rt, String oldId, String newId, Path jar, int window, String extra) throws Exception {
         CellRig.Trace<Pose> olds = new CellRig.Trace<>();
         CellRig.Trace<Pose> news = new CellRig.Trace<>();
         CellRig.Trace<VState> oldStates = new CellRig.Trace<>();
@@ -209,7 +213,7 @@ class VisionStateIT {
             });
             Map<String, Object> robot0 = ChangeSetIT.stats(rt, "sim-robot");
             int logMark = rt.logMark();
-            String command = "arflex:change apply update vision file:" + jar + " " + sha256(jar) + " window 25" + extra;
+            String command = "arflex:change apply update vision file:" + jar + " " + sha256(jar) + " window " + window + extra;
             long t0 = System.nanoTime();
             CompletableFuture<String> apply = CompletableFuture.supplyAsync(() -> rt.cmd(command));
             Path newPose = rt.segment(newId, "tcp_pose");
@@ -253,30 +257,31 @@ class VisionStateIT {
                 }
             }
             double same = 0;
-            double sigmas = 0;
             int compared = 0;
             for (Pose p : n) {
                 Pose q = byStamp.get(p.tNs());
                 if (p.valid() == 1 && q != null) {
-                    same = Math.max(same, p.distance(q));
-                    sigmas = Math.max(sigmas, p.distance(q) / Math.max(p.sigma(), q.sigma()));
-                    compared++;
+                    // see SAME_VIEWS_BOUND: the same number of views, three or more
+                    if (p.views() >= 3 && p.views() == q.views()) {
+                        same = Math.max(same, p.distance(q));
+                        compared++;
+                    }
                     System.out.printf(Locale.ROOT, "VisionStateIT: frames of %d: seq %d (%d views) against %d (%d views): "
                             + "%.2f um apart, sigma %.2f / %.2f um%n", p.tNs(), p.seq(), p.views(), q.seq(), q.views(),
                             p.distance(q) * 1e6, p.sigma() * 1e6, q.sigma() * 1e6);
                 }
             }
             List<CellRig.Sample> e = err.snapshot();
-            System.out.printf(Locale.ROOT, "VisionStateIT: %s -> %s: %d poses of the old half, %d of the new; same frame "
-                    + "sets %d, largest difference %.2f um (%.2f standard deviations); tcp-correction's error around the "
-                    + "switch (mm, per measurement it took): %s%n", oldId, newId, o.size(), n.size(), compared, same * 1e6,
-                    sigmas, e.subList(Math.max(0, errAfter - 4), e.size()).stream()
+            System.out.printf(Locale.ROOT, "VisionStateIT: %s -> %s: %d poses of the old half, %d of the new; frame "
+                    + "sets with the same three views or more %d, largest difference %.3f um; tcp-correction's error around "
+                    + "the switch (mm, per measurement it took): %s%n", oldId, newId, o.size(), n.size(), compared, same * 1e6,
+                    e.subList(Math.max(0, errAfter - 4), e.size()).stream()
                             .map(s -> String.format(Locale.ROOT, "%.3f", s.value())).toList());
             Map<String, Object> robot1 = ChangeSetIT.stats(rt, "sim-robot");
             assertNull(safety.snapshot().stream().filter(s -> s.mode() != CellRig.Safety.NORMAL).findFirst().orElse(null),
                     "the guard left NORMAL");
             assertEquals(0, ChangeSetIT.delta(robot0, robot1, "safeCycles"), "sim-robot ran safe cycles");
-            return new Update(out, o, n, oldStates.snapshot(), newStates.snapshot(), same, sigmas, compared);
+            return new Update(out, o, n, oldStates.snapshot(), newStates.snapshot(), same, compared);
         } finally {
             for (CellRig.Port p : late) {
                 p.close();
