@@ -161,6 +161,65 @@ static void component_attach_every_call_fails(void **state)
 	assert_true(came_up >= 1);
 }
 
+static char env_start[64];
+
+/* The test fault of an RT half's START (D58): ARFLEX_FAULT_START_ERRNO=<n> in its environment
+ * refuses every START with -n and leaves the half READY, able to shut down as always; the same
+ * probe without it (the shipped default) starts. What the update tests' "refuses START"
+ * versions set (tests/.../FaultyVersions.refusingStart). */
+static void env_var_refuses_start(void **state)
+{
+	struct arflex_host_output out;
+	struct arflex_param_slot p;
+	struct arflex_host_opts o;
+
+	(void)state;
+	th_rid(rid, sizeof(rid), "fstart");
+	fill_opts(&o, &p, &out, "probe");
+	out.spec.type.elem_size = 96; /* struct probe_out, as above */
+	for (int refuse = 0; refuse < 2; refuse++) {
+		struct arflex_host h;
+		int k = 0;
+
+		for (char **e = environ; *e && k < 250; e++)
+			if (strncmp(*e, "ARFLEX_", 7))
+				envp[k++] = *e;
+		if (refuse) {
+			snprintf(env_start, sizeof(env_start), "ARFLEX_FAULT_START_ERRNO=%d", ECANCELED);
+			envp[k++] = env_start;
+		}
+		envp[k] = NULL;
+		int first, second = 0, stop = 0, down, status;
+		uint32_t state;
+
+		assert_int_equal(arflex_host_create(&h, &o), 0);
+		assert_int_equal(arflex_host_spawn(&h, ARFLEX_PROBE_EXE, NULL, envp), 0);
+		assert_int_equal(arflex_host_wait_state(&h, ARFLEX_STATE_READY, 10 * SEC), 0);
+		first = arflex_host_start(&h, 2 * SEC);
+		state = arflex_ctl_state(h.ctl);
+		if (refuse) /* refused again: the fault is every START's, not the first one's */
+			second = arflex_host_start(&h, 2 * SEC);
+		else
+			stop = arflex_host_stop(&h, 2 * SEC);
+		/* the half is shut down before anything is asserted: a failure leaves no process */
+		down = arflex_host_shutdown(&h, 2 * SEC);
+		if (down == 0)
+			down = arflex_host_wait_exit(&h, 10 * SEC);
+		else
+			arflex_host_kill(&h, SIGKILL);
+		status = arflex_host_exit_status(&h);
+		arflex_host_destroy(&h);
+		th_assert_clean(rid);
+		assert_int_equal(first, refuse ? -ECANCELED : 0);
+		assert_int_equal(state, refuse ? ARFLEX_STATE_READY : ARFLEX_STATE_RUNNING);
+		assert_int_equal(second, refuse ? -ECANCELED : 0);
+		assert_int_equal(stop, 0);
+		assert_int_equal(down, 0);
+		assert_true(WIFEXITED(status));
+		assert_int_equal(WEXITSTATUS(status), 0);
+	}
+}
+
 static void env_var_enables_injection(void **state)
 {
 	(void)state;
@@ -192,6 +251,7 @@ int main(void)
 		cmocka_unit_test(env_var_enables_injection),
 		cmocka_unit_test(host_create_every_call_fails),
 		cmocka_unit_test(component_attach_every_call_fails),
+		cmocka_unit_test(env_var_refuses_start),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);

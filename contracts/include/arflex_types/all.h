@@ -14,6 +14,7 @@
 #include "teach_state.h"
 #include "tool_state.h"
 #include "trajectory_state.h"
+#include "vision_state.h"
 #include "wrench.h"
 
 #endif /* ARFLEX_TYPES_ALL_H */

@@ -30,6 +30,12 @@ static int do_start(struct arflex_component *c)
 
 	if (c->running)
 		return -EALREADY;
+	if (c->fault_start_err) { /* a test fault only (D58): never set by a shipped default */
+		arflex_comp_log(c, "START refused: test fault ARFLEX_FAULT_START_ERRNO=%d (%s)",
+				c->fault_start_err, strerror(c->fault_start_err));
+		arflex_comp_adopt_done(c); /* an ADOPT given for it is not taken */
+		return -c->fault_start_err;
+	}
 	STORE(&c->ctl->state, ARFLEX_STATE_RUNNING);
 	/* the RT thread must not take the process signals */
 	sigemptyset(&all);

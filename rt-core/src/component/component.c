@@ -8,6 +8,7 @@
 #include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
 #include <unistd.h>
@@ -149,6 +150,27 @@ static void init_params(struct arflex_ctl *ctl)
 	arflex_ctl_param_apply_all(ctl, false);
 }
 
+/* The test fault of START (D58, as ARFLEX_FAULT_NTH in sys.c): ARFLEX_FAULT_START_ERRNO=<n>,
+ * 1..4095, makes this half refuse every START with -n. Only the update tests' deliberately
+ * faulty versions set it (a script that execs the real executable); nothing shipped does. */
+static void fault_start_env(struct arflex_component *c)
+{
+	const char *s = getenv("ARFLEX_FAULT_START_ERRNO");
+	char *end;
+	long n;
+
+	if (!s || !*s)
+		return;
+	n = strtol(s, &end, 10);
+	if (*end || n < 1 || n > 4095) {
+		fprintf(stderr, "arflex: %s: ARFLEX_FAULT_START_ERRNO=%s ignored (an errno 1..4095)\n",
+			c->name, s);
+		return;
+	}
+	c->fault_start_err = (int)n;
+	fprintf(stderr, "arflex: %s: test fault: every START is refused with errno %ld\n", c->name, n);
+}
+
 int arflex_component_main(int argc, char **argv, const struct arflex_component_ops *ops)
 {
 	static struct arflex_component comp;
@@ -169,6 +191,7 @@ int arflex_component_main(int argc, char **argv, const struct arflex_component_o
 	r = parse_args(c, argc, argv);
 	if (r)
 		return r > 0 ? ARFLEX_EXIT_OK : ARFLEX_EXIT_USAGE;
+	fault_start_env(c);
 
 	memset(&sa, 0, sizeof(sa));
 	sa.sa_handler = on_signal;

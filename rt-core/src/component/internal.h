@@ -86,6 +86,7 @@ struct arflex_component {
 	unsigned ninputs;
 	struct arflex_stats stats_copy;
 	struct arflex_state_block state;
+	int fault_start_err;          /* test fault (D58): > 0 refuses every START with -it */
 };
 
 /* One log line on stderr, one write (component.c). */

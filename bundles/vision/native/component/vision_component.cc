@@ -16,6 +16,18 @@
 // forward kinematics of the joint state, or around the last pose, otherwise the full frame),
 // estimates the multi-view pose and leaves the result for the next update.
 //
+// State block (contract <state type="arflex.VisionState">, docs/DECISIONS.md D58): the cameras'
+// extrinsic calibration, the last valid marker pose, the seq of the pose written last and the
+// calibrate value served last. The worker leaves a snapshot of its part with each result; the
+// RT thread publishes the block every cycle the worker is idle (the snapshot is the worker's
+// last, the seqs are the RT thread's). A new version adopts it at its START in a change set
+// (the adopt hook, on the RT thread before the first update, while the worker has no job): it
+// measures in the old half's camera frames from its first frame set, without calibrating again,
+// and its poses continue the old half's seq. A block it cannot take is refused, which refuses
+// the START with the reason's errno (rt-core logs it): another type or major version
+// -EPROTOTYPE, a block shorter than the type -EMSGSIZE, a value outside the type's bounds or a
+// quaternion that is not a unit one -EINVAL.
+//
 // Validated data (docs/safety.md): a joint state that fails arflex_joint_state_valid (a
 // non-finite q, qd or tau) is not used for the ROI prediction (the worker searches around the
 // last pose, or the full frame) and is counted (update returns -EINVAL: stats.update_errors)
@@ -42,6 +54,7 @@ extern "C" {
 #include "arflex_types/image_frame.h"
 #include "arflex_types/joint_state.h"
 #include "arflex_types/pose.h"
+#include "arflex_types/vision_state.h"
 #include "arflex_vision/cell_layout.h"
 #include "arflex_vision/detector.h"
 #include "arflex_vision/estimator.h"
@@ -98,6 +111,12 @@ struct Vision {
   bool have_last = false;
   Eigen::Isometry3d last_marker = Eigen::Isometry3d::Identity();
   vision::EstimatorOptions options;
+  uint64_t calibrations = 0;
+
+  // The worker's part of the state block, written with each result (D58); read by the RT
+  // thread while busy == 0.
+  arflex_vision_state snapshot{};
+  arflex_vision_state state{};  // RT thread: the block published
 };
 
 Vision g;
@@ -112,6 +131,44 @@ const arflex_port_type kFrameType = {ARFLEX_TYPE_IMAGE_FRAME_NAME, 1, 0,
                                      ARFLEX_TYPE_IMAGE_FRAME_SIZE + ARFLEX_TYPE_IMAGE_FRAME_MAX_PAYLOAD};
 const arflex_port_type kJointType = {ARFLEX_TYPE_JOINT_STATE_NAME, 1, 0, ARFLEX_TYPE_JOINT_STATE_SIZE};
 const arflex_port_type kPoseType = {ARFLEX_TYPE_POSE_NAME, 1, 0, ARFLEX_TYPE_POSE_SIZE};
+
+// Quaternion w, x, y, z of a rotation, to 4 doubles.
+void PutQuat(const Eigen::Matrix3d& r, double* q) {
+  const Eigen::Quaterniond e(r);
+  q[0] = e.w();
+  q[1] = e.x();
+  q[2] = e.y();
+  q[3] = e.z();
+}
+
+// A unit quaternion (w, x, y, z) as a rotation; false when it is not one (to 1e-6).
+bool GetQuat(const double* q, Eigen::Matrix3d* r) {
+  const Eigen::Quaterniond e(q[0], q[1], q[2], q[3]);
+  if (!(std::abs(e.norm() - 1.0) <= 1e-6)) return false;
+  *r = e.normalized().toRotationMatrix();
+  return true;
+}
+
+// The worker's part of the state block (worker thread, at the end of a job).
+void Snapshot() {
+  Vision& v = g;
+  arflex_vision_state& s = v.snapshot;
+  s.calibrations = v.calibrations;
+  s.flags = v.have_last ? ARFLEX_VISION_STATE_FLAG_HAVE_LAST : 0u;
+  const Eigen::Vector3d lp = v.last_marker.translation();
+  for (int i = 0; i < 3; ++i) s.last_p[i] = lp(i);
+  PutQuat(v.last_marker.linear(), s.last_quat);
+  s.calibrated = 0;
+  for (int c = 0; c < kCameras; ++c) {
+    const vision::Camera& cam = v.cameras[c];
+    if (cam.calibrated) s.calibrated |= 1u << c;
+    const Eigen::Vector3d p = cam.world_from_camera.translation();
+    for (int i = 0; i < 3; ++i) s.cam_p[3 * c + i] = p(i);
+    PutQuat(cam.world_from_camera.linear(), &s.cam_quat[4 * c]);
+    s.cam_rms[c] = cam.calibration_rms_px;
+  }
+  s.fovy_deg = v.fovy_deg;
+}
 
 void Process() {
   Vision& v = g;
@@ -151,6 +208,7 @@ void Process() {
       fresh.calibrated = false;
       if (n > 0 && vision::CalibrateCamera(&fresh, v.board, dets.data(), n, v.options, nullptr, &error)) {
         cam = fresh;
+        ++v.calibrations;
       }
       if (!cam.calibrated) continue;
       vision::CollectObservations(c, dets.data(), n, v.tool, obs.data(), &nobs);
@@ -186,6 +244,7 @@ void Process() {
   for (int i = 0; i < 6; ++i) r.cov[i] = est.covariance(i, i);
   r.valid = est.valid ? 1u : 0u;
   r.n_views = static_cast<uint32_t>(est.valid ? est.n_views : 0);
+  Snapshot();
   v.result_ready = true;
 }
 
@@ -209,6 +268,11 @@ int Configure(arflex_component* c, void*) {
   if (r < 0) return r;
   r = arflex_component_output(c, "tcp_pose", ARFLEX_PORT_STATE, &kPoseType, &g.out);
   if (r < 0) return r;
+  // The state block (D58): without a state segment (a contract without <state>, a host test
+  // without one) publishing is a no-op.
+  static const arflex_port_type kStateType = {ARFLEX_TYPE_VISION_STATE_NAME, ARFLEX_TYPE_VISION_STATE_VERSION_MAJOR,
+                                              ARFLEX_TYPE_VISION_STATE_VERSION_MINOR, ARFLEX_TYPE_VISION_STATE_SIZE};
+  if ((r = arflex_component_state(c, &kStateType, nullptr)) < 0 && r != -ENOENT) return r;
   g.p_fovy = arflex_component_param(c, "fovy_deg");
   g.p_tcp[0] = arflex_component_param(c, "tcp_x");
   g.p_tcp[1] = arflex_component_param(c, "tcp_y");
@@ -225,6 +289,8 @@ int Configure(arflex_component* c, void*) {
     return -EINVAL;
   }
   for (FrameSlot& f : g.frames) f.pixels.reset(new uint8_t[kMaxPixels]);
+  g.fovy_deg = ParamF64(c, g.p_fovy, 50.0);
+  Snapshot();  // what a block published before the first job says (identity poses, nothing calibrated)
   if (sem_init(&g.go, 0, 0) != 0) return -errno;
   g.sem_ok = true;
   try {
@@ -237,13 +303,68 @@ int Configure(arflex_component* c, void*) {
   return 0;
 }
 
-int Update(arflex_component* c, void*, uint64_t) {
+// The state block (D58), RT thread, while the worker is idle: its last snapshot and the RT
+// thread's own seqs.
+void PublishState(arflex_component* c, uint64_t release_ns) {
+  if (!arflex_component_state_open(c)) return;
+  arflex_vision_state& st = g.state;
+  const uint64_t seq = st.seq;
+  st = g.snapshot;
+  st.t_ns = static_cast<int64_t>(release_ns);
+  st.seq = seq + 1;
+  st.out_seq = g.out_seq;
+  st.calibrate_seen = g.calibrate_seen;
+  arflex_component_state_publish(c, &st, sizeof(st), release_ns);
+}
+
+// The adopt hook (D58): the state block of the version this half replaces, at its START (RT
+// thread, right after the start hook, before the first update; no job was handed to the
+// worker yet, so its state is this thread's to write).
+int Adopt(arflex_component* c, void*, const arflex_adopted_state* a) {
+  if (std::strcmp(a->type_name, ARFLEX_TYPE_VISION_STATE_NAME) != 0 || a->major != ARFLEX_TYPE_VISION_STATE_VERSION_MAJOR)
+    return -EPROTOTYPE;
+  arflex_vision_state st;
+  if (a->length < sizeof(st)) return -EMSGSIZE;
+  if (g.busy.load(std::memory_order_acquire) != 0) return -EBUSY;  // a half that ran: never adopts
+  std::memcpy(&st, a->data, sizeof(st));
+  if (!arflex_vision_state_valid(&st) || (st.calibrated & ~((1u << kCameras) - 1u)) != 0 ||
+      (st.flags & ~ARFLEX_VISION_STATE_FLAG_HAVE_LAST) != 0)
+    return -EINVAL;
+  Eigen::Matrix3d last, cams[kCameras];
+  if (!GetQuat(st.last_quat, &last)) return -EINVAL;
+  for (int k = 0; k < kCameras; ++k)
+    if (!GetQuat(&st.cam_quat[4 * k], &cams[k])) return -EINVAL;
+  // taken whole, or not at all (above); calibrations made with another field of view than
+  // this half's are not used (it calibrates again from the board)
+  const bool same_optics = std::abs(st.fovy_deg - ParamF64(c, g.p_fovy, 50.0)) < 1e-9;
+  for (int k = 0; k < kCameras; ++k) {
+    vision::Camera& cam = g.cameras[k];
+    cam.calibrated = same_optics && ((st.calibrated >> k) & 1u) != 0;
+    cam.world_from_camera = Eigen::Isometry3d::Identity();
+    cam.world_from_camera.linear() = cams[k];
+    cam.world_from_camera.translation() = Eigen::Vector3d(st.cam_p[3 * k], st.cam_p[3 * k + 1], st.cam_p[3 * k + 2]);
+    cam.calibration_rms_px = st.cam_rms[k];
+  }
+  g.have_last = (st.flags & ARFLEX_VISION_STATE_FLAG_HAVE_LAST) != 0;
+  g.last_marker = Eigen::Isometry3d::Identity();
+  g.last_marker.linear() = last;
+  g.last_marker.translation() = Eigen::Vector3d(st.last_p[0], st.last_p[1], st.last_p[2]);
+  g.calibrations = st.calibrations;
+  g.out_seq = st.out_seq;
+  g.calibrate_seen = st.calibrate_seen;
+  g.state.seq = st.seq;
+  Snapshot();
+  return 0;
+}
+
+int Update(arflex_component* c, void*, uint64_t release_ns) {
   if (g.busy.load(std::memory_order_acquire) != 0) return 0;  // worker still on the last job
   if (g.result_ready) {
     g.result.seq = ++g.out_seq;
     arflex_state_write(g.out, &g.result, sizeof(g.result));
     g.result_ready = false;
   }
+  PublishState(c, release_ns);
   // Collect the newest frame of every camera; the job goes when every bound camera has a
   // fresh frame (one set of views), or three cycles after the first one arrived.
   bool all = true, any = false;
@@ -334,5 +455,6 @@ int main(int argc, char** argv) {
   ops.configure = Configure;
   ops.update = Update;
   ops.cleanup = Cleanup;
+  ops.adopt = Adopt;
   return arflex_component_main(argc, argv, &ops);
 }

@@ -3,7 +3,14 @@
 // state) it writes itself, with synthetic frames of the board and the tool tags drawn through
 // the cell's camera model, spawns the vision component, binds it and reads tcp_pose.
 //
-//   vision_comp_test <case> <vision exe> <contract>      cases: pose, loss, invalid
+//   vision_comp_test <case> <vision exe> <contract>      cases: pose, loss, invalid, adopt
+//
+// adopt (docs/DECISIONS.md D58): a second vision half given the first one's state block
+// (arflex.VisionState) by ADOPT continues its estimate: its first pose carries the next seq,
+// lies where the first half's last one did (the same frames), and its cameras are the first
+// half's calibration (to rounding), not a new one. Blocks it cannot take refuse its START with the reason's errno and leave it
+// READY: another type or major version (-EPROTOTYPE), a block shorter than the type (-EMSGSIZE),
+// a non-finite or out-of-range value and a quaternion that is not a unit one (-EINVAL).
 //
 // The vision instance's ports, parameters, task type and safe mode come from the bundle's
 // contract (arflex_host_load_contract, docs/DECISIONS.md D32/D34). The harness's own choices:
@@ -32,6 +39,7 @@ extern "C" {
 #include "arflex_types/image_frame.h"
 #include "arflex_types/joint_state.h"
 #include "arflex_types/pose.h"
+#include "arflex_types/vision_state.h"
 #include "arflex_vision/cell_layout.h"
 #include "synthetic_scene.h"
 
@@ -175,18 +183,19 @@ class Feeder {
 };
 
 // The vision instance as its contract declares it, with the harness's period and flags.
-int MakeVision(arflex_host* h, const char* exe) {
+// `instance` names its objects ("vision"; the half that replaces it in the adopt case: "2-vision").
+int MakeVision(arflex_host* h, const char* exe, const char* instance = "vision") {
   static const arflex_host_type types[] = {ARFLEX_HOST_FRAME_TYPE(IMAGE_FRAME), ARFLEX_HOST_TYPE(JOINT_STATE),
-                                           ARFLEX_HOST_TYPE(POSE)};
+                                           ARFLEX_HOST_TYPE(POSE), ARFLEX_HOST_TYPE(VISION_STATE)};
   static arflex_host_contract c;
   char err[512];
-  int r = arflex_host_load_contract(&c, contract_xml, types, 3, err, sizeof(err));
+  int r = arflex_host_load_contract(&c, contract_xml, types, 4, err, sizeof(err));
   if (r < 0) {
     std::fprintf(stderr, "%s\n", err);
     return r;
   }
   arflex_host_opts o;
-  arflex_host_contract_opts(&c, rid, "vision", &o);
+  arflex_host_contract_opts(&c, rid, instance, &o);
   o.config.period_ns = 20 * kMs;
   o.config.deadline_ns = 20 * kMs;
   o.config.priority = 0;
@@ -218,6 +227,136 @@ bool WaitPose(Feeder* feeder, arflex_port* reader, bool tags, bool want_valid, a
     usleep(1000);  // polling interval of the reader, not a wait for a condition
   }
   return false;
+}
+
+// Reads the newest value of a state segment; false when there is none.
+bool ReadState(arflex_port* p, arflex_vision_state* st) {
+  return p != nullptr && arflex_state_read(p, st, sizeof(*st), nullptr) == 1;
+}
+
+// The adopt case (D58), after `first` gave a valid pose (`pose`) and was stopped.
+void AdoptCase(Feeder* feeder, arflex_host* first, const arflex_pose& last_pose, const char* exe) {
+  static const char* const ports[] = {"cam0", "cam1", "cam2", "cam3", "joint_state"};
+  arflex_vision_state old{};
+  arflex_host bad;
+  bool bad_created = false;
+  std::memset(&bad, 0, sizeof(bad));
+  CHECK(ReadState(arflex_host_state(first), &old), "the first half published no state block");
+  CHECK(old.calibrated == 0xfu, "calibrated cameras 0x%x", old.calibrated);
+  CHECK(old.calibrations >= 4, "%llu calibrations", static_cast<unsigned long long>(old.calibrations));
+  CHECK(old.out_seq == last_pose.seq, "the block's out_seq %llu, the last pose's seq %llu",
+        static_cast<unsigned long long>(old.out_seq), static_cast<unsigned long long>(last_pose.seq));
+  CHECK(old.flags & ARFLEX_VISION_STATE_FLAG_HAVE_LAST, "no last estimate in the block");
+  {
+    // Blocks the new half must refuse, each in a state segment of the test's own instance.
+    struct Bad {
+      const char* port;
+      arflex_port_type type;
+      int want;
+    };
+    const Bad cases[] = {
+        {"other", {ARFLEX_TYPE_POSE_NAME, 1, 0, ARFLEX_TYPE_POSE_SIZE}, -EPROTOTYPE},
+        {"major2", {ARFLEX_TYPE_VISION_STATE_NAME, 2, 0, ARFLEX_TYPE_VISION_STATE_SIZE}, -EPROTOTYPE},
+        {"short", {ARFLEX_TYPE_VISION_STATE_NAME, 1, 0, 128}, -EMSGSIZE},
+        {"nan", {ARFLEX_TYPE_VISION_STATE_NAME, 1, 0, ARFLEX_TYPE_VISION_STATE_SIZE}, -EINVAL},
+        {"notunit", {ARFLEX_TYPE_VISION_STATE_NAME, 1, 0, ARFLEX_TYPE_VISION_STATE_SIZE}, -EINVAL},
+    };
+    constexpr int kBad = sizeof(cases) / sizeof(cases[0]);
+    struct arflex_host_output outs[kBad];
+    std::memset(outs, 0, sizeof(outs));
+    for (int i = 0; i < kBad; ++i) {
+      outs[i].port = cases[i].port;
+      outs[i].spec.method = ARFLEX_PORT_STATE;
+      outs[i].spec.type = cases[i].type;
+      outs[i].spec.depth = 1;
+    }
+    arflex_host_opts o;
+    std::memset(&o, 0, sizeof(o));
+    o.runtime = rid;
+    o.instance = "bad";
+    o.config = Config(10 * kMs);
+    o.outputs = outs;
+    o.noutputs = kBad;
+    CHECK(arflex_host_create(&bad, &o) == 0, "the bad blocks' instance");
+    bad_created = true;
+    arflex_pose other{};
+    other.seq = 1;
+    other.quat[0] = 1;
+    CHECK(arflex_state_write(arflex_host_output(&bad, "other"), &other, sizeof(other)) == 0, "write other");
+    CHECK(arflex_state_write(arflex_host_output(&bad, "major2"), &old, sizeof(old)) == 0, "write major2");
+    CHECK(arflex_state_write(arflex_host_output(&bad, "short"), &old, 128) == 0, "write short");
+    arflex_vision_state v = old;
+    v.cam_p[4] = std::nan("");
+    CHECK(arflex_state_write(arflex_host_output(&bad, "nan"), &v, sizeof(v)) == 0, "write nan");
+    v = old;
+    v.cam_quat[4] = 0.5;  // camera 1: (0.5, x, y, z) is no unit quaternion, every number in bounds
+    v.cam_quat[5] = v.cam_quat[6] = v.cam_quat[7] = 0.0;
+    CHECK(arflex_state_write(arflex_host_output(&bad, "notunit"), &v, sizeof(v)) == 0, "write notunit");
+    for (const Bad& b : cases) {
+      arflex_host h;
+      std::memset(&h, 0, sizeof(h));
+      bool ok = MakeVision(&h, exe, "2-vision") == 0 && arflex_host_wait_state(&h, ARFLEX_STATE_READY, 20 * kSec) == 0;
+      int st = ok ? arflex_host_adopt(&h, arflex_host_output_name(&bad, b.port), 2 * kSec) : -1;
+      int started = st == 0 ? arflex_host_start(&h, 2 * kSec) : 1;
+      const bool ready = arflex_ctl_state(h.ctl) == ARFLEX_STATE_READY;
+      std::printf("adopt: a block '%s' (%s %u.%u, %u B): START %d (%s)\n", b.port, b.type.name, b.type.major,
+                  b.type.minor, b.type.elem_size, started, started < 0 ? std::strerror(-started) : "-");
+      const bool down = arflex_host_shutdown(&h, 5 * kSec) == 0 && arflex_host_wait_exit(&h, 10 * kSec) == 0;
+      arflex_host_destroy(&h);
+      CHECK(ok && st == 0, "the refusing half came up and took the ADOPT (%d)", st);
+      CHECK(started == b.want, "block '%s': START %d, expected %d", b.port, started, b.want);
+      CHECK(ready, "block '%s': the refusing half is not READY", b.port);
+      CHECK(down, "block '%s': the refusing half did not shut down", b.port);
+    }
+  }
+  {
+    // The good block: the first half's.
+    arflex_host next;
+    std::memset(&next, 0, sizeof(next));
+    arflex_port reader;
+    bool reader_open = false;
+    arflex_pose p{};
+    arflex_vision_state now{};
+    bool ok = MakeVision(&next, exe, "2-vision") == 0 && arflex_host_wait_state(&next, ARFLEX_STATE_READY, 20 * kSec) == 0;
+    if (ok) ok = arflex_host_adopt(&next, arflex_host_state(first)->name, 2 * kSec) == 0;
+    for (const char* port : ports)
+      if (ok) ok = arflex_host_bind(&next, port, arflex_host_output_name(feeder->host(), port), 2 * kSec) == 0;
+    if (ok) {
+      const arflex_port_type t = {ARFLEX_TYPE_POSE_NAME, 1, 0, ARFLEX_TYPE_POSE_SIZE};
+      ok = arflex_port_open(&reader, arflex_host_output_name(&next, "tcp_pose"), false, false, ARFLEX_PORT_STATE, &t) == 0;
+      reader_open = ok;
+    }
+    if (ok) ok = arflex_host_start(&next, 2 * kSec) == 0;
+    // its first pose: WaitPose returns the first value it reads that is valid with 3 views
+    const bool got = ok && WaitPose(feeder, &reader, true, true, &p);
+    const bool have_state = got && ReadState(arflex_host_state(&next), &now);
+    double dp = 0, dcam = 0;
+    for (int i = 0; i < 3; ++i) dp = std::max(dp, std::abs(p.p[i] - last_pose.p[i]));
+    for (int i = 0; i < 12; ++i) dcam = std::max(dcam, std::abs(now.cam_p[i] - old.cam_p[i]));
+    for (int i = 0; i < 16; ++i) dcam = std::max(dcam, std::abs(now.cam_quat[i] - old.cam_quat[i]));
+    std::printf("adopt: the adopting half's first pose seq %llu (the first half's last %llu), %.3g m from the "
+                "first half's last pose; its cameras %.3g from the adopted calibration, %llu calibrations "
+                "(adopted %llu)\n", static_cast<unsigned long long>(p.seq),
+                static_cast<unsigned long long>(last_pose.seq), dp, dcam,
+                static_cast<unsigned long long>(now.calibrations), static_cast<unsigned long long>(old.calibrations));
+    const bool down = arflex_host_shutdown(&next, 5 * kSec) == 0 && arflex_host_wait_exit(&next, 10 * kSec) == 0;
+    if (reader_open) arflex_port_close(&reader);
+    arflex_host_destroy(&next);
+    CHECK(ok, "the adopting half: ADOPT, BIND, START");
+    CHECK(got, "no valid tcp_pose from the adopting half");
+    CHECK(have_state, "no state block from the adopting half");
+    CHECK(p.seq == last_pose.seq + 1, "its first pose has seq %llu, not %llu", static_cast<unsigned long long>(p.seq),
+          static_cast<unsigned long long>(last_pose.seq + 1));
+    CHECK(dp < 1e-6, "its first pose is %.3g m from the first half's last one", dp);
+    CHECK(now.calibrations == old.calibrations, "it calibrated again (%llu, adopted %llu)",
+          static_cast<unsigned long long>(now.calibrations), static_cast<unsigned long long>(old.calibrations));
+    // the camera poses go through a quaternion and back: the same to rounding (a calibration
+    // of its own would move them by 1e-5 and more)
+    CHECK(dcam < 1e-12, "its cameras are %.3g from the adopted calibration", dcam);
+    CHECK(down, "the adopting half did not shut down");
+  }
+out:
+  if (bad_created) arflex_host_destroy(&bad);
 }
 
 int RunCase(const std::string& name, const char* exe) {
@@ -283,6 +422,13 @@ int RunCase(const std::string& name, const char* exe) {
     CHECK(arflex_ctl_stats_read(vis.ctl, &st) == 0 && st.update_errors == e1,
           "errors counted with a valid joint state (%llu)", static_cast<unsigned long long>(st.update_errors - e1));
   }
+  if (name == "adopt") {
+    CHECK(arflex_host_stop(&vis, 5 * kSec) == 0, "STOP the first half");  // its block holds still
+    // the last pose it wrote (a job in flight at the STOP is not published): a newer one than
+    // WaitPose read (1), or that one (0)
+    CHECK(arflex_state_read(&reader, &pose, sizeof(pose), nullptr) >= 0, "the first half's last pose");
+    AdoptCase(&feeder, &vis, pose, exe);
+  }
   if (name == "loss") {
     // Vision drops out (the tags are covered): the pose turns invalid, it never keeps
     // reporting the stale one as valid; then it recovers.
@@ -307,13 +453,13 @@ out:
 
 int main(int argc, char** argv) {
   if (argc != 4) {
-    std::fprintf(stderr, "usage: vision_comp_test <pose|loss|invalid> <vision exe> <contract>\n");
+    std::fprintf(stderr, "usage: vision_comp_test <pose|loss|invalid|adopt> <vision exe> <contract>\n");
     return 2;
   }
   contract_xml = argv[3];
   std::snprintf(rid, sizeof(rid), "vct%d", static_cast<int>(getpid()));
   const std::string name = argv[1];
-  if (name != "pose" && name != "loss" && name != "invalid") {
+  if (name != "pose" && name != "loss" && name != "invalid" && name != "adopt") {
     std::fprintf(stderr, "vision_comp_test: unknown case '%s'\n", argv[1]);
     return 2;
   }

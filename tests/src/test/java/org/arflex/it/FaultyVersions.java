@@ -9,9 +9,11 @@ import java.nio.file.attribute.PosixFilePermissions;
 
 /**
  * Deliberately faulty builds of a component for the update tests (UpdateSetIT, ShadowRunIT,
- * ReconfigBench): the bundle's real executable, written beside a script that runs it with its
- * arguments and kills it by SIGSEGV a fixed time after its spawn. The script takes the place of
- * the executable in a copy of the bundle, which is then pinned and spawned like any other build.
+ * ReconfigBench, RefusedStartIT): the bundle's real executable, written beside a script that runs
+ * it with its arguments and either kills it by SIGSEGV a fixed time after its spawn or sets
+ * rt-core's test fault {@code ARFLEX_FAULT_START_ERRNO} (D58: the half refuses every START). The
+ * script takes the place of the executable in a copy of the bundle, which is then pinned and
+ * spawned like any other build.
  */
 final class FaultyVersions {
 
@@ -35,6 +37,24 @@ final class FaultyVersions {
                 + "# " + who + "'s deliberately faulty " + file + ": the real one, killed by SIGSEGV " + afterMs
                 + " ms after its spawn\n"
                 + "( sleep " + seconds + "; kill -SEGV $$ ) </dev/null >/dev/null 2>&1 &\n"
+                + "exec " + real + " \"$@\"\n";
+        return script.getBytes(StandardCharsets.UTF_8);
+    }
+
+    /**
+     * As {@link #crashingAfterMs}, but the script execs the real executable with rt-core's test
+     * fault {@code ARFLEX_FAULT_START_ERRNO=<errno>} in its environment: the half comes up READY,
+     * takes its BINDs and ADOPT, and refuses every START with {@code -errno} (D58).
+     */
+    static byte[] refusingStart(Path dir, Path bundle, String exeEntry, int errno, String who) throws IOException {
+        String file = exeEntry.substring(exeEntry.lastIndexOf('/') + 1);
+        Path real = dir.resolve(file);
+        Files.write(real, UpdateSetIT.entry(bundle, exeEntry));
+        Files.setPosixFilePermissions(real, PosixFilePermissions.fromString("r-x------"));
+        String script = "#!/bin/sh\n"
+                + "# " + who + "'s deliberately faulty " + file + ": the real one, refusing every START\n"
+                + "ARFLEX_FAULT_START_ERRNO=" + errno + "\n"
+                + "export ARFLEX_FAULT_START_ERRNO\n"
                 + "exec " + real + " \"$@\"\n";
         return script.getBytes(StandardCharsets.UTF_8);
     }
