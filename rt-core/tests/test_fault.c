@@ -15,6 +15,9 @@
 #include "arflex/host.h"
 #include "helper.h"
 
+/* the probe's output, struct probe_out of tests/probe_kit.h (14 x 8 B): its type must match exactly */
+#define PROBE_OUT_BYTES 112
+
 #define SEC 1000000000ull
 #define INJECTED ENOTRECOVERABLE
 
@@ -119,7 +122,7 @@ static void component_attach_every_call_fails(void **state)
 	th_rid(rid, sizeof(rid), "fcomp");
 	fill_opts(&o, &p, &out, "probe");
 	/* the probe's output must match its type exactly (tests/probe.c, struct probe_out: 14 x 8 B) */
-	out.spec.type.elem_size = 112;
+	out.spec.type.elem_size = PROBE_OUT_BYTES;
 	for (n = 1; n <= 16; n++) {
 		struct arflex_host h;
 		int r, st;
@@ -176,7 +179,7 @@ static void env_var_refuses_start(void **state)
 	(void)state;
 	th_rid(rid, sizeof(rid), "fstart");
 	fill_opts(&o, &p, &out, "probe");
-	out.spec.type.elem_size = 96; /* struct probe_out, as above */
+	out.spec.type.elem_size = PROBE_OUT_BYTES;
 	for (int refuse = 0; refuse < 2; refuse++) {
 		struct arflex_host h;
 		int k = 0;
