@@ -189,18 +189,23 @@ final class Runtime implements AutoCloseable {
     }
 
     /** Sends one Gogo command and returns its output (prompts removed), waiting at most 60 s. */
-    synchronized String cmd(String command) {
+    String cmd(String command) {
+        return cmd(command, 60);
+    }
+
+    /** Sends one Gogo command and returns its output (prompts removed), waiting at most {@code seconds}. */
+    synchronized String cmd(String command, long seconds) {
         String m = "__arflex_end_" + (++marker) + "__";
         try {
             stdin.write(command + "\necho " + m + "\n");
             stdin.flush();
             StringBuilder sb = new StringBuilder();
-            long deadline = System.nanoTime() + TimeUnit.SECONDS.toNanos(60);
+            long deadline = System.nanoTime() + TimeUnit.SECONDS.toNanos(seconds);
             while (true) {
                 long left = deadline - System.nanoTime();
                 String line = left > 0 ? out.poll(left, TimeUnit.NANOSECONDS) : null;
                 if (line == null) {
-                    fail("no reply to '" + command + "' within 60 s\n" + tail());
+                    fail("no reply to '" + command + "' within " + seconds + " s\n" + tail());
                 }
                 while (line.startsWith("g! ")) {
                     line = line.substring(3);
