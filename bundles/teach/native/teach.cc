@@ -42,70 +42,12 @@
 #include "arflex_types/wrench.h"
 #include "cellkin.h"
 #include "teach_rec.h"
+#include "teach_internal.h"
 
-namespace {
+namespace teach {
 
-using arflex::cellkin::Q;
-static_assert(sizeof(Q) == 6 * sizeof(double), "a waypoint is 6 doubles, contiguous");
-constexpr size_t kMaxPoints = TEACH_REC_MAX;
-static_assert(TEACH_REC_TAIL == ARFLEX_TEACH_STATE_TAIL_MAX, "the tail of arflex.TeachState");
-static_assert(sizeof(((struct arflex_teach_state*)nullptr)->tail) == TEACH_REC_TAIL * 48, "tail");
-// Taking over a moving arm (docs/DECISIONS.md D35: teach replaces trajectory while the arm
-// moves): the reference starts at the measured joints and, from the measured joint speeds,
-// ramps the speed down to zero over kTakeoverStopS (trajectory's default stop_time), along the
-// path the arm was on. Holding the first measured pose at once would leave the stop to the
-// servo, which brakes a 0.2 rad/s base joint hard enough for the force guard to read 800 N and
-// latch a protective stop (ChangeSetIT, before this). An arm slower than kRestSpeed is at rest.
-constexpr double kTakeoverStopS = 0.3;
-constexpr double kRestSpeed = 1e-3;
+State g;
 
-struct State {
-  arflex::cellkin::Model model;
-  struct arflex_port* out = nullptr;
-  struct arflex_input* in_js = nullptr;
-  struct arflex_input* in_w = nullptr;
-  struct arflex_input* in_safety = nullptr;
-  struct arflex_safety_state safety{};
-  bool have_safety = false;
-  int p_teach, p_mass, p_damping, p_deadband, p_max_speed, p_payload, p_step, p_save, p_slot;
-  struct arflex_joint_state js{};
-  struct arflex_wrench w{};
-  bool have_js = false, have_w = false, initialized = false;
-  bool teach_prev = false, save_prev = false;
-  Q q_ref = Q::Zero();
-  Q brake_v0 = Q::Zero();        // measured joint speeds when the reference was taken over
-  double brake_t = kTakeoverStopS;  // time into the take-over ramp; >= kTakeoverStopS: none
-  Eigen::Vector3d x = Eigen::Vector3d::Zero(), v = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d r_hold = Eigen::Matrix3d::Identity();
-  uint64_t seq = 0;
-  // recording (RT thread writes points and count; the writer reads under `saving`)
-  Q* points = nullptr;
-  size_t count = 0;
-  std::atomic<bool> saving{false};
-  std::atomic<size_t> save_count{0};
-  std::atomic<long> save_slot{0};
-  std::atomic<bool> quit{false};
-  std::atomic<uint64_t> saved{0}, save_errors{0}, dropped{0};
-  sem_t sem;
-  pthread_t writer;
-  bool writer_started = false;
-  std::string dir;
-  // D57: the state block, the recording's chain and journal
-  struct arflex_teach_state st{};  // RT: the recording's part is kept up to date, published
-  uint64_t* chain = nullptr;       // chain[i]: over the first i waypoints (teach_rec.h)
-  uint32_t pid = 0;
-  std::atomic<uint32_t> pub_count{0};  // waypoints the writer may copy
-  std::atomic<uint32_t> episode{0};    // changes when the recording starts over
-  int journal_fd = -1;                 // writer thread
-  std::string journal;                 // its path
-  uint32_t journal_count = 0, journal_episode = ~0u;
-  uint64_t journal_nonce = 0;
-  bool journal_failed = false;
-  bool preloaded = false;          // mailbox: the old half's journal read (adopt_prepare)
-  uint32_t preload_count = 0;
-  char why[512] = {0};             // RT: why the adopt hook refused (printed by the writer)
-  std::atomic<bool> why_pending{false};
-} g;
 
 // ---- the recording (RT thread) --------------------------------------------------------------
 
@@ -142,80 +84,6 @@ void RecAppend(const Q& q) {
   g.st.rec_hash = g.chain[g.count];
   g.pub_count.store((uint32_t)g.count, std::memory_order_release);
   sem_post(&g.sem);  // the writer brings the journal up to date
-}
-
-// ---- the journal (writer thread) ------------------------------------------------------------
-
-bool WriteAll(int fd, const void* buf, size_t len, off_t off) {
-  const char* p = static_cast<const char*>(buf);
-  while (len) {
-    const ssize_t n = pwrite(fd, p, len, off);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return false;
-    p += n;
-    len -= (size_t)n;
-    off += n;
-  }
-  return true;
-}
-
-void JournalFail(const char* what) {
-  if (!g.journal_failed)
-    fprintf(stderr, "teach: the recording's journal %s: %s: %s (an update in a change set will be refused)\n",
-            g.journal.c_str(), what, strerror(errno));
-  g.journal_failed = true;
-}
-
-// Brings the journal file up to the recording: the waypoints first, then the header's count,
-// so a reader never finds a count beyond what the file holds (teach_rec_load refuses a size
-// that is not header + count waypoints, and the new half retries for a while).
-void CloseJournal();
-
-void SyncJournal() {
-  // An adopted recording brings its nonce (Adopt writes it before it bumps the episode): the
-  // journal is then named after it.
-  (void)g.episode.load(std::memory_order_acquire);
-  const uint64_t nonce = g.st.rec_nonce;
-  if (g.journal_fd >= 0 && nonce != g.journal_nonce) CloseJournal();
-  if (g.journal_fd < 0) {
-    if (g.journal_failed) return;
-    char name[64];
-    teach_rec_name(name, sizeof(name), g.pid, nonce);
-    g.journal_nonce = nonce;
-    g.journal = g.dir + "/" + name;
-    if (mkdir(g.dir.c_str(), 0700) != 0 && errno != EEXIST) return JournalFail("its folder");
-    g.journal_fd = open(g.journal.c_str(), O_RDWR | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0600);
-    if (g.journal_fd < 0) return JournalFail("create");
-    if (fchmod(g.journal_fd, 0600) != 0) return JournalFail("chmod");
-    g.journal_count = 0;
-    g.journal_episode = ~0u;
-  }
-  for (int attempt = 0; attempt < 4; ++attempt) {
-    const uint32_t ep = g.episode.load(std::memory_order_acquire);
-    const uint32_t n = g.pub_count.load(std::memory_order_acquire);
-    if (ep == g.journal_episode && n == g.journal_count) return;
-    uint32_t from = ep == g.journal_episode && n > g.journal_count ? g.journal_count : 0;
-    if (from == 0 && ftruncate(g.journal_fd, TEACH_REC_HEADER + (off_t)n * 48) != 0)
-      return JournalFail("truncate");
-    if (n > from && !WriteAll(g.journal_fd, g.points[from].data(), (size_t)(n - from) * 48,
-                              TEACH_REC_HEADER + (off_t)from * 48))
-      return JournalFail("write");
-    if (g.episode.load(std::memory_order_acquire) != ep) continue;  // started over meanwhile
-    unsigned char hdr[TEACH_REC_HEADER];
-    teach_rec_header(hdr, g.pid, g.journal_nonce, n);
-    if (!WriteAll(g.journal_fd, hdr, sizeof(hdr), 0)) return JournalFail("write its header");
-    g.journal_count = n;
-    g.journal_episode = ep;
-    return;
-  }
-}
-
-void CloseJournal() {
-  if (g.journal_fd >= 0) {
-    close(g.journal_fd);
-    g.journal_fd = -1;
-    unlink(g.journal.c_str());  // the next half has read it, or nothing needs it
-  }
 }
 
 void Save();
@@ -279,7 +147,6 @@ void Save() {
   }
 }
 
-int AdoptPrepare(struct arflex_component*, void*, const struct arflex_adopted_state* s);
 
 int Configure(struct arflex_component* c, void*) {
   static const struct arflex_port_type js_t = {ARFLEX_TYPE_JOINT_STATE_NAME, 1, 0,
@@ -513,149 +380,10 @@ int Safe(struct arflex_component* c, void*, enum arflex_safe_mode, bool) {
   return 0;
 }
 
-// ---- D57: handing over to a new version -----------------------------------------------------
-
-bool Claim(const struct arflex_adopted_state* s, const struct arflex_teach_state** v,
-           struct teach_rec_claim* claim) {
-  if (strcmp(s->type_name, ARFLEX_TYPE_TEACH_STATE_NAME) != 0 || s->major != 1 ||
-      s->length < sizeof(struct arflex_teach_state))
-    return false;
-  *v = static_cast<const struct arflex_teach_state*>(s->data);
-  const struct arflex_teach_state* t = *v;
-  memset(claim, 0, sizeof(*claim));
-  claim->key[0] = t->rec_key[0];
-  claim->key[1] = t->rec_key[1];
-  claim->nonce = t->rec_nonce;
-  claim->pid = t->journal_pid;
-  claim->count = t->rec_count;
-  claim->hash = t->rec_hash;
-  claim->tail_first = t->tail_first;
-  claim->tail_count = t->tail_count;
-  claim->tail_hash = t->tail_hash;
-  claim->tail = t->tail;
-  return true;
-}
-
-struct teach_rec_loaded Loaded() {
-  struct teach_rec_loaded l;
-  l.points = reinterpret_cast<double(*)[6]>(g.points);
-  l.chain = g.chain;
-  l.count = g.preload_count;
-  return l;
-}
-
-// Mailbox thread, at the ADOPT: reads the old half's journal (blocking I/O belongs here) and
-// checks it against the state block of now. Retries for up to ~200 ms: the old half's writer
-// may be between a journal's waypoints and its header.
-int AdoptPrepare(struct arflex_component*, void*, const struct arflex_adopted_state* s) {
-  const struct arflex_teach_state* t;
-  struct teach_rec_claim claim;
-  char why[512];
-  g.preloaded = false;
-  if (!Claim(s, &t, &claim)) {
-    fprintf(stderr, "teach: cannot take over the state block %s %u.%u (%u bytes): not arflex.TeachState 1.x\n",
-            s->type_name, s->major, s->minor, s->length);
-    return -EPROTOTYPE;
-  }
-  int r = teach_rec_check_claim(&claim, why, sizeof(why));
-  if (r == 0 && claim.tail_first == 0) {
-    g.preload_count = 0;  // the state block's tail holds the whole recording
-    g.preloaded = true;
-    fprintf(stderr, "teach: the recording (%u waypoints) is all in the state block\n", claim.count);
-    return 0;
-  }
-  if (r != 0) {
-    fprintf(stderr, "teach: cannot take over the recording of %u waypoints: %s\n", claim.count, why);
-    return r;
-  }
-  char name[64];
-  teach_rec_name(name, sizeof(name), claim.pid, claim.nonce);
-  const std::string path = g.dir + "/" + name;
-  for (int attempt = 0; attempt < 40; ++attempt) {
-    if (attempt) usleep(5000);
-    struct teach_rec_loaded l = Loaded();
-    r = teach_rec_load(path.c_str(), &claim, &l, why, sizeof(why));
-    if (r == 0) r = teach_rec_join(&l, &claim, why, sizeof(why));
-    if (r == 0) {
-      g.preload_count = l.count;
-      g.preloaded = true;
-      fprintf(stderr, "teach: the recording read from %s: %u waypoints, checked against the state block\n",
-              path.c_str(), l.count);
-      return 0;
-    }
-    if (r == -EPERM) break;  // nothing a wait can mend
-  }
-  fprintf(stderr, "teach: cannot take over the recording of %u waypoints: %s\n", claim.count, why);
-  return r;
-}
-
-// RT thread, at the START after an ADOPT: the motion and the recording, whole or not at all.
-// No I/O: the journal was read by AdoptPrepare; the join is O(tail).
-int Adopt(struct arflex_component*, void*, const struct arflex_adopted_state* s) {
-  const struct arflex_teach_state* t;
-  struct teach_rec_claim claim;
-  if (!Claim(s, &t, &claim)) {
-    snprintf(g.why, sizeof(g.why), "the state block %s %u.%u is not arflex.TeachState 1.x", s->type_name,
-             s->major, s->minor);
-    g.why_pending.store(true);
-    sem_post(&g.sem);
-    return -EPROTOTYPE;
-  }
-  if (!arflex_teach_state_valid(t)) {
-    snprintf(g.why, sizeof(g.why), "the state block's motion is out of its bounds (a non-finite number)");
-    g.why_pending.store(true);
-    sem_post(&g.sem);
-    return -EINVAL;
-  }
-  int r;
-  {
-    // Without a journal read at the ADOPT only a recording that is all in the tail can be taken
-    // (teach_rec_join refuses the rest: -ENODATA).
-    struct teach_rec_loaded l = Loaded();
-    if (!g.preloaded) l.count = 0;
-    r = teach_rec_join(&l, &claim, g.why, sizeof(g.why));
-    if (r == 0) {
-      g.count = l.count;
-      g.st.rec_key[0] = claim.key[0];
-      g.st.rec_key[1] = claim.key[1];
-      g.st.rec_nonce = claim.nonce;  // the chain goes on; the journal is this half's own (pid)
-      g.st.rec_count = claim.count;
-      g.st.rec_hash = claim.hash;
-      g.st.tail_first = claim.tail_first;
-      g.st.tail_count = claim.tail_count;
-      g.st.tail_hash = claim.tail_hash;
-      memcpy(g.st.tail, t->tail, sizeof(g.st.tail));
-    }
-  }
-  g.preloaded = false;
-  if (r < 0) {
-    g.why_pending.store(true);
-    sem_post(&g.sem);
-    return r;
-  }
-  for (int j = 0; j < 6; ++j) {
-    g.q_ref[j] = t->q_ref[j];
-    g.brake_v0[j] = t->brake_v0[j];
-  }
-  g.brake_t = t->brake_t;
-  for (int i = 0; i < 3; ++i) {
-    g.x[i] = t->x[i];
-    g.v[i] = t->v[i];
-    for (int k = 0; k < 3; ++k) g.r_hold(i, k) = t->r_hold[3 * i + k];
-  }
-  g.seq = t->out_seq;
-  g.initialized = (t->flags & ARFLEX_TEACH_STATE_FLAG_INITIALIZED) != 0;
-  g.teach_prev = (t->flags & ARFLEX_TEACH_STATE_FLAG_TEACH) != 0;  // the recording goes on
-  g.pub_count.store((uint32_t)g.count, std::memory_order_release);
-  g.episode.fetch_add(1, std::memory_order_acq_rel);  // the writer writes its journal whole
-  sem_post(&g.sem);
-  return 0;
-}
-
 const struct arflex_component_ops kOps = {
     "teach", nullptr, Configure, Start, Update, nullptr, Cleanup, Safe, Adopt,
 };
 
-}  // namespace
+}  // namespace teach
 
-int main(int argc, char** argv) { return arflex_component_main(argc, argv, &kOps); }
+int main(int argc, char** argv) { return arflex_component_main(argc, argv, &teach::kOps); }
