@@ -571,4 +571,32 @@ final class CellRig {
             thread.join(10_000);
         }
     }
+
+    /**
+     * The largest step of a reference per cycle of its source ({@link ChangeSetIT#perSourceCycle})
+     * before index {@code mark} and from it on: {before, after}.
+     */
+    static double[] stepsBeforeAndAfter(List<Ref> refs, int mark) {
+        double before = 0;
+        double after = 0;
+        for (int i = 1; i < refs.size(); i++) {
+            double s = ChangeSetIT.perSourceCycle(refs.get(i - 1), refs.get(i));
+            if (i < mark) {
+                before = Math.max(before, s);
+            } else {
+                after = Math.max(after, s);
+            }
+        }
+        return new double[] {before, after};
+    }
+
+    /** The guard's output with the largest force. */
+    static Safety worst(List<Safety> ss) {
+        return ss.stream().max(java.util.Comparator.comparingDouble(Safety::forceNorm)).orElseThrow();
+    }
+
+    /** The guard's first output that is not NORMAL, or null. */
+    static Safety tripped(List<Safety> ss) {
+        return ss.stream().filter(x -> x.mode() != Safety.NORMAL).findFirst().orElse(null);
+    }
 }

@@ -199,22 +199,12 @@ class StateTransferIT {
                     CellRig.Ref first = n.get(0);
                     CellRig.Ref prior = o.stream().filter(r -> r.tNs() <= first.tNs()).reduce((a, b) -> b).orElseThrow();
                     double firstStep = ChangeSetIT.perSourceCycle(prior, first);
-                    List<CellRig.Ref> rr = robotRef.snapshot();
-                    double robotBefore = 0;
-                    double robotAfter = 0;
-                    for (int i = 1; i < rr.size(); i++) {
-                        double s = ChangeSetIT.perSourceCycle(rr.get(i - 1), rr.get(i));
-                        if (i < robotMark) {
-                            robotBefore = Math.max(robotBefore, s);
-                        } else {
-                            robotAfter = Math.max(robotAfter, s);
-                        }
-                    }
+                    double[] robotSteps = CellRig.stepsBeforeAndAfter(robotRef.snapshot(), robotMark);
+                    double robotBefore = robotSteps[0];
+                    double robotAfter = robotSteps[1];
                     List<CellRig.Safety> ss = safety.snapshot();
-                    CellRig.Safety worst = ss.stream().max(java.util.Comparator.comparingDouble(
-                            CellRig.Safety::forceNorm)).orElseThrow();
-                    CellRig.Safety tripped = ss.stream().filter(s -> s.mode() != CellRig.Safety.NORMAL).findFirst()
-                            .orElse(null);
+                    CellRig.Safety worst = CellRig.worst(ss);
+                    CellRig.Safety tripped = CellRig.tripped(ss);
                     Map<String, Object> robot1 = ChangeSetIT.stats(rt, "sim-robot");
                     System.out.printf(Locale.ROOT, "StateTransferIT: the new half's first seq %d (the old half's "
                             + "last before the apply %d); %d values written by both halves under the same seq, largest "

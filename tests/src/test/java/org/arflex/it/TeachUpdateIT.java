@@ -183,22 +183,12 @@ class TeachUpdateIT {
                     for (int i = Math.max(1, mark - 1000); i < mark; i++) {
                         before0 = Math.max(before0, ChangeSetIT.perSourceCycle(o.get(i - 1), o.get(i)));
                     }
-                    List<CellRig.Ref> rr = robotRef.snapshot();
-                    double robotBefore = 0;
-                    double robotAfter = 0;
-                    for (int i = 1; i < rr.size(); i++) {
-                        double s = ChangeSetIT.perSourceCycle(rr.get(i - 1), rr.get(i));
-                        if (i < robotMark) {
-                            robotBefore = Math.max(robotBefore, s);
-                        } else {
-                            robotAfter = Math.max(robotAfter, s);
-                        }
-                    }
+                    double[] robotSteps = CellRig.stepsBeforeAndAfter(robotRef.snapshot(), robotMark);
+                    double robotBefore = robotSteps[0];
+                    double robotAfter = robotSteps[1];
                     List<CellRig.Safety> ss = safety.snapshot();
-                    CellRig.Safety worst = ss.stream().max(java.util.Comparator.comparingDouble(
-                            CellRig.Safety::forceNorm)).orElseThrow();
-                    CellRig.Safety tripped = ss.stream().filter(s -> s.mode() != CellRig.Safety.NORMAL).findFirst()
-                            .orElse(null);
+                    CellRig.Safety worst = CellRig.worst(ss);
+                    CellRig.Safety tripped = CellRig.tripped(ss);
                     Map<String, Object> robot1 = ChangeSetIT.stats(rt, "sim-robot");
                     System.out.printf(Locale.ROOT, "TeachUpdateIT: the new half's first seq %d, %.3f mrad per source "
                             + "cycle from the old half's value of seq %d (teach's own motion before the apply: up to "
