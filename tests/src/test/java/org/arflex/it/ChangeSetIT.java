@@ -169,6 +169,7 @@ class ChangeSetIT {
                         + " largest run of sim-robot states the test missed: %d%n", jump * 1e3, JUMP_BOUND * 1e3,
                         jumpRaw * 1e3, before * 1e3, beforeRaw * 1e3, tookMs, lost);
                 assertTrue(jump <= JUMP_BOUND, "reference step " + jump + " rad per source cycle from the apply on");
+                SwitchWindow.of(rt.logSince(logMark)).assertNoReleaseLost("ChangeSetIT", js.snapshot());
 
                 // no safe stop, no reset
                 List<CellRig.Safety> ss = safety.snapshot();

@@ -77,6 +77,7 @@ class ToolChangeSetIT {
 
                 Map<String, Object> robot0 = ChangeSetIT.stats(rt, "sim-robot");
                 int mark = ref.size();
+                int logMark = rt.logMark();
                 long t0 = System.nanoTime();
                 String out = rt.cmd("arflex:change apply install tool-spindle uninstall tool-gripper");
                 System.out.printf(Locale.ROOT, "ToolChangeSetIT: apply (%.0f ms):%n%s%n", (System.nanoTime() - t0) / 1e6, out);
@@ -98,6 +99,7 @@ class ToolChangeSetIT {
                         ChangeSetIT.delta(robot0, robot1, "cycles"), ChangeSetIT.delta(robot0, robot1, "overruns"),
                         ChangeSetIT.delta(robot0, robot1, "safeCycles"));
                 assertTrue(jump <= ChangeSetIT.JUMP_BOUND, "reference step " + jump + " rad per source cycle");
+                SwitchWindow.of(rt.logSince(logMark)).assertNoReleaseLost("ToolChangeSetIT", js.snapshot());
                 assertNull(ss.stream().filter(s -> s.mode() != CellRig.Safety.NORMAL).findFirst().orElse(null),
                         "the guard left NORMAL");
                 assertEquals(0, ChangeSetIT.delta(robot0, robot1, "safeCycles"), "sim-robot ran safe cycles");

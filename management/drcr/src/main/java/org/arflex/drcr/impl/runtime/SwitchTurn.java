@@ -186,8 +186,10 @@ final class SwitchTurn {
             }
         }
         long switchNs = cell.config().monotonicNs().getAsLong() - ts;
-        log.accept(String.format("arflex: change set %s: switched (prepared in %.1f ms, switch turn %.3f ms)",
-                run.set.describe(), (ts - run.t0) / 1e6, switchNs / 1e6));
+        // the turn's bounds on CLOCK_MONOTONIC, the clock of every port's t_ns: what a consumer
+        // ran around its BIND can be read against them (the switch-window tests)
+        log.accept(String.format("arflex: change set %s: switched (prepared in %.1f ms, switch turn %.3f ms, "
+                + "monotonic %d..%d ns)", run.set.describe(), (ts - run.t0) / 1e6, switchNs / 1e6, ts, ts + switchNs));
         cell.changed();
         java.util.concurrent.CompletableFuture<String> verdict = verdicts.isEmpty() ? null
                 : java.util.concurrent.CompletableFuture.allOf(verdicts.toArray(java.util.concurrent.CompletableFuture[]::new))
