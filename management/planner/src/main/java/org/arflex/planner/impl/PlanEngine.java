@@ -316,7 +316,7 @@ public final class PlanEngine {
             try {
                 plan = InstallDryRun.plan(base, resolver, delta, x, change, capacities, measured, blocked.keySet(),
                         cpuTest);
-            } catch (Admission.ReplayRefused e) {
+            } catch (ReplayRefused e) {
                 plan = null; // a test whose state the trace cannot rebuild: plan in full
             }
             if (plan != null) {
