@@ -74,7 +74,7 @@ final class AdmissionTrace {
     private boolean anyExclusive;
     private AdmissionResult result;
 
-    // -- recording (Admission.Run) ------------------------------------------------------------
+    // -- recording (AdmissionRun) ------------------------------------------------------------
 
     Step beginStep(int eff, boolean running, List<String> names, long memBefore, long netBefore) {
         Step s = new Step(steps.size(), eff, running, names.get(0), new ArrayList<>(), memBefore, netBefore);

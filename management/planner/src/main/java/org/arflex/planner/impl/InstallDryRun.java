@@ -28,7 +28,7 @@ import org.arflex.planner.Wire;
  * admission run processes the same groups in the same order with {@code x} inserted where the
  * priority queue would pop it ({@link #insertionPoint}). Everything before that point is placed
  * as before; {@code x} is placed on the state of the CPUs at that point (rebuilt from the trace,
- * {@link Admission.Resumed}); after it, every member is checked to be placed as before: the
+ * {@link ResumedAdmission}); after it, every member is checked to be placed as before: the
  * budgets still fit (or {@code x} took none), and a member that may use the CPU {@code x} went to
  * ({@code k}) was placed first try on its previous CPU, and when that is {@code k}, it still fits
  * there (tested beside {@code x}). Then only the decisions and load of {@code k} change. A
@@ -82,7 +82,7 @@ final class InstallDryRun {
             ready = Math.max(ready, m.step + 1);
         }
         int pos = insertionPoint(tr.steps(), ready, x);
-        Admission.Resumed run = new Admission.Resumed(tr, pos, x, providers, resolver.inputWires(xn), caps, measured,
+        ResumedAdmission run = new ResumedAdmission(tr, pos, x, providers, resolver.inputWires(xn), caps, measured,
                 test);
         AdmissionResult old = b.admission();
         Decision refused = run.admit();
@@ -204,7 +204,7 @@ final class InstallDryRun {
      * are added to {@code run} in order.
      */
     private static boolean laterUnchanged(List<AdmissionTrace.Step> steps, int pos, int k, long dMem, long dNet,
-            Capacities caps, Admission.Resumed run, Resolver resolver) {
+            Capacities caps, ResumedAdmission run, Resolver resolver) {
         for (int t = pos; t < steps.size(); t++) {
             AdmissionTrace.Step s = steps.get(t);
             for (AdmissionTrace.Member m : s.members()) {
