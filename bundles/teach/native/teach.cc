@@ -95,6 +95,7 @@ void* Writer(void*) {
     if (g.why_pending.exchange(false)) fprintf(stderr, "teach: START refused: %s\n", g.why);
     // A save requested just before shutdown is still written; then quit.
     if (g.saving.load(std::memory_order_acquire)) Save();
+    if (g.sweep_pending.exchange(false, std::memory_order_acq_rel)) Sweep();
     if (g.quit.load()) {
       CloseJournal();
       return nullptr;
@@ -231,8 +232,7 @@ void Cleanup(struct arflex_component*, void*) {
 
 // Publishes the state block (D57): the motion of this cycle; the recording's part is kept up
 // to date by RecReset/RecAppend. RT safe (a seqlock write).
-void Publish(struct arflex_component* c, uint64_t stamp_ns) {
-  if (!arflex_component_state_open(c)) return;
+void PublishBlock(struct arflex_component* c, uint64_t stamp_ns) {
   g.st.t_ns = (int64_t)stamp_ns;
   g.st.seq++;
   g.st.out_seq = g.seq;
@@ -251,6 +251,16 @@ void Publish(struct arflex_component* c, uint64_t stamp_ns) {
     for (int k = 0; k < 3; ++k) g.st.r_hold[3 * i + k] = g.r_hold(i, k);
   }
   arflex_component_state_publish(c, &g.st, sizeof(g.st), stamp_ns);
+}
+
+// Every cycle (update and safe): the state block, then, once, the sweep of the journals of
+// halves that are gone (D63: this half's block no longer names a dead half's journal).
+void Publish(struct arflex_component* c, uint64_t stamp_ns) {
+  if (arflex_component_state_open(c)) PublishBlock(c, stamp_ns);
+  if (!g.sweep_asked) {
+    g.sweep_asked = true;
+    AskSweep();
+  }
 }
 
 int Start(struct arflex_component* c, void*) {
@@ -310,6 +320,7 @@ int Update(struct arflex_component* c, void*, uint64_t release_ns) {
     g.r_hold = t.linear();
     g.v.setZero();
     if (!g.saving.load(std::memory_order_acquire)) RecReset();
+    if (g.sweep_asked) AskSweep();  // D63: a new recording, a new look for dead halves' journals
     Record(c, true);
   }
   if (!teach && g.teach_prev) Record(c, true);  // the end point

@@ -1,5 +1,5 @@
 // teach's RT half, shared by its files (teach.cc: the component; teach_journal.cc: the
-// recording's journal on the writer thread; teach_handover.cc: taking a recording over from an
+// recording's journal on the writer thread, and the sweep of dead halves' journals (D63); teach_handover.cc: taking a recording over from an
 // old half, D57). One process, one State.
 #pragma once
 
@@ -80,6 +80,11 @@ struct State {
   uint32_t preload_count = 0;
   char why[512] = {0};             // RT: why the adopt hook refused (printed by the writer)
   std::atomic<bool> why_pending{false};
+  // D63: the journals of halves that are gone are swept by the writer thread once this half has
+  // started (its state block published: it no longer names a dead half's journal) and whenever
+  // a new recording begins
+  bool sweep_asked = false;              // RT
+  std::atomic<bool> sweep_pending{false};
 };
 
 extern State g;
@@ -90,6 +95,8 @@ void RecAppend(const Q& q);
 // the journal (teach_journal.cc, writer thread)
 void SyncJournal();
 void CloseJournal();
+void AskSweep();  // RT safe (an atomic store and sem_post)
+void Sweep();     // writer thread
 // the hand-over (teach_handover.cc): the ADOPT on the mailbox thread, the START on the RT thread
 int AdoptPrepare(struct arflex_component* c, void* user, const struct arflex_adopted_state* s);
 int Adopt(struct arflex_component* c, void* user, const struct arflex_adopted_state* s);

@@ -1,5 +1,7 @@
-// teach: the recording's journal, kept by the writer thread (docs/DECISIONS.md D57; teach_internal.h).
+// teach: the recording's journal, kept by the writer thread (docs/DECISIONS.md D57; teach_internal.h),
+// and the sweep of the journals of halves that are gone (D63, teach_sweep.h).
 #include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -8,6 +10,7 @@
 #include <cstring>
 
 #include "teach_internal.h"
+#include "teach_sweep.h"
 
 namespace teach {
 
@@ -53,6 +56,11 @@ void SyncJournal() {
     g.journal_fd = open(g.journal.c_str(), O_RDWR | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0600);
     if (g.journal_fd < 0) return JournalFail("create");
     if (fchmod(g.journal_fd, 0600) != 0) return JournalFail("chmod");
+    // D63: held while this half lives (released by the kernel when it dies, kill -9 too): a
+    // sweeper keeps a journal whose lock is held even when its pid looks gone
+    if (flock(g.journal_fd, LOCK_EX | LOCK_NB) != 0)
+      fprintf(stderr, "teach: the recording's journal %s: lock: %s (a sweep relies on the pid alone)\n",
+              g.journal.c_str(), strerror(errno));
     g.journal_count = 0;
     g.journal_episode = ~0u;
   }
@@ -82,6 +90,22 @@ void CloseJournal() {
     g.journal_fd = -1;
     unlink(g.journal.c_str());  // the next half has read it, or nothing needs it
   }
+}
+
+// ---- D63: the journals of halves that are gone --------------------------------------------
+
+void AskSweep() {
+  g.sweep_pending.store(true, std::memory_order_release);
+  sem_post(&g.sem);
+}
+
+void Sweep() {
+  struct teach_sweep_count n;
+  const int r = teach_sweep(
+      g.dir.c_str(), g.pid, geteuid(), [](void*, const char* line) { fprintf(stderr, "%s\n", line); }, nullptr, &n);
+  if (r == 0 && n.removed + n.kept + n.refused > 0)
+    fprintf(stderr, "teach: swept %s: %u journal(s) of halves that are gone removed, %u of running halves kept, %u refused\n",
+            g.dir.c_str(), n.removed, n.kept, n.refused);
 }
 
 }  // namespace teach

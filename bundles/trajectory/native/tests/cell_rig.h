@@ -141,6 +141,7 @@ void CaseStateTransfer();   // test_cell_state_transfer.cc
 void CaseForceGuard();      // test_cell_force_guard.cc
 void CaseForceGuardState(); // test_cell_force_guard_state.cc (D52)
 void CaseTeachState();      // test_cell_teach_state.cc (D57)
+void CaseTeachSweep();      // test_cell_teach_sweep.cc (D63)
 void CaseTeachReplay();     // test_cell_teach.cc
 void CaseTools();           // test_cell_tools.cc
 void CaseInvalidInput();    // test_cell_input.cc

@@ -26,7 +26,7 @@ using namespace celltest;
 
 int main(int argc, char** argv) {
   if (argc != 4) {
-    fprintf(stderr, "usage: %s <trajectory|program_switch|late_robot|stop_away|invalid_input|bad_program|force_guard|force_guard_state|teach_replay|teach_state|tools> <bin dir> <bundles dir>\n", argv[0]);
+    fprintf(stderr, "usage: %s <trajectory|program_switch|late_robot|stop_away|invalid_input|bad_program|force_guard|force_guard_state|teach_replay|teach_state|teach_sweep|tools> <bin dir> <bundles dir>\n", argv[0]);
     return 2;
   }
   bindir = argv[2];
@@ -38,6 +38,7 @@ int main(int argc, char** argv) {
   else if (c == "force_guard_state") CaseForceGuardState();
   else if (c == "teach_replay") CaseTeachReplay();
   else if (c == "teach_state") CaseTeachState();
+  else if (c == "teach_sweep") CaseTeachSweep();
   else if (c == "tools") CaseTools();
   else if (c == "bad_program") CaseBadProgram();
   else if (c == "program_switch") CaseProgramSwitch();
