@@ -18,6 +18,9 @@
 // folder (teach_rec.h). A new half reads the journal when the ADOPT arrives (adopt_prepare,
 // mailbox thread) and joins it with the state block's tail at its START (adopt, RT thread, no
 // I/O); it takes the recording only whole and refuses the ADOPT or the START otherwise.
+// The journals of halves that are gone (killed: they could not remove theirs) are removed by
+// the writer thread after this half's first cycle and whenever a recording begins (D63,
+// teach_sweep.h): never a running half's, a link or another uid's file.
 #include <fcntl.h>
 #include <pthread.h>
 #include <semaphore.h>
