@@ -51,6 +51,10 @@ void CaseTeachSweep() {
   DirGuard dir{MakeDataDir()};
   CHECK(!dir.d.empty(), "mkdtemp");
   const std::string victim = dir.d + ".victim";
+  struct FileGuard {  // the planted file outside the folder goes with the case, failed or not
+    std::string p;
+    ~FileGuard() { unlink(p.c_str()); }
+  } victim_guard{victim};
   std::string env = "ARFLEX_DATA_DIR=" + dir.d;
   char* envp[] = {const_cast<char*>(env.c_str()), nullptr};
   CHECK(MakeScript(&script, {{"joint_state", kJsT}, {"wrench", kWT}, {"safety", kST}}) == 0, "script");
@@ -128,8 +132,6 @@ void CaseTeachSweep() {
   printf("teach_sweep: journals left: %zu (teach1 pid %u, teach2 pid %u%s)\n", js.size(), s1.journal_pid, s2.journal_pid,
          root ? ", uid 12345's file" : "");
   CHECK(arflex_host_stop(&t1, kCall) == 0 && arflex_host_stop(&t2, kCall) == 0, "stop");
-  unlink(link.c_str());
-  unlink(victim.c_str());
 }
 
 }  // namespace celltest
