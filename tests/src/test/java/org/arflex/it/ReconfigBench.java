@@ -63,17 +63,18 @@ class ReconfigBench {
                long quietReleases, long quietMissed, long releases, long missed, long longest,
                CellChurnBench.Tally quiet, CellChurnBench.Tally window, double jump, double jumpBefore,
                boolean safeStop, long safeCycles, double force, int resets, long restarts, String gaps,
-               long missedInCommand) {
+               long missedInCommand, long turnReleases, long turnMissed) {
         String json(double rate) {
             return String.format(Locale.ROOT, "{\"example\":\"%s\",\"rep\":%d,\"ok\":%b,\"note\":\"%s\",\"prepare_ms\":%s,"
                     + "\"switch_turn_ms\":%s,\"command_ms\":%.1f,\"quiet_releases\":%d,\"quiet_missed\":%d,"
                     + "\"releases\":%d,\"missed\":%d,\"longest_missed_run\":%d,\"expected_missed\":%.2f,"
                     + "\"missed_in_excess\":%d,\"quiet\":%s,\"switch\":%s,\"max_jump_rad\":%.6g,"
                     + "\"max_step_before_rad\":%.6g,\"safe_stop\":%b,\"safe_cycles\":%d,\"max_force_n\":%.1f,"
-                    + "\"resets\":%d,\"restarts\":%d,\"not_run_at_ms\":\"%s\",\"not_run_in_command\":%d}", example, rep, ok, note.replace("\\", "\\\\").replace("\"", "'"),
+                    + "\"resets\":%d,\"restarts\":%d,\"not_run_at_ms\":\"%s\",\"not_run_in_command\":%d,"
+                    + "\"turn_releases\":%d,\"turn_missed\":%d}", example, rep, ok, note.replace("\\", "\\\\").replace("\"", "'"),
                     num(prepMs), num(switchMs), cmdMs, quietReleases, quietMissed, releases, missed, longest,
                     rate * releases, excess(rate), quiet.json(), window.json(), jump, jumpBefore, safeStop, safeCycles,
-                    force, resets, restarts, gaps, missedInCommand);
+                    force, resets, restarts, gaps, missedInCommand, turnReleases, turnMissed);
         }
 
         long excess(double rate) {
@@ -276,6 +277,7 @@ class ReconfigBench {
             long qFrom = c.js().last().tNs();
             awaitRobotTime(c, qFrom + QUIET_MS * 1_000_000L, "a quiet window before '" + example + "'");
             CellChurnBench.Snap a0s = robot(rt);
+            int logMark = rt.logMark();
             long a0 = System.nanoTime();
             CompletableFuture<String> apply = CompletableFuture.supplyAsync(() -> rt.cmd("arflex:change apply " + actions));
             if (update) {
@@ -322,6 +324,9 @@ class ReconfigBench {
             long[] qs = UpdateSetIT.skips(qjs, 0);
             long[] ws = UpdateSetIT.skips(wjs, 0);
             String gaps = gaps(wjs, a0);
+            // around the switch turn (D65: 2 ms before it to 3 ms after): what the switch itself cost
+            SwitchWindow turn = SwitchWindow.find(rt.logSince(logMark));
+            long[] ts = turn == null ? new long[] {0, -1} : turn.skips(wjs);
             // the robot's reference: the largest step per source cycle in the switch window, across
             // both versions of an update whichever cycle sim-robot took the BIND at
             List<CellRig.Ref> o = oldRef.snapshot();
@@ -363,7 +368,7 @@ class ReconfigBench {
             return new Row(example, rep, ok, note, applied ? Double.parseDouble(m.group(1)) : Double.NaN,
                     applied ? Double.parseDouble(m.group(2)) : Double.NaN, cmdMs, releases(qjs), qs[0], releases(wjs),
                     ws[0], ws[1], quiet, window, jump, before, safeStop, safe1 - safe0, force, resets,
-                    restarts(rt) - restarts0, gaps, inCommand(wjs, a0, aRet));
+                    restarts(rt) - restarts0, gaps, inCommand(wjs, a0, aRet), ts[1], ts[0]);
         } finally {
             if (np != null) {
                 np.close();
@@ -374,12 +379,13 @@ class ReconfigBench {
     static String line(Row r) {
         return String.format(Locale.ROOT, "reconfig: %-26s #%d %-4s prep %6s ms  turn %6s ms  cmd %6.0f ms | "
                 + "p99 %s us, >200 us %s, ovr %d (quiet %s us, %s, %d) | not run %d of %d, %d in a row (quiet %d of %d) | "
-                + "jump %.3f mrad (before %.3f) | force %.1f N  safe %s  resets %d  restarts %d%s",
+                + "at the turn %s | jump %.3f mrad (before %.3f) | force %.1f N  safe %s  resets %d  restarts %d%s",
                 r.example(), r.rep(), r.ok() ? "ok" : "FAIL", num(r.prepMs()), num(r.switchMs()), r.cmdMs(),
                 CellChurnBench.Tally.num(r.window().quantileUs(0.99)), over(r.window()),
                 r.window().overruns, CellChurnBench.Tally.num(r.quiet().quantileUs(0.99)),
                 over(r.quiet()), r.quiet().overruns, r.missed(), r.releases(), r.longest(),
-                r.quietMissed(), r.quietReleases(), r.jump() * 1e3, r.jumpBefore() * 1e3, r.force(),
+                r.quietMissed(), r.quietReleases(), r.turnMissed() < 0 ? "-" : r.turnMissed() + " of " + r.turnReleases(),
+                r.jump() * 1e3, r.jumpBefore() * 1e3, r.force(),
                 r.safeStop() ? "YES" : "no", r.resets(), r.restarts(), r.gaps().isEmpty() ? "" : " | not run at ms " + r.gaps());
     }
 
@@ -463,11 +469,17 @@ class ReconfigBench {
                 + "\"jvm_cpus\":\"%s\",\"sets\":%d,\"missed_cycles\":%d,\"safe_stops\":%d,"
                 + "\"resets\":%d,\"restarts\":%d,\"max_jump_rad\":%.6g,\"jump_bound_rad\":%.6g,\"quiet_releases\":%d,"
                 + "\"quiet_missed\":%d,\"switch_releases\":%d,\"switch_missed\":%d,\"missed_per_set_floored_sum\":%d,"
-                + "\"spurious_rollbacks\":%d,\"rows\":[\n%s]}%n", Boolean.getBoolean("arflex.it.mlock"),
+                + "\"spurious_rollbacks\":%d,\"switch_turn_missed\":%d,\"switch_turn_releases\":%d,\"rows\":[\n%s]}%n", Boolean.getBoolean("arflex.it.mlock"),
                 System.getProperty("arflex.bench.shield", ""), Boolean.getBoolean("arflex.bench.poll"),
                 System.getProperty("arflex.it.jvmcpus", ""), rows.size(), m, x,
-                resets, restarts, j, ChangeSetIT.JUMP_BOUND, qr, qm, releases, missedRaw, perSet, spurious.size(), sb));
+                resets, restarts, j, ChangeSetIT.JUMP_BOUND, qr, qm, releases, missedRaw, perSet, spurious.size(),
+                rows.stream().mapToLong(r -> Math.max(0, r.turnMissed())).sum(),
+                rows.stream().filter(r -> r.turnMissed() >= 0).mapToLong(Row::turnReleases).sum(), sb));
         System.out.println("JSON: " + out.toAbsolutePath());
+        List<Row> turned = rows.stream().filter(r -> r.turnMissed() >= 0).toList();
+        System.out.printf(Locale.ROOT, "reconfig: around the switch turns (2 ms before each to 3 ms after, D65): %d of %d "
+                + "releases not run, in %d sets that switched%n", turned.stream().mapToLong(Row::turnMissed).sum(),
+                turned.stream().mapToLong(Row::turnReleases).sum(), turned.size());
         System.out.println("reconfig: RT halves " + (Boolean.getBoolean("arflex.it.mlock") ? "with" : "without")
                 + " mlockall (--mlock)");
         System.out.printf(Locale.ROOT, "reconfig: %d sets, missed cycles %d, safe stops %d, resets %d, max jump %.6f rad%n",

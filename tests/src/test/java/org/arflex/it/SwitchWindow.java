@@ -26,6 +26,13 @@ record SwitchWindow(long fromNs, long toNs) {
 
     /** The last switch turn in {@code log}, or an assertion error naming what was there. */
     static SwitchWindow of(List<String> log) {
+        SwitchWindow w = find(log);
+        assertTrue(w != null, () -> "no switch turn in the runtime's log:\n" + String.join("\n", log));
+        return w;
+    }
+
+    /** The last switch turn in {@code log}, or null (a set refused, torn down or rejected in shadow). */
+    static SwitchWindow find(List<String> log) {
         SwitchWindow w = null;
         for (String l : log) {
             Matcher m = LINE.matcher(l);
@@ -33,7 +40,6 @@ record SwitchWindow(long fromNs, long toNs) {
                 w = new SwitchWindow(Long.parseLong(m.group(1)), Long.parseLong(m.group(2)));
             }
         }
-        assertTrue(w != null, () -> "no switch turn in the runtime's log:\n" + String.join("\n", log));
         return w;
     }
 
