@@ -73,6 +73,12 @@ class VisionChangeSetIT {
             rt.awaitState("ACTIVE", T, "vision", "sim-camera-0", "sim-camera-1", "sim-camera-2", "sim-camera-3");
             rt.waitUntil("tcp-correction.tcp_pose bound to vision", T,
                     () -> rt.cmd("arflex:bindings").contains("tcp-correction.tcp_pose <- vision.tcp_pose"));
+            // tcp-correction holds a measurement whose sigma exceeds max_sigma (0.2 mm by default);
+            // on this moving program most of vision's are 0.1-2.3 mm (D58), so few reached it and
+            // the correction was barely exercised across the update (and the wait below timed out
+            // under load). 3 mm lets them through; max_rate (0.01 rad/s) still bounds the correction's
+            // change to 0.01 mrad per cycle, far inside the reference-step bound asserted below.
+            CellRig.set(rt, "tcp-correction", "max_sigma", "0.003");
             Path jar = version(VISION, "vision", Files.createDirectories(rt.dir.resolve("versions")), "1.0.1");
             long robotPid = rt.pid("sim-robot");
             long guardPid = rt.pid("force-guard");
@@ -95,15 +101,14 @@ class VisionChangeSetIT {
                 rec.add(sp, CellRig.Safety::of, CellRig.Safety::seq, safety::add);
                 rec.add(ep, CellRig.Sample::of, CellRig.Sample::seq, err::add);
                 rec.start();
-                // tcp-correction takes only measurements within its max_sigma (0.2 mm); on this program
-                // vision's are mostly wider (D58: 0.11-2.3 mm), so they are few: one run of two on a quiet
-                // machine, after the other ITs, timed out at T (the other saw 4; 82 s for the whole test); the
-                // deadline is twice T, the count the same
+                // with max_sigma 3 mm (above) most measurements reach tcp-correction; the deadline stays
+                // twice T for a machine whose cameras and vision are starved by other work
                 rt.waitUntil("the arm moving and vision's measurements reaching tcp-correction (3 seen)", 2 * T,
                         () -> FailSafeIT.moving(js) && err.size() > 3);
                 assertTrue(CellRig.awaitingReset(rt).isEmpty(), "before: " + CellRig.awaitingReset(rt));
                 Map<String, Object> robot0 = ChangeSetIT.stats(rt, "sim-robot");
                 int mark = ref.size();
+                int logMark = rt.logMark();
                 long t0 = System.nanoTime();
                 String out = rt.cmd("arflex:change apply update vision file:" + jar + " " + UpdateSetIT.sha256(jar)
                         + " window 10");
@@ -131,6 +136,7 @@ class VisionChangeSetIT {
                 assertNull(ss.stream().filter(s -> s.mode() != CellRig.Safety.NORMAL).findFirst().orElse(null),
                         "the guard left NORMAL");
                 assertEquals(0, ChangeSetIT.delta(robot0, robot1, "safeCycles"), "sim-robot ran safe cycles");
+                SwitchWindow.of(rt.logSince(logMark)).assertNoReleaseLost("VisionChangeSetIT", js.snapshot());
             }
             assertEquals(List.of(), CellRig.awaitingReset(rt));
             assertEquals(List.of(), CellRig.awaitingCommand(rt));
