@@ -23,7 +23,8 @@ import org.arflex.drcr.impl.runtime.Instance;
  * parsed, Felix's part checked, the new versions read and the dry run, the executables
  * extracted, the set handed to the cell, then Felix brought in line and, for updates, the
  * verdict of their windows awaited. Its phases are published (D53) and it ends with its outcome
- * whichever way it returns.
+ * whichever way it returns; the answer carries the outcome and each update's entry for the
+ * history (D62).
  */
 final class ChangeSetApply {
 
@@ -57,6 +58,9 @@ final class ChangeSetApply {
             } else {
                 String outcome = ChangeSetProgress.outcomeOf(d.applied, d.refusal, verdict[0], missing[0]);
                 p.done(outcome, d.refusal != null ? d.refusal : verdict[0]);
+                // the history keeps what the progress showed of each update (D62)
+                d.outcome = outcome;
+                d.updates = p.updates();
             }
         }
     }
