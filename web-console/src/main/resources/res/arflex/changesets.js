@@ -5,7 +5,8 @@
  * shadow, rolled back, torn down) and the history of the sets applied in this runtime. While a
  * set is applied, its live progress (D53) from the DRCR: the phases gone through, what it does
  * now, an update's shadow or window cycles and the worst deviation so far, then the outcome;
- * a set of several updates gets a row for each (D60), kept with the outcome.
+ * a set of several updates gets a row for each (D60), kept with the outcome; the history shows
+ * each update of a set as the DRCR kept it (D62), a cancelled one naming whose rejection.
  * Everything goes into the DOM through textContent and attribute setters only. */
 'use strict';
 (() => {
@@ -128,14 +129,31 @@
     }
   });
 
+  /**
+   * An update of a set in the history (D62), as the DRCR's progress last showed it: its phase,
+   * cycle k of K, its shadow run's worst deviation, its verdict (a cancelled one names the update
+   * whose rejection cancelled it). The numbers also as data-* attributes for a browser test.
+   */
+  function historyEntry(u) {
+    return el('div', {class: 'arflex-cs-history-update', 'data-component': u.component, 'data-phase': u.phase || '',
+      'data-cycle': u.cycle, 'data-cycles': u.cycles, 'data-worst': u.worstField ? u.worstDeviation : '',
+      'data-verdict': u.verdict || '', title: u.why || ''},
+      u.component + ': ' + (u.phase ? (PHASE_TEXT[u.phase] || u.phase) + ' cycle ' + u.cycle + ' of ' + u.cycles
+        : 'no shadow run or window')
+      + (u.worstField ? ', worst ' + u.worstField + ' ' + Number(u.worstDeviation).toPrecision(3)
+        + ' (tolerance ' + u.tolerance + ')' : '')
+      + '; ' + verdictText(u, false));
+  }
+
   function outcomeRow(o, i) {
     const ups = (o.updates || []).map(u => u.component + ': ' + u.verdict.replace(/-/g, ' ')
       + (u.cycles !== null && u.cycles !== undefined ? ' after ' + u.cycles + ' cycles' : '')).join('; ');
+    const entries = o.entries || [];
     return el('tr', {'data-outcome': o.outcome, 'data-index': i},
       el('td', {}, when(o.finishedMillis)),
       el('td', {}, (o.actions || []).join('; ')),
       el('td', {class: o.outcome === 'committed' ? '' : 'arflex-bad'}, OUTCOME_TEXT[o.outcome] || o.outcome),
-      el('td', {}, o.why || ''), el('td', {}, ups),
+      el('td', {}, o.why || ''), el('td', {}, entries.length ? entries.map(historyEntry) : ups),
       el('td', {}, o.applied ? (o.prepareMs.toFixed(1) + ' ms / ' + (o.switchUs / 1000).toFixed(1) + ' ms') : ''),
       el('td', {}, el('details', {}, el('summary', {}, 'text'), el('div', {class: 'arflex-plan'}, o.text || ''))));
   }
@@ -170,6 +188,12 @@
 
   const VERDICT_TEXT = {'committed': 'committed', 'rolled-back': 'rolled back', 'rejected-in-shadow': 'rejected in shadow'};
 
+  /** An update's verdict in words; a cancelled one says whose rejection cancelled it (its why, D62). */
+  function verdictText(u, running) {
+    if (u.verdict === 'cancelled' && u.why) return u.why;
+    return u.verdict ? VERDICT_TEXT[u.verdict] || u.verdict : running ? '' : 'no verdict of its own';
+  }
+
   /**
    * One row per update of a set of several (D60), in the set's order: its phase, a bar with cycle
    * k of K, its shadow run's worst deviation, its verdict. Each row carries the numbers as data-*
@@ -188,8 +212,7 @@
         u.cycles > 0 ? ' cycle ' + u.cycle + ' of ' + u.cycles : ''),
       el('td', {}, u.worstField ? u.worstField + ' ' + Number(u.worstDeviation).toPrecision(3)
         + ' (tolerance ' + u.tolerance + ')' : ''),
-      el('td', {title: u.why || ''}, u.verdict ? VERDICT_TEXT[u.verdict] || u.verdict
-        : p.running ? '' : 'no verdict of its own'))), 'no update');
+      el('td', {title: u.why || ''}, verdictText(u, p.running)))), 'no update');
   }
 
   /** The DRCR's progress of the set being applied (or of the last one): phases, step, cycles, outcome. */

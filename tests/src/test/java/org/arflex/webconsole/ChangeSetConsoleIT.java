@@ -669,7 +669,28 @@ class ChangeSetConsoleIT {
             }
             assertEquals("", rows.get(0).get("worst"), "no shadow run, no deviation: " + rows);
             assertFalse(rows.get(1).get("worst").isEmpty(), "the scaler's shadow run's worst deviation kept: " + rows);
+            // the history's newest row: each update as the DRCR kept it (D62)
+            List<Map<String, String>> kept = b.await("the history's row with each update", WAIT, () -> {
+                List<Map<String, String>> h = (List<Map<String, String>>) b.js("const r = document.querySelector("
+                        + "'#arflex-cs-history-table tr[data-index=\"0\"]'); return r ? Array.from(r.querySelectorAll("
+                        + "'div.arflex-cs-history-update')).map(e => ({component: e.dataset.component, phase: e.dataset.phase,"
+                        + " cycle: e.dataset.cycle, cycles: e.dataset.cycles, worst: e.dataset.worst,"
+                        + " verdict: e.dataset.verdict, text: e.innerText})) : [];");
+                return h.size() == 2 ? h : null;
+            }, b::source);
+            System.out.println("ChangeSetConsoleIT: two updates, the history's row: " + kept);
+            assertEquals(List.of("sample-counter", "sample-scaler"), kept.stream().map(r -> r.get("component")).toList());
+            for (Map<String, String> r : kept) {
+                assertEquals("committed", r.get("verdict"), kept.toString());
+                assertEquals("200", r.get("cycles"), kept.toString());
+            }
+            assertFalse(kept.get(1).get("worst").isEmpty(), kept.toString());
         }
+        // the endpoint's history: the same entries
+        List<Map<String, Object>> entries = (List<Map<String, Object>>) history().get(0).get("entries");
+        assertEquals(List.of("sample-counter", "sample-scaler"), entries.stream().map(u -> u.get("component")).toList());
+        assertEquals(List.of("committed", "committed"), entries.stream().map(u -> u.get("verdict")).toList());
+        assertEquals("y.value", entries.get(1).get("worstField"), String.valueOf(entries));
         // the endpoint says the same
         Map<String, Object> p = Json.object(rt.get(PAGE + "/api/changeset-progress", true).body());
         Map<String, Object> last = (Map<String, Object>) p.get("progress");
@@ -689,5 +710,15 @@ class ChangeSetConsoleIT {
         assertTrue(tail.matches("(?s).*\nupdate sample-counter: rollback window, cycle \\d+ of 200; committed\n"
                 + "update sample-scaler: rollback window, cycle \\d+ of 200, worst deviation in shadow y\\.value \\S+ "
                 + "\\(tolerance 1\\.0E-6\\); committed.*"), tail);
+        // and its history (D62): the same lines, kept
+        rt.gogo("arflex:change history 1");
+        RuntimeUnderTest.awaitCondition("arflex:change history answered", WAIT,
+                () -> rt.tail().contains("1 of the "));
+        String history = rt.tail().substring(rt.tail().lastIndexOf("1 of the "));
+        assertTrue(history.matches("(?s)1 of the \\d+ change sets applied in this runtime, newest first\n"
+                + "\\S+ \\S+ UTC  change set: update sample-counter .*\n  outcome: committed\n"
+                + "  update sample-counter: rollback window, cycle \\d+ of 200; committed\n"
+                + "  update sample-scaler: rollback window, cycle \\d+ of 200, worst deviation in shadow y\\.value \\S+ "
+                + "\\(tolerance 1\\.0E-6\\); committed\n  prepared in .*"), history);
     }
 }

@@ -238,31 +238,10 @@ final class ChangeSetBackend {
         v.put("forMs", Math.max(0, clock.getAsLong() - p.startedMillis));
         v.put("outcome", p.outcome);
         v.put("why", p.why);
-        v.put("updates", updates(p.updates));
+        v.put("updates", UpdateEntries.of(p.updates));
         v.put("seq", p.seq);
         m.put("progress", v);
         return m;
-    }
-
-    /** Each update of the set, in its order (D60): its phase, counters, shadow's worst deviation, verdict. */
-    private static List<Map<String, Object>> updates(org.arflex.drcr.dto.UpdateProgressDTO[] updates) {
-        List<Map<String, Object>> out = new ArrayList<>();
-        for (org.arflex.drcr.dto.UpdateProgressDTO u : updates == null ? new org.arflex.drcr.dto.UpdateProgressDTO[0]
-                : updates) {
-            Map<String, Object> e = new LinkedHashMap<>();
-            e.put("component", u.component);
-            e.put("phase", u.phase);
-            e.put("step", u.step);
-            e.put("cycle", u.cycle);
-            e.put("cycles", u.cycles);
-            e.put("worstField", u.worstField);
-            e.put("worstDeviation", u.worstDeviation);
-            e.put("tolerance", u.tolerance);
-            e.put("verdict", u.verdict);
-            e.put("why", u.why);
-            out.add(e);
-        }
-        return out;
     }
 
     /** What is being applied, the last outcome here, and the DRCR's history. */

@@ -36,7 +36,11 @@ final class ChangeSetOutcome {
     private ChangeSetOutcome() {
     }
 
-    /** The JSON-ready view of an apply's answer: outcome, why, per-update verdicts and the parts of its text. */
+    /**
+     * The JSON-ready view of an apply's answer: outcome, why, per-update verdicts read from its
+     * text ({@code updates}), each update's entry as the DRCR kept it ({@code entries}, D62; empty
+     * from a DRCR before 0.13 of its DTOs) and the parts of its text.
+     */
     static Map<String, Object> of(ChangeSetDTO d) {
         Map<String, Object> parts = ChangeSetText.parse(d.text);
         List<Map<String, Object>> updates = new ArrayList<>();
@@ -95,6 +99,8 @@ final class ChangeSetOutcome {
         m.put("why", why);
         m.put("cycles", cycles);
         m.put("updates", updates);
+        // each update as the DRCR's live progress last showed it (D62): counters, worst deviation, verdict
+        m.put("entries", UpdateEntries.of(d.updates));
         m.put("admitted", d.admitted);
         m.put("applied", d.applied);
         m.put("refusal", d.refusal);

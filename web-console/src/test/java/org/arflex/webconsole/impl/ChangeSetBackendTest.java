@@ -383,4 +383,33 @@ class ChangeSetBackendTest {
         assertEquals(0.004, u.get(1).get("worstDeviation"));
         assertNull(u.get(1).get("verdict"));
     }
+
+    @Test
+    @SuppressWarnings("unchecked")
+    void theHistoryCarriesEachUpdatesEntryAsTheDrcrKeptIt() throws Exception {
+        applyAnswer = answer(false, "update stage: rejected in shadow after 45 cycles: it exited; nothing changed (pid 9"
+                + " runs stage on)", "change set: x\nrefused: ...\n");
+        applyAnswer.outcome = "rejected-in-shadow";
+        org.arflex.drcr.dto.UpdateProgressDTO src = entry("src", "shadow", 25, 100, 0.002, "cancelled");
+        src.why = "cancelled: update stage was rejected in shadow (it exited)";
+        applyAnswer.updates = new org.arflex.drcr.dto.UpdateProgressDTO[] {src,
+                entry("stage", "shadow", 45, 200, 0.004, "rejected-in-shadow")};
+        List<Map<String, Object>> h = (List<Map<String, Object>>) backend.status().get("history");
+        assertEquals(1, h.size());
+        List<Map<String, Object>> entries = (List<Map<String, Object>>) h.get(0).get("entries");
+        assertEquals(List.of("src", "stage"), entries.stream().map(e -> e.get("component")).toList());
+        assertEquals("cancelled", entries.get(0).get("verdict"));
+        assertEquals("cancelled: update stage was rejected in shadow (it exited)", entries.get(0).get("why"));
+        assertEquals(25L, entries.get(0).get("cycle"));
+        assertEquals(100L, entries.get(0).get("cycles"));
+        assertEquals(0.002, entries.get(0).get("worstDeviation"));
+        assertEquals("rejected-in-shadow", entries.get(1).get("verdict"));
+        assertEquals(45L, entries.get(1).get("cycle"));
+        // the verdicts read from the text are as before
+        assertEquals(List.of("stage"), ((List<Map<String, Object>>) h.get(0).get("updates")).stream()
+                .map(e -> e.get("component")).toList());
+        // a DRCR before 0.13 of its DTOs keeps no entries
+        applyAnswer.updates = null;
+        assertEquals(List.of(), ((List<Map<String, Object>>) backend.status().get("history")).get(0).get("entries"));
+    }
 }

@@ -21,4 +21,18 @@ public class ChangeSetDTO {
      * {@link org.arflex.drcr.ChangeSetService#history} lists; 0 for a dry run (D46).
      */
     public long finishedMillis;
+    /**
+     * How the apply ended, in the live progress's words ({@code committed}, {@code applied},
+     * {@code rolled-back}, {@code rejected-in-shadow}, {@code torn-down} or {@code refused}); set
+     * on the sets {@link org.arflex.drcr.ChangeSetService#history} lists; null for a dry run (D62).
+     */
+    public String outcome;
+    /**
+     * Each update of the set, in the set's order, as the apply's live progress last showed it
+     * (D60): its shadow run's or rollback window's cycles, its shadow run's worst deviation, its
+     * verdict and why (D62). Set on the sets {@link org.arflex.drcr.ChangeSetService#history}
+     * lists: empty for a set without updates, or refused before the executor accepted it; null
+     * for a dry run.
+     */
+    public UpdateProgressDTO[] updates;
 }

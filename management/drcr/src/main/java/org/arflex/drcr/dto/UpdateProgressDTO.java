@@ -32,11 +32,15 @@ public class UpdateProgressDTO {
     public double tolerance;
     /**
      * Its own verdict once known: {@code committed} (its window is over without a rollback),
-     * {@code rolled-back} (in its window or at the switch) or {@code rejected-in-shadow}; null
-     * before, and for an update the set's outcome ended without a verdict of its own (the set
-     * refused, torn down or rejected for another update).
+     * {@code rolled-back} (in its window or at the switch), {@code rejected-in-shadow}, or
+     * {@code cancelled} (another update of the set was rejected in its shadow run, so the set was
+     * abandoned: {@link #why} names it and its reason, D62); null before, and for an update the
+     * set's outcome ended without a verdict of its own (the set refused or torn down).
      */
     public String verdict;
-    /** The verdict's text (the log's line), or null. */
+    /**
+     * The verdict's text (the log's line; for {@code cancelled}: {@code cancelled: update <c> was
+     * rejected in shadow (<its reason>)}), or null.
+     */
     public String why;
 }

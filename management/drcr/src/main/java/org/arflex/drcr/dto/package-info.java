@@ -4,5 +4,5 @@
  * tests read the cell only through these.
  */
 @org.osgi.annotation.bundle.Export
-@org.osgi.annotation.versioning.Version("0.12.0")
+@org.osgi.annotation.versioning.Version("0.13.0")
 package org.arflex.drcr.dto;

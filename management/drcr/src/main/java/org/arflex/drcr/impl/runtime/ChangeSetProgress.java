@@ -34,6 +34,8 @@ public final class ChangeSetProgress {
     public static final String COMMITTED = "committed";
     public static final String ROLLED_BACK = "rolled-back";
     public static final String REJECTED_IN_SHADOW = "rejected-in-shadow";
+    /** An update whose set another update's shadow run rejected (D62): it did not happen, not for its own reason. */
+    public static final String CANCELLED = "cancelled";
 
     private final LongSupplier clock;
     private volatile ChangeSetProgressDTO shown;
@@ -86,6 +88,15 @@ public final class ChangeSetProgress {
         c.why = d.why;
         c.seq = d.seq;
         return c;
+    }
+
+    /** Copies of {@code updates} (an empty array for null): for the history, which keeps them (D62). */
+    public static UpdateProgressDTO[] copies(UpdateProgressDTO[] updates) {
+        UpdateProgressDTO[] out = new UpdateProgressDTO[updates == null ? 0 : updates.length];
+        for (int i = 0; i < out.length; i++) {
+            out[i] = copy(updates[i]);
+        }
+        return out;
     }
 
     private static UpdateProgressDTO copy(UpdateProgressDTO u) {
@@ -223,6 +234,39 @@ public final class ChangeSetProgress {
                 d.updates = updates.clone();
                 d.seq = ++seq;
                 shown = d;
+            }
+        }
+
+        /**
+         * The shadow run of {@code component} rejected it after {@code cycle} cycles for
+         * {@code reason} ({@code refusal}: the set's refusal line): its entry says
+         * {@code rejected-in-shadow}, and every other update without a verdict of its own is
+         * {@code cancelled}, naming it and the reason (D62), its counters kept.
+         */
+        public void rejectedInShadow(String component, String refusal, String reason, long cycle) {
+            synchronized (ChangeSetProgress.this) {
+                if (owner != this || !running || indexOf(component) < 0) {
+                    return;
+                }
+                for (int i = 0; i < updates.length; i++) {
+                    if (updates[i].verdict == null && !updates[i].component.equals(component)) {
+                        UpdateProgressDTO u = copy(updates[i]);
+                        u.verdict = CANCELLED;
+                        u.why = ShadowReport.cancelled(component, reason);
+                        updates[i] = u;
+                    }
+                }
+                verdict(component, REJECTED_IN_SHADOW, refusal, cycle); // publishes them all in one snapshot
+            }
+        }
+
+        /**
+         * Each update's last entry, in the set's order (copies): what the history keeps of the
+         * apply (D62); empty when the executor never accepted the set.
+         */
+        public UpdateProgressDTO[] updates() {
+            synchronized (ChangeSetProgress.this) {
+                return copies(updates);
             }
         }
 

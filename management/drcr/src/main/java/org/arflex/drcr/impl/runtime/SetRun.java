@@ -210,7 +210,7 @@ final class SetRun {
                 String refusal = String.format(java.util.Locale.ROOT, "update %s: rejected in shadow after %d cycles: "
                         + "%s; nothing changed (pid %d runs %s on)", r.next.name, r.cycles(), why, r.oldHalf.pid(),
                         r.next.name);
-                progress.verdict(r.next.name, ChangeSetProgress.REJECTED_IN_SHADOW, refusal, r.cycles());
+                progress.rejectedInShadow(r.next.name, refusal, why, r.cycles());
                 abandon(refusal, "rejected in shadow: " + r.next.name);
             }
         }

@@ -45,6 +45,14 @@ final class ShadowReport {
         return sb.append(')').toString();
     }
 
+    /**
+     * The verdict's line of an update whose set was abandoned because {@code rejected}'s shadow
+     * run rejected it for {@code reason} (D62).
+     */
+    static String cancelled(String rejected, String reason) {
+        return "cancelled: update " + rejected + " was rejected in shadow (" + reason + ")";
+    }
+
     static String overran(long newBad, long cycles, long oldBad) {
         return String.format(Locale.ROOT, "it overran or missed its deadline in %d of its %d cycles (the running "
                 + "version, on the same inputs: %d; allowed %d more)", newBad, cycles, oldBad,

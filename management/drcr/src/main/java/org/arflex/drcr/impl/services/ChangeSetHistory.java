@@ -6,12 +6,14 @@ import java.util.Deque;
 import java.util.List;
 import java.util.function.LongSupplier;
 import org.arflex.drcr.dto.ChangeSetDTO;
+import org.arflex.drcr.dto.UpdateProgressDTO;
+import org.arflex.drcr.impl.runtime.ChangeSetProgress;
 
 /**
  * The outcomes of the change sets applied in this runtime, newest first, at most {@link #MAX}
  * (D46): what the console's Change sets page shows as its history, whether the set came from
- * the console or from {@code arflex:change apply}. In memory only; a restart of the DRCR starts
- * an empty history.
+ * the console or from {@code arflex:change apply}, each with its update entries as the live
+ * progress last showed them (D62). In memory only; a restart of the DRCR starts an empty history.
  */
 final class ChangeSetHistory {
     /** Outcomes kept; the oldest goes first. */
@@ -24,9 +26,19 @@ final class ChangeSetHistory {
         this.clock = wallClockMillis;
     }
 
-    /** Records an apply's outcome (a copy, stamped with the time it came back); returns it. */
+    /**
+     * Records an apply's outcome (a copy, stamped with the time it came back); returns it. A
+     * record without an outcome (a deployment set refused before its change set) is
+     * {@code refused} (or {@code applied}), without update entries.
+     */
     synchronized ChangeSetDTO record(ChangeSetDTO d) {
         d.finishedMillis = clock.getAsLong();
+        if (d.outcome == null) {
+            d.outcome = d.applied ? "applied" : "refused";
+        }
+        if (d.updates == null) {
+            d.updates = new UpdateProgressDTO[0];
+        }
         entries.addFirst(copy(d));
         while (entries.size() > MAX) {
             entries.removeLast();
@@ -53,6 +65,8 @@ final class ChangeSetHistory {
         c.prepareMs = d.prepareMs;
         c.switchUs = d.switchUs;
         c.finishedMillis = d.finishedMillis;
+        c.outcome = d.outcome;
+        c.updates = ChangeSetProgress.copies(d.updates);
         return c;
     }
 }

@@ -52,23 +52,7 @@ final class ChangeSetProgressText {
     /** One line per update (D60): its phase, cycles, its shadow run's worst deviation, its verdict. */
     private static void updates(StringBuilder sb, ChangeSetProgressDTO p) {
         for (UpdateProgressDTO u : p.updates) {
-            sb.append("update ").append(u.component).append(": ");
-            if (u.phase == null) {
-                sb.append(p.running ? "not in a shadow run or window yet" : "no shadow run or window");
-            } else {
-                sb.append(String.format(Locale.ROOT, "%s, cycle %d of %d", u.phase.equals("shadow") ? "shadow run"
-                        : "rollback window", u.cycle, u.cycles));
-            }
-            if (u.worstField != null) {
-                sb.append(String.format(Locale.ROOT, ", worst deviation in shadow %s %.3g (tolerance %s)", u.worstField,
-                        u.worstDeviation, u.tolerance));
-            }
-            if (u.verdict != null) {
-                sb.append("; ").append(u.verdict);
-            } else if (!p.running) {
-                sb.append("; no verdict of its own");
-            }
-            sb.append('\n');
+            sb.append(UpdateLine.of(u, p.running)).append('\n');
         }
     }
 }

@@ -210,15 +210,23 @@ public final class Commands {
      * {@code set <component> <parameter> <value>} and {@code update <component> <jar URL> [<sha256>]
      * [window <cycles>] [shadow <cycles>] [envelope ...] [tolerance ...]} (D38, D42), in any number, e.g.
      * {@code change apply install teach uninstall trajectory}. {@code change progress}: where the
-     * set being applied is, or how the last one ended (D53).
+     * set being applied is, or how the last one ended (D53). {@code change history [<count>]}: the
+     * sets applied in this runtime, newest first, each update's last counters and verdict (D62).
      */
     public String change(String... args) {
         return guard(() -> {
-            String usage = "usage: change plan|apply <action>... | change progress (actions: install <component>, uninstall <component>,"
+            String usage = "usage: change plan|apply <action>... | change progress | change history [<count>] (actions: install <component>, uninstall <component>,"
                     + " set <component> <parameter> <value>, update <component> <jar URL> [<sha256>] [window <cycles>]"
                     + " [shadow <cycles>] [envelope <port>.<field> <min> <max>]... [tolerance <port>.<field> <max difference>]...)";
             if (changeSets != null && args.length == 1 && args[0].equals("progress")) {
                 return ChangeSetProgressText.of(changeSets.progress(), System.currentTimeMillis());
+            }
+            if (changeSets != null && args.length >= 1 && args.length <= 2 && args[0].equals("history")) {
+                if (args.length == 2 && !args[1].matches("[1-9][0-9]{0,2}")) {
+                    return "error: change history: '" + args[1] + "' is not a count of sets (1 to 999)";
+                }
+                return ChangeSetHistoryText.of(changeSets.history(), args.length == 2 ? Integer.parseInt(args[1])
+                        : Integer.MAX_VALUE);
             }
             if (changeSets == null || args.length < 2 || !(args[0].equals("plan") || args[0].equals("apply"))) {
                 return usage;

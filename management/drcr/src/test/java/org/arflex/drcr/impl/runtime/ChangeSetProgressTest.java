@@ -312,7 +312,7 @@ class ChangeSetProgressTest {
     }
 
     @Test
-    void whenOneUpdateOfASetIsRejectedInShadowTheOtherKeepsItsCountersWithoutAVerdict() throws Exception {
+    void whenOneUpdateOfASetIsRejectedInShadowTheOtherIsCancelledNamingItAndItsReason() throws Exception {
         runningCell();
         List<ChangeSet.Tolerance> y = List.of(new ChangeSet.Tolerance("y", "value", 0.01));
         ChangeSet set = ChangeSet.builder()
@@ -339,11 +339,44 @@ class ChangeSetProgressTest {
         rig.stepUntil("progress done", () -> !now().running);
         ChangeSetProgressDTO p = now();
         assertEquals("rejected-in-shadow", p.outcome);
-        assertEntry(p.updates[0], "src", "shadow", 25, 100, 0, null);
+        // src's shadow run was cancelled for stage's rejection: it keeps its counters and says so (D62)
+        assertEntry(p.updates[0], "src", "shadow", 25, 100, 0, "cancelled");
+        assertEquals("cancelled: update stage was rejected in shadow (the new version (pid " + newStage.pid
+                + ") exited: killed by signal 11)", p.updates[0].why);
         assertEntry(p.updates[1], "stage", "shadow", 45, 200, 0, "rejected-in-shadow");
         assertTrue(p.updates[1].why.startsWith("update stage: rejected in shadow after 45 cycles: the new version (pid "
                 + newStage.pid + ") exited: killed by signal 11"), p.updates[1].why);
         assertEquals(p.why, p.updates[1].why);
+    }
+
+    @Test
+    void everyUpdateWithoutAVerdictOfItsOwnIsCancelledWhenAnotherIsRejectedInShadow() {
+        ChangeSetProgress progress = new ChangeSetProgress(() -> 1_000);
+        ChangeSetProgress.Apply a = progress.begin(List.of("update a x", "update b y", "update c z", "update d w"));
+        a.claim(List.of("a", "b", "c", "d"));
+        a.cycles(ChangeSetProgress.SHADOW, "a at 100 of 100", "a", 100, 100, null, 0, 0); // a passed, waits
+        a.cycles(ChangeSetProgress.SHADOW, "b at 30 of 200", "b", 30, 200, null, 0, 0);
+        a.cycles(ChangeSetProgress.SHADOW, "d at 10 of 50", "d", 10, 50, null, 0, 0); // c has no shadow run
+        a.rejectedInShadow("b", "update b: rejected in shadow after 30 cycles: y.value 0.5 from the running "
+                + "version's (tolerance 0.01); nothing changed (pid 9 runs b on)", "y.value 0.5 from the running "
+                + "version's (tolerance 0.01)", 30);
+        a.done(ChangeSetProgress.REJECTED_IN_SHADOW, "update b: rejected in shadow after 30 cycles: ...");
+        UpdateProgressDTO[] u = progress.snapshot().updates;
+        String cancelled = "cancelled: update b was rejected in shadow (y.value 0.5 from the running version's "
+                + "(tolerance 0.01))";
+        assertEquals(List.of("cancelled", "rejected-in-shadow", "cancelled", "cancelled"),
+                List.of(u[0].verdict, u[1].verdict, u[2].verdict, u[3].verdict));
+        assertEquals(List.of(cancelled, cancelled, cancelled), List.of(u[0].why, u[2].why, u[3].why));
+        assertTrue(u[1].why.startsWith("update b: rejected in shadow after 30 cycles"), u[1].why);
+        // each keeps its counters: a's passed run, b's 30, c none, d's 10 of 50
+        assertEquals(List.of(100L, 30L, 0L, 10L), List.of(u[0].cycle, u[1].cycle, u[2].cycle, u[3].cycle));
+        assertNull(u[2].phase);
+        // the entries the history keeps are the same, and copies
+        UpdateProgressDTO[] kept = a.updates();
+        assertEquals(4, kept.length);
+        assertEquals(cancelled, kept[3].why);
+        kept[3].why = "changed by a reader";
+        assertEquals(cancelled, a.updates()[3].why);
     }
 
     private static void assertEntry(UpdateProgressDTO u, String component, String phase, long cycle, long cycles,

@@ -102,14 +102,22 @@ class ChangeSetProgressTextTest {
         p.phaseMillis = 12_000;
         p.outcome = "rejected-in-shadow";
         p.why = "update stage: rejected in shadow after 40 cycles: it exited";
-        p.updates = new UpdateProgressDTO[] {entry("src", "shadow", 60, 100, "y.value", 0.002, null),
+        p.updates = new UpdateProgressDTO[] {entry("src", "shadow", 60, 100, "y.value", 0.002, "cancelled"),
                 entry("stage", "shadow", 40, 100, null, 0, "rejected-in-shadow")};
+        p.updates[0].why = "cancelled: update stage was rejected in shadow (it exited)";
         assertEquals("change set: update src file:/s.jar; update stage file:/x.jar\n"
                 + "finished 0.5 s ago, after 2.0 s (phases checking > preparing > shadow > done)\n"
                 + "outcome: rejected-in-shadow: update stage: rejected in shadow after 40 cycles: it exited\n"
                 + "update src: shadow run, cycle 60 of 100, worst deviation in shadow y.value 0.00200 (tolerance 0.01); "
-                + "no verdict of its own\n"
+                + "cancelled: update stage was rejected in shadow (it exited)\n"
                 + "update stage: shadow run, cycle 40 of 100; rejected-in-shadow", ChangeSetProgressText.of(p, 12_500));
+        // a set torn down gives neither update a verdict of its own
+        p.outcome = "torn-down";
+        p.updates = new UpdateProgressDTO[] {entry("src", "shadow", 60, 100, null, 0, null),
+                entry("stage", null, 0, 0, null, 0, null)};
+        assertEquals("update src: shadow run, cycle 60 of 100; no verdict of its own\n"
+                + "update stage: no shadow run or window; no verdict of its own", String.join("\n",
+                ChangeSetProgressText.of(p, 12_500).lines().skip(3).toList()));
     }
 
     @Test

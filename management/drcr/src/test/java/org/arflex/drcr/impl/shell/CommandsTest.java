@@ -329,7 +329,7 @@ class CommandsTest {
 
     @Test
     void changeWithoutActionsPrintsItsUsage() {
-        String usage = "usage: change plan|apply <action>... | change progress (actions: install <component>, uninstall <component>,"
+        String usage = "usage: change plan|apply <action>... | change progress | change history [<count>] (actions: install <component>, uninstall <component>,"
                 + " set <component> <parameter> <value>, update <component> <jar URL> [<sha256>] [window <cycles>]"
                 + " [shadow <cycles>] [envelope <port>.<field> <min> <max>]... [tolerance <port>.<field> <max difference>]...)";
         assertEquals(usage, cmd.change());
