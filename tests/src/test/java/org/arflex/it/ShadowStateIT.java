@@ -1,0 +1,100 @@
+package org.arflex.it;
+
+import static org.junit.jupiter.api.Assertions.assertEquals;
+import static org.junit.jupiter.api.Assertions.assertNotEquals;
+import static org.junit.jupiter.api.Assertions.assertTrue;
+
+import java.nio.file.Files;
+import java.nio.file.Path;
+import java.util.List;
+import java.util.Locale;
+import java.util.regex.Matcher;
+import java.util.regex.Pattern;
+import org.junit.jupiter.api.Test;
+
+/**
+ * docs/DECISIONS.md D61 through the real runtime, on the moving arm (FailSafeIT's looping
+ * program; trajectory -> tcp-correction -> sim-robot): the state of an update's shadow half.
+ *
+ * <p>tcp-correction is put in the middle of a fade first: trajectory is updated (its state handed
+ * over, D41) and tcp-correction fades the step its input took at that provider change over
+ * {@code blend_time} 10 s (D35). While that fade runs, tcp-correction itself is updated with a
+ * shadow run of 500 cycles and a tolerance of 1 urad on its output {@code corrected.q}: the shadow
+ * half must fade exactly as the running one, which it does only with the running half's state
+ * (the fade's offset and time): a half started without it writes the bare reference, off by
+ * what is left of the offset, and is rejected by the tolerance. At the switch the shadow half
+ * takes the running half's newest state again (READOPT), so the robot's reference goes on from
+ * the old half's at the switch: within one cycle of the programmed motion, no safe cycle, no
+ * reset, the new half's logs saying both adoptions.
+ */
+class ShadowStateIT {
+
+    static final long T = CellRig.T;
+    /** The step tcp-correction's input must have taken at the trajectory update for a fade to compare, rad. */
+    static final double FADE_MIN = 20e-6;
+    static final double TOLERANCE = 1e-6;
+
+    @Test
+    void aStatefulComponentInTheMiddleOfAFadePassesATightShadowRunAndSwitchesFromTheOldState() throws Exception {
+        CellRig.assertBuilt(CellRig.SIM_ROBOT, CellRig.TRAJECTORY, CellRig.FORCE_GUARD, CellRig.TCP_CORRECTION);
+        try (Runtime rt = new Runtime("shadow-state")) {
+            FailSafeIT.movingCell(rt);
+            Path dir = Files.createDirectories(rt.dir.resolve("versions"));
+            rt.cmd("arflex:set tcp-correction blend_time 10");
+            // 1. a fade in tcp-correction: trajectory updated, until its input stepped by a program step
+            double offset = 0;
+            for (int k = 1; k <= 5 && offset < FADE_MIN; k++) {
+                Path traj = StateTransferIT.version(dir, "1.0." + k, x -> x);
+                String out = rt.cmd("arflex:change apply update trajectory file:" + traj + " " + UpdateSetIT.sha256(traj)
+                        + " window 0");
+                assertTrue(out.contains("update trajectory: committed"), out);
+                // tcp-correction takes its new binding at its next cycle boundary: its state block says
+                long end = System.nanoTime() + 500_000_000L;
+                do {
+                    offset = StateTransferIT.switchOffset(rt);
+                } while (offset < FADE_MIN && System.nanoTime() < end);
+                System.out.printf(Locale.ROOT, "ShadowStateIT: trajectory 1.0.%d: tcp-correction's input stepped %.4f "
+                        + "mrad at the switch, faded out over 10 s%n", k, offset * 1e3);
+            }
+            assertTrue(offset >= FADE_MIN, "no trajectory update gave tcp-correction a fade: " + offset);
+            long tFade = System.nanoTime();
+
+            // 2. tcp-correction updated in the middle of that fade, with a tight shadow run
+            Path jar = UpdateSetIT.version(dir, "1.0.1", null);
+            int logMark = rt.logMark();
+            UpdateSetIT.Run r = UpdateSetIT.update(rt, jar, "shadow 500 tolerance corrected.q " + TOLERANCE + " window 300");
+            double fadeAge = (System.nanoTime() - tFade) / 1e9;
+            List<String> log = rt.logSince(logMark);
+            Matcher m = Pattern.compile("update tcp-correction: passed its shadow run of (\\d+) cycles \\((\\d+) overruns "
+                    + "or deadline misses, the running version (\\d+); (\\d+) values compared, corrected.q at most (\\S+) "
+                    + "from the running version's").matcher(r.out());
+            assertTrue(m.find(), r.out());
+            assertTrue(Long.parseLong(m.group(4)) > 0, r.out());
+            assertTrue(r.out().contains("update tcp-correction: committed: the new version ran"), r.out());
+            // the shadow half adopted the running half's state at its START, and again at the switch
+            String seg = "/arflex." + rt.rid + ".tcp-correction.state";
+            assertTrue(log.stream().anyMatch(l -> l.contains("1-tcp-correction") && l.contains("adopted the state block "
+                    + "arflex.TcpCorrectionState2 1.0 of " + seg) && !l.contains("re-adopted")), String.join("\n", log));
+            assertTrue(log.stream().anyMatch(l -> l.contains("1-tcp-correction") && l.contains("re-adopted the state block "
+                    + "arflex.TcpCorrectionState2 1.0 of " + seg + " while running")), String.join("\n", log));
+            assertTrue(log.stream().anyMatch(l -> l.contains("tcp-correction: the shadow half (pid ")
+                    && l.contains(") re-adopted " + seg + " at the switch")), String.join("\n", log));
+            double oneCycle = StateTransferIT.ONE_CYCLE;
+            System.out.printf(Locale.ROOT, "ShadowStateIT: in the fade (%.1f s after its start, of 10 s; offset %.4f "
+                    + "mrad): shadow run of %s cycles, %s values compared, corrected.q at most %s rad from the running "
+                    + "version's (tolerance %s); at the switch the robot's reference stepped %.4f mrad per source cycle "
+                    + "between the versions (one cycle of the programmed motion: %.4f; before, the program alone: %.4f); "
+                    + "sim-robot %d safe cycles; command %d ms%n", fadeAge, offset * 1e3, m.group(1), m.group(4),
+                    m.group(5), TOLERANCE, r.jump() * 1e3, oneCycle * 1e3, r.before() * 1e3, r.robotSafe(), r.applyMs());
+            assertTrue(r.jump() <= oneCycle * 1.02, "the robot's reference stepped " + r.jump()
+                    + " rad per source cycle between the versions");
+            assertEquals(0, r.robotSafe(), "sim-robot ran safe cycles");
+            assertEquals(List.of(), CellRig.awaitingReset(rt));
+            assertEquals(List.of(), CellRig.awaitingCommand(rt));
+            rt.awaitState("ACTIVE", T, "tcp-correction", "sim-robot", "force-guard", "trajectory");
+            assertNotEquals(r.oldPid(), rt.pid("tcp-correction"), "the new version runs");
+            assertEquals(0, ((Number) rt.instance("tcp-correction").get("restarts")).intValue());
+            assertTrue(rt.cmd("arflex:info tcp-correction").contains("1.0.1"), rt.cmd("arflex:info tcp-correction"));
+        }
+    }
+}
