@@ -34,6 +34,32 @@ class ShadowStateIT {
     static final double FADE_MIN = 20e-6;
     static final double TOLERANCE = 1e-6;
 
+    /** The last line of {@code log} containing {@code what}. */
+    static String last(List<String> log, String what) {
+        String found = null;
+        for (String l : log) {
+            if (l.contains(what)) {
+                found = l;
+            }
+        }
+        assertTrue(found != null, "no log line with '" + what + "'");
+        return found;
+    }
+
+    /** Seconds from the time stamp of line {@code a} to that of line {@code b}, which must also contain {@code bAlso}. */
+    static double seconds(String a, String b, String bAlso) {
+        assertTrue(b.contains(bAlso), b);
+        return (stamp(b) - stamp(a)) / 1e9;
+    }
+
+    /** The runtime log's time of day of a line ({@code err| HH:MM:SS.nnnnnnnnn ...}), ns. */
+    static long stamp(String line) {
+        Matcher m = Pattern.compile("(\\d{2}):(\\d{2}):(\\d{2})\\.(\\d{9})").matcher(line);
+        assertTrue(m.find(), "no time stamp in " + line);
+        return ((Long.parseLong(m.group(1)) * 60 + Long.parseLong(m.group(2))) * 60 + Long.parseLong(m.group(3)))
+                * 1_000_000_000L + Long.parseLong(m.group(4));
+    }
+
     @Test
     void aStatefulComponentInTheMiddleOfAFadePassesATightShadowRunAndSwitchesFromTheOldState() throws Exception {
         CellRig.assertBuilt(CellRig.SIM_ROBOT, CellRig.TRAJECTORY, CellRig.FORCE_GUARD, CellRig.TCP_CORRECTION);
@@ -41,6 +67,7 @@ class ShadowStateIT {
             FailSafeIT.movingCell(rt);
             Path dir = Files.createDirectories(rt.dir.resolve("versions"));
             rt.cmd("arflex:set tcp-correction blend_time 10");
+            int fadeMark = rt.logMark();
             // 1. a fade in tcp-correction: trajectory updated, until its input stepped by a program step
             double offset = 0;
             for (int k = 1; k <= 5 && offset < FADE_MIN; k++) {
@@ -57,13 +84,11 @@ class ShadowStateIT {
                         + "mrad at the switch, faded out over 10 s%n", k, offset * 1e3);
             }
             assertTrue(offset >= FADE_MIN, "no trajectory update gave tcp-correction a fade: " + offset);
-            long tFade = System.nanoTime();
 
             // 2. tcp-correction updated in the middle of that fade, with a tight shadow run
             Path jar = UpdateSetIT.version(dir, "1.0.1", null);
             int logMark = rt.logMark();
             UpdateSetIT.Run r = UpdateSetIT.update(rt, jar, "shadow 500 tolerance corrected.q " + TOLERANCE + " window 300");
-            double fadeAge = (System.nanoTime() - tFade) / 1e9;
             List<String> log = rt.logSince(logMark);
             Matcher m = Pattern.compile("update tcp-correction: passed its shadow run of (\\d+) cycles \\((\\d+) overruns "
                     + "or deadline misses, the running version (\\d+); (\\d+) values compared, corrected.q at most (\\S+) "
@@ -79,12 +104,18 @@ class ShadowStateIT {
                     + "arflex.TcpCorrectionState2 1.0 of " + seg + " while running")), String.join("\n", log));
             assertTrue(log.stream().anyMatch(l -> l.contains("tcp-correction: the shadow half (pid ")
                     && l.contains(") re-adopted " + seg + " at the switch")), String.join("\n", log));
+            // the whole shadow run inside the fade: from the trajectory update's commit (the fade's
+            // start, within a cycle) to the shadow run's pass, by the runtime log's own clock
+            List<String> all = rt.logSince(fadeMark);
+            double inFade = seconds(last(all, "arflex: update trajectory: committed"), last(all,
+                    ") passed its shadow run of "), "arflex: tcp-correction: the new version (pid ");
+            assertTrue(inFade < 9.5, "the shadow run passed " + inFade + " s after the fade began (it lasts 10 s)");
             double oneCycle = StateTransferIT.ONE_CYCLE;
-            System.out.printf(Locale.ROOT, "ShadowStateIT: in the fade (%.1f s after its start, of 10 s; offset %.4f "
+            System.out.printf(Locale.ROOT, "ShadowStateIT: in the fade (passed %.2f s after its start, of 10 s; offset %.4f "
                     + "mrad): shadow run of %s cycles, %s values compared, corrected.q at most %s rad from the running "
                     + "version's (tolerance %s); at the switch the robot's reference stepped %.4f mrad per source cycle "
                     + "between the versions (one cycle of the programmed motion: %.4f; before, the program alone: %.4f); "
-                    + "sim-robot %d safe cycles; command %d ms%n", fadeAge, offset * 1e3, m.group(1), m.group(4),
+                    + "sim-robot %d safe cycles; command %d ms%n", inFade, offset * 1e3, m.group(1), m.group(4),
                     m.group(5), TOLERANCE, r.jump() * 1e3, oneCycle * 1e3, r.before() * 1e3, r.robotSafe(), r.applyMs());
             assertTrue(r.jump() <= oneCycle * 1.02, "the robot's reference stepped " + r.jump()
                     + " rad per source cycle between the versions");
