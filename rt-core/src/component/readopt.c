@@ -66,6 +66,22 @@ void arflex_comp_readopt_take(struct arflex_component *c)
 	STORE(&ra->phase, READOPT_DONE);
 }
 
+/* The test fault of READOPT (as D58's ARFLEX_FAULT_START_ERRNO): ARFLEX_FAULT_READOPT_ERRNO=<n>,
+ * 1..4095, makes this half refuse every READOPT with -n, as a hook that cannot take the state
+ * would. Only the update tests' deliberately faulty versions set it (a script that execs the
+ * real executable); nothing shipped does. 0: not set (mailbox thread). */
+static int fault_readopt_env(void)
+{
+	const char *s = getenv("ARFLEX_FAULT_READOPT_ERRNO");
+	char *end;
+	long n;
+
+	if (!s || !*s)
+		return 0;
+	n = strtol(s, &end, 10);
+	return *end || n < 1 || n > 4095 ? 0 : (int)n;
+}
+
 /* Mailbox thread, while running. */
 int arflex_comp_readopt_cmd(struct arflex_component *c, const struct arflex_msg *m)
 {
@@ -78,6 +94,12 @@ int arflex_comp_readopt_cmd(struct arflex_component *c, const struct arflex_msg 
 
 	if (!ra->fn)
 		return -EOPNOTSUPP; /* this executable cannot take a state over while it runs */
+	r = fault_readopt_env();
+	if (r) {
+		arflex_comp_log(c, "READOPT refused: test fault ARFLEX_FAULT_READOPT_ERRNO=%d (%s)", r,
+				strerror(r));
+		return -r;
+	}
 	if (memchr(b->shm_name, 0, sizeof(b->shm_name)) == NULL || !b->shm_name[0])
 		return -EINVAL;
 	p = calloc(1, sizeof(*p));

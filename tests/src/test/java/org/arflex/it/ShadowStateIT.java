@@ -128,4 +128,48 @@ class ShadowStateIT {
             assertTrue(rt.cmd("arflex:info tcp-correction").contains("1.0.1"), rt.cmd("arflex:info tcp-correction"));
         }
     }
+
+    /**
+     * A shadow half that cannot take the running half's state at the switch (rt-core's test fault
+     * ARFLEX_FAULT_READOPT_ERRNO=95, what a half without a re-adopt hook answers) fails closed:
+     * it passes its shadow run, is refused at the switch, and the old half keeps the component
+     * (D55's hand-back), its consumer never rebound, the arm moving on without a safe cycle or a
+     * reset; the verdict names the refusal.
+     */
+    @Test
+    void aShadowHalfThatCannotTakeTheStateAtTheSwitchHandsBackToTheOldHalfOnTheMovingArm() throws Exception {
+        CellRig.assertBuilt(CellRig.SIM_ROBOT, CellRig.TRAJECTORY, CellRig.FORCE_GUARD, CellRig.TCP_CORRECTION);
+        try (Runtime rt = new Runtime("shadow-state-refused")) {
+            FailSafeIT.movingCell(rt);
+            Path dir = Files.createDirectories(rt.dir.resolve("versions"));
+            byte[] script = FaultyVersions.refusingReadopt(dir, CellRig.TCP_CORRECTION, UpdateSetIT.EXE, 95,
+                    "ShadowStateIT");
+            Path jar = UpdateSetIT.version(dir, "1.0.3-noreadopt", script);
+            long oldPid = rt.pid("tcp-correction");
+            String bindings = rt.cmd("arflex:bindings");
+            int logMark = rt.logMark();
+            UpdateSetIT.Run r = UpdateSetIT.update(rt, jar, "shadow 300 tolerance corrected.q " + TOLERANCE + " window 300");
+            List<String> log = rt.logSince(logMark);
+            assertTrue(r.out().contains("update tcp-correction: passed its shadow run of "), r.out());
+            assertTrue(r.out().contains("update tcp-correction: rolled back at the switch: its shadow half could not take "
+                    + "the running half's state at the switch: READOPT of /arflex." + rt.rid + ".tcp-correction.state "
+                    + "refused by 1-tcp-correction: status -95 (EOPNOTSUPP: its executable has no re-adopt hook, "
+                    + "arflex_component_readopt); pid " + oldPid + " (tcp-correction) runs it again"), r.out());
+            assertTrue(log.stream().anyMatch(l -> l.contains("READOPT refused: test fault ARFLEX_FAULT_READOPT_ERRNO=95")),
+                    String.join("\n", log));
+            System.out.printf(Locale.ROOT, "ShadowStateIT: refused re-adopt: handed back; the robot's reference stepped "
+                    + "%.4f mrad per source cycle over the apply (the program alone before: %.4f); sim-robot %d safe "
+                    + "cycles; command %d ms%n", r.jump() * 1e3, r.before() * 1e3, r.robotSafe(), r.applyMs());
+            assertEquals(oldPid, rt.pid("tcp-correction"), "the old half keeps the component");
+            assertTrue(rt.cmd("arflex:info tcp-correction").lines().findFirst().orElse("").contains("1.1.0"),
+                    rt.cmd("arflex:info tcp-correction"));
+            assertEquals(bindings, rt.cmd("arflex:bindings"), "no consumer moved");
+            assertEquals(0, r.robotSafe(), "sim-robot ran safe cycles");
+            assertEquals(List.of(), CellRig.awaitingReset(rt));
+            assertEquals(List.of(), CellRig.awaitingCommand(rt));
+            rt.waitUntil("the refused half's process and segments gone", T, () -> Runtime.rtProcesses(rt.rid).stream()
+                    .noneMatch(p -> p.contains("--instance 1-tcp-correction ")) && Files.list(Path.of("/dev/shm"))
+                    .noneMatch(f -> f.getFileName().toString().startsWith("arflex." + rt.rid + ".1-tcp-correction.")));
+        }
+    }
 }
