@@ -63,6 +63,18 @@ static int prepare(struct arflex_component *c, void *user, const struct arflex_a
 	return 0;
 }
 
+static int adopt(struct arflex_component *c, void *user, const struct arflex_adopted_state *s);
+
+/* D61: ARFLEX_PROBE_READOPT=refuse refuses every re-adopt (-EBADMSG), state untouched. */
+static int readopt_refuse(struct arflex_component *c, void *user,
+			  const struct arflex_adopted_state *s)
+{
+	(void)c;
+	(void)user;
+	(void)s;
+	return -EBADMSG;
+}
+
 static int configure(struct arflex_component *c, void *user)
 {
 	const char *path = getenv("ARFLEX_PROBE_LOG");
@@ -91,6 +103,12 @@ static int configure(struct arflex_component *c, void *user)
 	}
 	if (getenv("ARFLEX_PROBE_PREPARE")) {
 		r = arflex_component_adopt_prepare(c, prepare);
+		if (r)
+			goto out_fail;
+	}
+	if (getenv("ARFLEX_PROBE_READOPT")) { /* D61: the adopt hook re-adopts too, or refuses */
+		r = arflex_component_readopt(c, strcmp(getenv("ARFLEX_PROBE_READOPT"), "refuse")
+							? adopt : readopt_refuse);
 		if (r)
 			goto out_fail;
 	}

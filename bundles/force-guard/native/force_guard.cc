@@ -63,6 +63,8 @@ struct arflex_ctl* Ctl(struct arflex_component* c) {
   return const_cast<struct arflex_ctl*>(arflex_component_ctl(c));
 }
 
+int Adopt(struct arflex_component* c, void*, const struct arflex_adopted_state* a);
+
 int Configure(struct arflex_component* c, void*) {
   static const struct arflex_port_type js_t = {ARFLEX_TYPE_JOINT_STATE_NAME, 1, 0,
                                                sizeof(struct arflex_joint_state)};
@@ -84,6 +86,9 @@ int Configure(struct arflex_component* c, void*) {
                                                ARFLEX_TYPE_FORCE_GUARD_STATE_VERSION_MINOR,
                                                ARFLEX_TYPE_FORCE_GUARD_STATE_SIZE};
   if ((r = arflex_component_state(c, &st_t, nullptr)) < 0 && r != -ENOENT) return r;
+  // D61: Adopt runs between two updates as well (it only adds a latch, never clears one): at the
+  // switch of an update whose new half ran in shadow it takes the old half's state again
+  if ((r = arflex_component_readopt(c, Adopt)) < 0) return r;
   const char* names[] = {"force_limit_n", "torque_limit_nm", "safe_power_fraction", "reset",
                          "payload_kg"};
   int* idx[] = {&g.p_force, &g.p_torque, &g.p_power, &g.p_reset, &g.p_payload};

@@ -116,6 +116,8 @@ int Param(struct arflex_component* c, const char* name, int* idx) {
   return *idx;
 }
 
+int Adopt(struct arflex_component* c, void*, const struct arflex_adopted_state* a);
+
 int Configure(struct arflex_component* c, void*) {
   static const struct arflex_port_type ref_t = {ARFLEX_TYPE_JOINT_REF_NAME, 1, 0,
                                                 sizeof(struct arflex_joint_ref)};
@@ -145,6 +147,9 @@ int Configure(struct arflex_component* c, void*) {
     fprintf(stderr, "trajectory: state block: %s\n", strerror(-r));
     return r;
   }
+  // D61: Adopt runs between two updates as well (it restores the player and the seqs only): at
+  // the switch of an update whose new half ran in shadow it takes the old half's state again
+  if ((r = arflex_component_readopt(c, Adopt)) < 0) return r;
   if ((r = arflex_component_input(c, "safety", ARFLEX_PORT_STATE, &safety_t, &g.in_safety)) < 0 ||
       (r = arflex_component_input(c, "joint_state", ARFLEX_PORT_STATE, &state_t, &g.in_state)) < 0 ||
       (r = arflex_component_input(c, "tool", ARFLEX_PORT_STATE, &tool_t, &g.in_tool)) < 0)

@@ -13,9 +13,11 @@
  *   3. calls configure (main thread), where the component declares its ports with
  *      arflex_component_output() / arflex_component_input() and looks up its parameters;
  *   4. state READY; the mailbox thread serves commands (START, STOP, SET_PARAM, GET_PARAM,
- *      BIND, UNBIND, GET_STATE, GET_STATS, RESET, SHUTDOWN, PING, ADOPT);
+ *      BIND, UNBIND, GET_STATE, GET_STATS, RESET, SHUTDOWN, PING, ADOPT, READOPT);
  *      ADOPT (before START, D41) names the state segment of the half this one replaces: at
  *      the next START, right after the start hook, its newest value goes to the adopt hook;
+ *      READOPT (while running, D61) names it again: at the next cycle boundary its newest
+ *      value goes to the re-adopt hook (arflex_component_readopt), before that cycle's update;
  *   5. on START: the RT thread (arflex_task: SCHED_FIFO at config.priority when permitted,
  *      affinity config.cpu_mask, mlockall, cpu_dma_latency) calls start, then every period:
  *      picks up new input bindings and parameter requests (cycle boundary), checks the
@@ -178,6 +180,21 @@ typedef int (*arflex_adopt_prepare_fn)(struct arflex_component *c, void *user,
  * component's initializer of it stay as they are). Returns 0 or -EINVAL.
  */
 ARFLEX_API int arflex_component_adopt_prepare(struct arflex_component *c, arflex_adopt_prepare_fn fn);
+/** The hook type of arflex_component_readopt (the adopt hook's). */
+typedef int (*arflex_readopt_fn)(struct arflex_component *c, void *user,
+				 const struct arflex_adopted_state *s);
+/**
+ * D61: registers @fn (NULL: none), called on the RT THREAD at a cycle boundary, before that
+ * cycle's update, when the manager sends READOPT to the RUNNING half: the newest value the
+ * half this one replaces has published then, to take over again (the switch of an update whose
+ * new half ran in shadow, its outputs not applied, since its START). As the adopt hook: convert
+ * or refuse what is not understood; must not block, allocate or print; @s is valid in the hook
+ * only. A negative return is the READOPT's reply (the manager then keeps the old half and stops
+ * this one: fail closed); the hook must leave the half's state as it was when it refuses. A
+ * half without the hook refuses READOPT (-EOPNOTSUPP). For a component whose adopt hook may
+ * run between two updates, the adopt hook itself. Configure only. Returns 0 or -EINVAL.
+ */
+ARFLEX_API int arflex_component_readopt(struct arflex_component *c, arflex_readopt_fn fn);
 /** True when the state segment is open (arflex_component_state returned 0). */
 ARFLEX_API bool arflex_component_state_open(const struct arflex_component *c);
 

@@ -147,6 +147,11 @@ ARFLEX_API int arflex_host_unbind(struct arflex_host *h, const char *port, uint6
  *  START ("" withdraws it). Refused while running (-EBUSY), by a half without an adopt hook
  *  (-EOPNOTSUPP), for a segment that does not open (-ENOENT, -EPROTO...). */
 ARFLEX_API int arflex_host_adopt(struct arflex_host *h, const char *shm_name, uint64_t timeout_ns);
+/** READOPT (D61): the RUNNING half takes the newest value of the state segment @shm_name at its
+ *  next cycle boundary (its re-adopt hook) and the reply says how that went: 0 taken, -ENOTCONN
+ *  not running, -EOPNOTSUPP no re-adopt hook, -ENODATA nothing published, -ETIMEDOUT not taken
+ *  within the apply deadline, the hook's own error, or the segment's open error. */
+ARFLEX_API int arflex_host_readopt(struct arflex_host *h, const char *shm_name, uint64_t timeout_ns);
 /** The instance's state segment (opts.state), or NULL. */
 ARFLEX_API struct arflex_port *arflex_host_state(struct arflex_host *h);
 

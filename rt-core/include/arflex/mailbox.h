@@ -57,6 +57,9 @@ enum arflex_cmd {
 	ARFLEX_CMD_PING = 11,     /**< no-op round trip (benchmarks, liveness) */
 	ARFLEX_CMD_ADOPT = 12,    /**< ABI 1.3: payload bind, shm_name = the state segment of the
 				   *  half this one replaces; adopted at the next START (D41) */
+	ARFLEX_CMD_READOPT = 13,  /**< D61: payload bind, shm_name = the state segment of the
+				   *  half this one replaces; a RUNNING half takes its newest value
+				   *  at its next cycle boundary (re-adopt hook); reply when taken */
 };
 
 /** msg.flags bits. */

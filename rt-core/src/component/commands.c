@@ -221,6 +221,9 @@ static bool serve(struct arflex_component *c, struct arflex_msg *m)
 	case ARFLEX_CMD_ADOPT:
 		st = c->running ? -EBUSY : arflex_comp_adopt_cmd(c, m);
 		break;
+	case ARFLEX_CMD_READOPT:
+		st = c->running ? arflex_comp_readopt_cmd(c, m) : -ENOTCONN; /* not started: ADOPT */
+		break;
 	default:
 		st = -ENOSYS;
 		break;

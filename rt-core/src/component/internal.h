@@ -50,6 +50,22 @@ struct arflex_state_block {
 	uint64_t age_ns;              /* RT: its age when it was adopted */
 };
 
+/* The re-adopt of a running half (D61): the mailbox thread maps the segment and posts it, the
+ * RT thread takes its newest value at its next cycle boundary, the mailbox thread replies and
+ * unmaps. phase: READOPT_IDLE -> POSTED (mailbox) -> TAKING -> DONE (RT) -> IDLE (mailbox); a
+ * post not taken by its deadline is withdrawn (POSTED -> IDLE, mailbox) so the RT thread never
+ * reads a mapping that is gone. */
+enum { READOPT_IDLE, READOPT_POSTED, READOPT_TAKING, READOPT_DONE };
+struct arflex_readopt {
+	arflex_readopt_fn fn;         /* configure */
+	struct arflex_port *src;      /* mailbox maps it; RT reads it while TAKING */
+	void *buf;                    /* one value of src (mailbox allocates) */
+	uint32_t phase;               /* atomic */
+	int result;                   /* RT -> mailbox: the hook's, or -ENODATA / a read error */
+	uint64_t seq;                 /* RT: the value's write count */
+	uint64_t age_ns;              /* RT: its age when it was taken */
+};
+
 struct arflex_component {
 	const struct arflex_component_ops *ops;
 	const char *name;
@@ -86,6 +102,7 @@ struct arflex_component {
 	unsigned ninputs;
 	struct arflex_stats stats_copy;
 	struct arflex_state_block state;
+	struct arflex_readopt readopt; /* D61 */
 	int fault_start_err;          /* test fault (D58): > 0 refuses every START with -it */
 };
 
@@ -124,6 +141,11 @@ int arflex_comp_adopt_cmd(struct arflex_component *c, const struct arflex_msg *m
 int arflex_comp_adopt_at_start(struct arflex_component *c);
 void arflex_comp_adopt_done(struct arflex_component *c);
 void arflex_comp_state_close(struct arflex_component *c);
+
+/* readopt.c (D61): READOPT (mailbox thread, while running: post, wait for the RT thread, reply,
+ * unmap) and its taking at a cycle boundary (RT thread: no blocking, allocation or printing). */
+int arflex_comp_readopt_cmd(struct arflex_component *c, const struct arflex_msg *m);
+void arflex_comp_readopt_take(struct arflex_component *c);
 
 /* supervisor.c (ABI.md 6.2, DECISIONS.md D10) */
 #define ARFLEX_ORPHAN_POLL_NS 10000000u /* mailbox wakes every 10 ms once the supervisor is lost */

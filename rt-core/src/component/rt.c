@@ -44,6 +44,7 @@ static void rt_boundary(struct arflex_component *c, uint64_t now)
 
 	STORE(&ctl->rt_hb_ns, now);
 	arflex_comp_take_bindings(c);
+	arflex_comp_readopt_take(c); /* D61: a state re-adopted, before this cycle's update */
 	if (arflex_ctl_param_apply_all(ctl, true))
 		for (unsigned i = 0; i < ctl->config.param_count; i++)
 			if (LOAD(&ctl->params[i].applied_seq) ==

@@ -451,6 +451,13 @@ int arflex_host_adopt(struct arflex_host *h, const char *shm_name, uint64_t time
 	return bind_call(h, ARFLEX_CMD_ADOPT, "", shm_name, timeout_ns);
 }
 
+int arflex_host_readopt(struct arflex_host *h, const char *shm_name, uint64_t timeout_ns)
+{
+	if (!shm_name || !shm_name[0])
+		return -EINVAL;
+	return bind_call(h, ARFLEX_CMD_READOPT, "", shm_name, timeout_ns);
+}
+
 struct arflex_port *arflex_host_state(struct arflex_host *h)
 {
 	return h->has_state ? &h->state : NULL;

@@ -166,7 +166,7 @@ const char *arflex_cmd_name(unsigned cmd)
 {
 	static const char *const n[] = { "?", "START", "STOP", "SET_PARAM", "GET_PARAM", "BIND",
 					 "UNBIND", "GET_STATE", "GET_STATS", "RESET", "SHUTDOWN",
-					 "PING", "ADOPT" };
+					 "PING", "ADOPT", "READOPT" };
 
 	return cmd < sizeof(n) / sizeof(n[0]) ? n[cmd] : "?";
 }

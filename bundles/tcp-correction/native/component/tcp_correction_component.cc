@@ -152,6 +152,8 @@ bool PoseWellFormed(const arflex_pose& m) {
   return std::fabs(std::sqrt(n2) - 1.0) < 1e-3;
 }
 
+int Adopt(arflex_component*, void*, const arflex_adopted_state* a);
+
 int Configure(arflex_component* c, void*) {
   int r = arflex_component_input(c, "reference", ARFLEX_PORT_STATE, &kRefType, &g.reference);
   if (r == 0) r = arflex_component_input(c, "tcp_pose", ARFLEX_PORT_STATE, &kPoseType, &g.pose);
@@ -175,6 +177,9 @@ int Configure(arflex_component* c, void*) {
     g.state_v1 = r == 0;
   }
   if (r < 0 && r != -ENOENT) return r;
+  // D61: Adopt runs between two updates as well (the law, the fade, the last reference and
+  // output): at the switch of an update whose new half ran in shadow it takes the old state again
+  if ((r = arflex_component_readopt(c, Adopt)) < 0) return r;
   g.p_gain = arflex_component_param(c, "gain");
   g.p_step = arflex_component_param(c, "max_step");
   g.p_rate = arflex_component_param(c, "max_rate");

@@ -47,14 +47,28 @@ final class FaultyVersions {
      * takes its BINDs and ADOPT, and refuses every START with {@code -errno} (D58).
      */
     static byte[] refusingStart(Path dir, Path bundle, String exeEntry, int errno, String who) throws IOException {
+        return withFault(dir, bundle, exeEntry, "ARFLEX_FAULT_START_ERRNO", errno, who, "refusing every START");
+    }
+
+    /**
+     * As {@link #refusingStart}, with rt-core's test fault {@code ARFLEX_FAULT_READOPT_ERRNO=<errno>}
+     * (D61): the half runs, and refuses every READOPT with {@code -errno}, as a half whose re-adopt
+     * hook cannot take the running half's state would.
+     */
+    static byte[] refusingReadopt(Path dir, Path bundle, String exeEntry, int errno, String who) throws IOException {
+        return withFault(dir, bundle, exeEntry, "ARFLEX_FAULT_READOPT_ERRNO", errno, who, "refusing every READOPT");
+    }
+
+    private static byte[] withFault(Path dir, Path bundle, String exeEntry, String fault, int errno, String who,
+                                    String what) throws IOException {
         String file = exeEntry.substring(exeEntry.lastIndexOf('/') + 1);
         Path real = dir.resolve(file);
         Files.write(real, UpdateSetIT.entry(bundle, exeEntry));
         Files.setPosixFilePermissions(real, PosixFilePermissions.fromString("r-x------"));
         String script = "#!/bin/sh\n"
-                + "# " + who + "'s deliberately faulty " + file + ": the real one, refusing every START\n"
-                + "ARFLEX_FAULT_START_ERRNO=" + errno + "\n"
-                + "export ARFLEX_FAULT_START_ERRNO\n"
+                + "# " + who + "'s deliberately faulty " + file + ": the real one, " + what + "\n"
+                + fault + "=" + errno + "\n"
+                + "export " + fault + "\n"
                 + "exec " + real + " \"$@\"\n";
         return script.getBytes(StandardCharsets.UTF_8);
     }

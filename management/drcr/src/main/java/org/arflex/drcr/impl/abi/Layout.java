@@ -213,6 +213,7 @@ public final class Layout {
     public static final int CMD_SHUTDOWN = 10;
     public static final int CMD_PING = 11;
     public static final int CMD_ADOPT = 12;
+    public static final int CMD_READOPT = 13;
 
     // struct arflex_msg
     public static final int SIZEOF_MSG = 512;

@@ -62,7 +62,8 @@ public final class Mailbox implements AutoCloseable {
         START(Layout.CMD_START), STOP(Layout.CMD_STOP), SET_PARAM(Layout.CMD_SET_PARAM),
         GET_PARAM(Layout.CMD_GET_PARAM), BIND(Layout.CMD_BIND), UNBIND(Layout.CMD_UNBIND),
         GET_STATE(Layout.CMD_GET_STATE), GET_STATS(Layout.CMD_GET_STATS), RESET(Layout.CMD_RESET),
-        SHUTDOWN(Layout.CMD_SHUTDOWN), PING(Layout.CMD_PING), ADOPT(Layout.CMD_ADOPT);
+        SHUTDOWN(Layout.CMD_SHUTDOWN), PING(Layout.CMD_PING), ADOPT(Layout.CMD_ADOPT),
+        READOPT(Layout.CMD_READOPT);
 
         public final int code;
 
@@ -159,6 +160,14 @@ public final class Mailbox implements AutoCloseable {
      */
     public Reply adopt(String shmName, long timeoutMs) throws IOException {
         return call(Cmd.ADOPT, bindPayload("", shmName), timeoutMs);
+    }
+
+    /**
+     * READOPT (D61): the running half takes the newest value of the state segment {@code shmName}
+     * at its next cycle boundary; the reply comes once it did, or says why it did not.
+     */
+    public Reply readopt(String shmName, long timeoutMs) throws IOException {
+        return call(Cmd.READOPT, bindPayload("", shmName), timeoutMs);
     }
 
     /** UNBIND of input {@code port}. */

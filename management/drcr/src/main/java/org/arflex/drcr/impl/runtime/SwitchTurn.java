@@ -100,6 +100,12 @@ final class SwitchTurn {
                 inst.life.to(State.UNSATISFIED, "change set: switching");
             }
             if (run.shadows.containsKey(inst)) { // bound and started by its shadow run (D42)
+                String refused = ShadowSwitch.readopt(olds.get(inst.name), inst, half, log); // D61
+                if (refused != null) { // fail closed: the old half keeps the component (D55)
+                    stops.submit(List.of(new Stops.Going(inst, half, List.of(), 0, "its state re-adopt was refused")));
+                    handBack(inst, olds.get(inst.name), run.oldHalves.get(inst.name), refused);
+                    continue;
+                }
                 starter.adopt(inst, Objects.requireNonNull(half), plan.cpuAssignment().getOrDefault(inst.name, -1),
                         "bound and started by its shadow run");
             } else if (run.nexts.get(inst.name) == inst) {
@@ -107,7 +113,8 @@ final class SwitchTurn {
                 // still running and read by its consumers until step 2, keeps the component (D55)
                 starter.activate(inst, Objects.requireNonNull(half), plan.cpuAssignment().getOrDefault(inst.name, -1),
                         inst.params.clone(), plan.wiringOf(inst.name), run.t0, ts,
-                        e -> handBack(inst, olds.get(inst.name), run.oldHalves.get(inst.name), e));
+                        e -> handBack(inst, olds.get(inst.name), run.oldHalves.get(inst.name),
+                                "its START was refused (" + e.getMessage() + ")"));
             } else {
                 starter.activate(inst, Objects.requireNonNull(half), plan.cpuAssignment().getOrDefault(inst.name, -1),
                         inst.params.clone(), plan.wiringOf(inst.name), run.t0, ts);
@@ -198,15 +205,16 @@ final class SwitchTurn {
     }
 
     /**
-     * An update's new half was refused at its START in the switch turn (D55): the old half is the
+     * An update's new half was refused at its START in the switch turn (D55), or its shadow half
+     * could not take the running half's state again there (D61): the old half is the
      * component's again before any consumer follows, the planner takes the old contract back, the
      * new instance goes once its half has stopped (the refusal stopped it). Its window then
      * reports the rollback ({@link UpdateWindow#begin}).
      */
-    private void handBack(Instance next, Instance old, RtHalf oldHalf, Exception e) {
+    private void handBack(Instance next, Instance old, RtHalf oldHalf, String why) {
         next.bound.clear();
         next.life.target(State.DESTROYED);
-        next.destroyReason = "its START was refused (" + e.getMessage() + ")";
+        next.destroyReason = why;
         cell.swap(next, old);
         old.half = oldHalf;
         try {
@@ -214,8 +222,8 @@ final class SwitchTurn {
         } catch (RuntimeException ex) {
             log.accept("arflex: " + next.name + ": the planner refused the old contract back: " + ex.getMessage());
         }
-        log.accept("arflex: " + next.name + ": the new version's START was refused at the switch (" + e.getMessage()
-                + "); pid " + oldHalf.pid() + " keeps running it");
+        log.accept("arflex: " + next.name + ": the new version was refused at the switch (" + why + "); pid "
+                + oldHalf.pid() + " keeps running it");
     }
 
     /** Null when {@code now} does what {@code shown} said, else what differs. */

@@ -218,6 +218,20 @@ public final class ProcessLauncher implements RtLauncher {
         };
     }
 
+    /** What a READOPT's refusal means (D61). */
+    static String readoptRefusal(int e) {
+        return switch (e) {
+            case 95 -> " (EOPNOTSUPP: its executable has no re-adopt hook, arflex_component_readopt)";
+            case 107 -> " (ENOTCONN: it is not running)";
+            case 61 -> " (ENODATA: the old half has published no state)";
+            case 110 -> " (ETIMEDOUT: its RT thread did not reach a cycle boundary in time)";
+            case 91 -> " (EPROTOTYPE: a state block it cannot take)";
+            case 22 -> " (EINVAL: a state it does not accept; the new half's log says what)";
+            case 2 -> " (ENOENT: the old half's state segment is gone)";
+            default -> adoptRefusal(e);
+        };
+    }
+
     static String errnoName(int e) {
         return switch (e) {
             case 1 -> "EPERM: not mutable while running";

@@ -144,6 +144,16 @@ final class ProcessRtHalf implements RtHalf {
     }
 
     @Override
+    public void readopt(String stateSegment) throws IOException {
+        // the half answers once its RT thread took it (within a second and two periods)
+        Mailbox.Reply r = mb.readopt(stateSegment, ProcessLauncher.CALL_TIMEOUT_MS);
+        if (r.status() != 0) {
+            throw new IOException("READOPT of " + stateSegment + " refused by " + inst + ": status " + r.status()
+                    + ProcessLauncher.readoptRefusal(-r.status()));
+        }
+    }
+
+    @Override
     public CompletableFuture<Void> rebind(String port, String segment, long waitMs) {
         return confirmer.rebind(mb, inst, port, segment, waitMs, ProcessLauncher.CALL_TIMEOUT_MS);
     }

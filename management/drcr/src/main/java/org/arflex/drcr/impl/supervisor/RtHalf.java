@@ -32,6 +32,15 @@ public interface RtHalf {
     }
 
     /**
+     * READOPT (D61): a running half takes the newest value of the state segment of the half it
+     * replaces again, at its next cycle boundary; returns once it did. Refused (with the reason)
+     * by a half that cannot take it while it runs.
+     */
+    default void readopt(String stateSegment) throws IOException {
+        throw new IOException("this RT half cannot re-adopt a state block while it runs");
+    }
+
+    /**
      * BIND ({@code segment} not null) or UNBIND of input {@code port} of a running half, waiting
      * at most {@code waitMs} for its answer (D39: the actor does not wait on a process). The
      * stage completes when the half has answered; exceptionally when it refused, did not answer

@@ -64,7 +64,7 @@ final class LayoutGenerator {
             mailbox.h
             const MSG_MAGIC MSG_SIZE MQ_MAXMSG MSG_PAYLOAD MSG_REPLY
             const CMD_START CMD_STOP CMD_SET_PARAM CMD_GET_PARAM CMD_BIND CMD_UNBIND CMD_GET_STATE CMD_GET_STATS
-            const CMD_RESET CMD_SHUTDOWN CMD_PING CMD_ADOPT
+            const CMD_RESET CMD_SHUTDOWN CMD_PING CMD_ADOPT CMD_READOPT
             struct msg magic abi_major abi_minor seq cmd flags status payload_len token u
             struct msg_param index type value applied_seq name
             struct msg_bind port shm_name

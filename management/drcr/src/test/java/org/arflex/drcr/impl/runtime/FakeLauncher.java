@@ -26,6 +26,8 @@ final class FakeLauncher implements RtLauncher {
     final Map<String, byte[]> values = new java.util.concurrent.ConcurrentHashMap<>();
     /** Instance id -> why its ADOPT is refused (tests set it). */
     final Map<String, String> refuseAdopt = new java.util.concurrent.ConcurrentHashMap<>();
+    /** Instance id -> why its READOPT is refused (D61; tests set it). */
+    final Map<String, String> refuseReadopt = new java.util.concurrent.ConcurrentHashMap<>();
     /** Instances whose START is refused (the half died before it, say); tests set it. */
     final Set<String> refuseStart = java.util.concurrent.ConcurrentHashMap.newKeySet();
     /** Instances whose next launches fail. */
@@ -83,6 +85,15 @@ final class FakeLauncher implements RtLauncher {
         public void adopt(String stateSegment) throws IOException {
             String why = refuseAdopt.get(inst);
             events.add(inst + " ADOPT " + stateSegment + (why != null ? " (refused)" : ""));
+            if (why != null) {
+                throw new IOException(why);
+            }
+        }
+
+        @Override
+        public void readopt(String stateSegment) throws IOException {
+            String why = refuseReadopt.get(inst);
+            events.add(inst + " READOPT " + stateSegment + (why != null ? " (refused)" : ""));
             if (why != null) {
                 throw new IOException(why);
             }
