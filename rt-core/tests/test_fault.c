@@ -223,6 +223,52 @@ static void env_var_refuses_start(void **state)
 	}
 }
 
+static char env_crash[64];
+
+/* The test fault of a crash counted in cycles (D68): ARFLEX_FAULT_CRASH_AFTER_CYCLES=<n> in the
+ * half's environment raises SIGSEGV in its n-th update after the START, not before: READY, and
+ * a wait of 50 periods before the START, leave it running. What the update tests' "crashes after
+ * 50 cycles" versions set (tests/.../FaultyVersions.crashingAfterCycles). */
+static void env_var_crashes_after_cycles(void **state)
+{
+	struct arflex_host_output out;
+	struct arflex_param_slot p;
+	struct arflex_host_opts o;
+	struct arflex_host h;
+	int k = 0, before, start, exited, status;
+	uint64_t cycles;
+
+	(void)state;
+	th_rid(rid, sizeof(rid), "fcrash");
+	fill_opts(&o, &p, &out, "probe");
+	out.spec.type.elem_size = PROBE_OUT_BYTES;
+	for (char **e = environ; *e && k < 250; e++)
+		if (strncmp(*e, "ARFLEX_", 7))
+			envp[k++] = *e;
+	snprintf(env_crash, sizeof(env_crash), "ARFLEX_FAULT_CRASH_AFTER_CYCLES=%d", 20);
+	envp[k++] = env_crash;
+	envp[k] = NULL;
+	assert_int_equal(arflex_host_create(&h, &o), 0);
+	assert_int_equal(arflex_host_spawn(&h, ARFLEX_PROBE_EXE, NULL, envp), 0);
+	assert_int_equal(arflex_host_wait_state(&h, ARFLEX_STATE_READY, 10 * SEC), 0);
+	before = arflex_host_wait_exit(&h, 50 * (SEC / 1000)); /* not started: no update, no crash */
+	start = arflex_host_start(&h, 2 * SEC);
+	exited = arflex_host_wait_exit(&h, 10 * SEC);
+	if (exited != 0)
+		arflex_host_kill(&h, SIGKILL), arflex_host_wait_exit(&h, 10 * SEC);
+	status = arflex_host_exit_status(&h);
+	cycles = h.ctl->stats.cycles;
+	arflex_host_destroy(&h);
+	th_assert_clean(rid);
+	assert_int_equal(before, -ETIMEDOUT);
+	assert_int_equal(start, 0);
+	assert_int_equal(exited, 0);
+	assert_true(WIFSIGNALED(status));
+	assert_int_equal(WTERMSIG(status), SIGSEGV);
+	/* killed inside its 20th update: 19 cycles completed */
+	assert_int_equal(cycles, 19);
+}
+
 static void env_var_enables_injection(void **state)
 {
 	(void)state;
@@ -255,6 +301,7 @@ int main(void)
 		cmocka_unit_test(host_create_every_call_fails),
 		cmocka_unit_test(component_attach_every_call_fails),
 		cmocka_unit_test(env_var_refuses_start),
+		cmocka_unit_test(env_var_crashes_after_cycles),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);

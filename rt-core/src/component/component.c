@@ -171,6 +171,29 @@ static void fault_start_env(struct arflex_component *c)
 	fprintf(stderr, "arflex: %s: test fault: every START is refused with errno %ld\n", c->name, n);
 }
 
+/* The test fault of a crash counted in cycles (D68): ARFLEX_FAULT_CRASH_AFTER_CYCLES=<n>,
+ * 1..10^9, makes the RT thread raise SIGSEGV in its n-th update after each START, whatever the
+ * time its spawn, READY and START took (a crash "a fixed time after the spawn" fell before the
+ * START or the switch on a loaded machine). Only the update tests' deliberately faulty versions
+ * set it; nothing shipped does. */
+static void fault_crash_env(struct arflex_component *c)
+{
+	const char *s = getenv("ARFLEX_FAULT_CRASH_AFTER_CYCLES");
+	char *end;
+	long long n;
+
+	if (!s || !*s)
+		return;
+	n = strtoll(s, &end, 10);
+	if (*end || n < 1 || n > 1000000000LL) {
+		fprintf(stderr, "arflex: %s: ARFLEX_FAULT_CRASH_AFTER_CYCLES=%s ignored (a count 1..10^9)\n",
+			c->name, s);
+		return;
+	}
+	c->fault_crash_after = (uint64_t)n;
+	fprintf(stderr, "arflex: %s: test fault: SIGSEGV in update %lld after each START\n", c->name, n);
+}
+
 int arflex_component_main(int argc, char **argv, const struct arflex_component_ops *ops)
 {
 	static struct arflex_component comp;
@@ -192,6 +215,7 @@ int arflex_component_main(int argc, char **argv, const struct arflex_component_o
 	if (r)
 		return r > 0 ? ARFLEX_EXIT_OK : ARFLEX_EXIT_USAGE;
 	fault_start_env(c);
+	fault_crash_env(c);
 
 	memset(&sa, 0, sizeof(sa));
 	sa.sa_handler = on_signal;

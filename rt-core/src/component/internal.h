@@ -104,6 +104,8 @@ struct arflex_component {
 	struct arflex_state_block state;
 	struct arflex_readopt readopt; /* D61 */
 	int fault_start_err;          /* test fault (D58): > 0 refuses every START with -it */
+	uint64_t fault_crash_after;   /* test fault (D68): > 0 raises SIGSEGV in that update after a START */
+	uint64_t fault_updates;       /* RT thread: updates run since the last START (for the fault above) */
 };
 
 /* One log line on stderr, one write (component.c). */

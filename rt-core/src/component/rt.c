@@ -4,6 +4,7 @@
  * hook while safe mode is active. Never blocks, allocates or prints. */
 #include "arflex/component.h"
 
+#include <signal.h>
 #include <string.h>
 
 #include "internal.h"
@@ -111,6 +112,8 @@ int arflex_comp_rt_cycle(void *arg, uint64_t release_ns)
 		STORE(&ctl->stats.seq, seq + 2);
 	} else {
 		r = c->ops->update(c, c->ops->user, release_ns);
+		if (c->fault_crash_after && ++c->fault_updates >= c->fault_crash_after)
+			raise(SIGSEGV); /* the test fault (D68): async-signal-safe, no allocation */
 	}
 	return r < 0 ? r : 0;
 }
@@ -121,6 +124,7 @@ int arflex_comp_rt_start(void *arg)
 	int r;
 
 	c->safe = false;
+	c->fault_updates = 0;
 	c->clk_binding = 0; /* the first poll takes the clock's binding as new */
 	c->clk_seen = 0;
 	memset(&c->hbw, 0, sizeof(c->hbw));

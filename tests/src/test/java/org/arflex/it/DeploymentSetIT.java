@@ -281,8 +281,8 @@ class DeploymentSetIT {
 
                 // D50: rejected in its shadow run (D42): the faulty version crashes while it shadows the
                 // running one; nothing was switched, and the gripper's bundle installed for the set goes again
-                Path faulty = UpdateSetIT.version(dir, "1.0.2-faulty", FaultyVersions.crashingAfterMs(dir,
-                        CellRig.TCP_CORRECTION, UpdateSetIT.EXE, 500, "DeploymentSetIT"));
+                Path faulty = UpdateSetIT.version(dir, "1.0.2-faulty", FaultyVersions.crashingAfterCycles(dir,
+                        CellRig.TCP_CORRECTION, UpdateSetIT.EXE, 50, "DeploymentSetIT"));
                 Path shadowed = Files.writeString(dir.resolve("shadowed.xml"), "<deployment xmlns=\"urn:arflex:deployment:1\">\n"
                         + "  <install jar=\"tool-gripper.jar\" sha256=\"" + gripperPin + "\"/>\n"
                         + "  <update component=\"tcp-correction\" jar=\"" + faulty.getFileName() + "\" sha256=\""
@@ -369,7 +369,7 @@ class DeploymentSetIT {
 
     /**
      * D50: a set whose update is rolled back after its switch (the faulty 1.0.2, killed by SIGSEGV
-     * 1.5 s after its spawn, window 5000 cycles) is taken back whole: the gripper it installed
+     * in its 500th update after its START, the switch's; window 5000 cycles) is taken back whole: the gripper it installed
      * is uninstalled from the cell and from Felix, the guard's limit it wrote is written back, and
      * the arm runs as before, tcp-correction 1.0.0 with the pid it had.
      */
@@ -380,9 +380,9 @@ class DeploymentSetIT {
         try (Runtime rt = new Runtime("deploy-rollback")) {
             FailSafeIT.movingCell(rt);
             Path dir = folder(rt);
-            // killed 1.5 s after its spawn: after the switch even on a loaded machine, within the window
-            Path faulty = UpdateSetIT.version(dir, "1.0.2-faulty", FaultyVersions.crashingAfterMs(dir, CellRig.TCP_CORRECTION,
-                    UpdateSetIT.EXE, 1500, "DeploymentSetIT"));
+            // killed in its 500th update after the switch (D68), within the window
+            Path faulty = UpdateSetIT.version(dir, "1.0.2-faulty", FaultyVersions.crashingAfterCycles(dir, CellRig.TCP_CORRECTION,
+                    UpdateSetIT.EXE, 500, "DeploymentSetIT"));
             Path gripper = signed(rt, dir.resolve("tool-gripper.jar"), "tool-gripper-signed", "DeploymentSetIT integrator", true);
             String limit = rt.cmd("arflex:get force-guard force_limit_n").strip();
             Path set = Files.writeString(dir.resolve("rolled-back.xml"), "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"

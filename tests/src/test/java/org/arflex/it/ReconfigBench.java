@@ -26,7 +26,7 @@ import org.junit.jupiter.api.Test;
  * <li>tcp-correction updated to 1.0.1 (UpdateSetIT's copy of the built bundle under a new
  * contract version, pinned; window 1000 cycles);</li>
  * <li>tcp-correction updated back to 1.0.0 (the built bundle, pinned);</li>
- * <li>UpdateSetIT's 1.0.2-faulty (SIGSEGV 250 ms after its spawn, window 5000): rolled back.</li>
+ * <li>UpdateSetIT's 1.0.2-faulty (SIGSEGV in its 50th update after the switch, D68; window 5000): rolled back.</li>
  * </ol>
  * Per set, against a quiet window of {@link #QUIET_MS} of robot cycles just before it with no
  * change: the preparation time and the switch's actor turn (the command's own report), the

@@ -24,8 +24,9 @@ import org.junit.jupiter.api.Test;
  * and is compared with the running version before anything is switched. Versions are made here
  * from the built bundles and pinned, as in UpdateSetIT:
  * <ul>
- * <li>tcp-correction 1.0.2-faulty (a script that runs the real executable and sends it SIGSEGV
- * 150 ms after its spawn, some 30-125 cycles after its START: spawn to READY took 10-51 ms, the BINDs and START 15-71 ms): rejected in shadow (200 cycles);
+ * <li>tcp-correction 1.0.2-faulty (a script that runs the real executable with rt-core's test
+ * fault of a SIGSEGV in its 50th update after its START, D68; a crash 150 ms after its spawn
+ * fell before its START on a loaded machine): rejected in shadow (200 cycles);
  * sim-robot never rebound, no safe cycle, the guard NORMAL, no reset, every pid unchanged;</li>
  * <li>sample-scaler 1.0.1-gain (its contract's gain 2.5 where the running version's is 2.0, in
  * the same runtime beside the moving arm): its output differs from the running version's by
@@ -136,7 +137,7 @@ class ShadowRunIT {
         try (Runtime rt = new Runtime("shadow-crash")) {
             FailSafeIT.movingCell(rt);
             Path dir = Files.createDirectories(rt.dir.resolve("versions"));
-            byte[] script = FaultyVersions.crashingAfterMs(dir, CellRig.TCP_CORRECTION, UpdateSetIT.EXE, 150, "ShadowRunIT");
+            byte[] script = FaultyVersions.crashingAfterCycles(dir, CellRig.TCP_CORRECTION, UpdateSetIT.EXE, 50, "ShadowRunIT");
             Path jar = version(dir, CellRig.TCP_CORRECTION, "tcp-correction-1.0.2-faulty", UpdateSetIT.CONTRACT,
                     versioned("tcp-correction", "1.0.2-faulty"), UpdateSetIT.EXE, script);
             long oldPid = rt.pid("tcp-correction");

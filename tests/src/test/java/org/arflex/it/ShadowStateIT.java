@@ -88,7 +88,10 @@ class ShadowStateIT {
             // 2. tcp-correction updated in the middle of that fade, with a tight shadow run
             Path jar = UpdateSetIT.version(dir, "1.0.1", null);
             int logMark = rt.logMark();
-            UpdateSetIT.Run r = UpdateSetIT.update(rt, jar, "shadow 500 tolerance corrected.q " + TOLERANCE + " window 300");
+            // 200 references of baseline, not 2000: the shadow run must pass inside the fade (a run
+            // under load passed 10.7 s after the fade began with UpdateSetIT's 3 s before the apply)
+            UpdateSetIT.Run r = UpdateSetIT.update(rt, jar, "shadow 500 tolerance corrected.q " + TOLERANCE + " window 300",
+                    null, 200);
             List<String> log = rt.logSince(logMark);
             Matcher m = Pattern.compile("update tcp-correction: passed its shadow run of (\\d+) cycles \\((\\d+) overruns "
                     + "or deadline misses, the running version (\\d+); (\\d+) values compared, corrected.q at most (\\S+) "

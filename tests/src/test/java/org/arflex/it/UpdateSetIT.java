@@ -29,9 +29,9 @@ import org.junit.jupiter.api.Test;
  *
  * <p>Two versions, both built here from the tcp-correction bundle the build made: 1.0.1, the
  * same executable under a new contract version (committed after its window), and 1.0.2-faulty,
- * whose executable is a script that runs the real one and kills it with SIGSEGV 250 ms after its
- * spawn (a deliberately broken build, pinned like any other): it crashes some 200 cycles after
- * the switch and is rolled back to the old half. And 1.0.1 again with an envelope declared for
+ * whose executable is a script that runs the real one with rt-core's test fault of a crash in its
+ * 50th update after its START (D68; a deliberately broken build, pinned like any other): it
+ * crashes 50 cycles after the switch and is rolled back to the old half. And 1.0.1 again with an envelope declared for
  * its output that the moving arm's reference leaves: rolled back.
  *
  * <p>Asserted for every case: the guard never leaves NORMAL and sim-robot runs no safe cycle from
@@ -67,10 +67,11 @@ class UpdateSetIT {
 
     /**
      * The deliberately faulty build 1.0.2-faulty (also ReconfigBench's): the real executable, run by a
-     * script that kills it by SIGSEGV 250 ms after its spawn (some 200 cycles after the switch).
+     * script that sets rt-core's test fault: SIGSEGV in its 50th update after its START (D68), which
+     * is the switch's when it has no shadow run.
      */
     static Path faulty(Path dir, String who) throws IOException {
-        return version(dir, "1.0.2-faulty", FaultyVersions.crashingAfterMs(dir, CellRig.TCP_CORRECTION, EXE, 250, who));
+        return version(dir, "1.0.2-faulty", FaultyVersions.crashingAfterCycles(dir, CellRig.TCP_CORRECTION, EXE, 50, who));
     }
 
     static byte[] entry(Path jar, String name) throws IOException {
@@ -108,6 +109,16 @@ class UpdateSetIT {
      */
     static Run update(Runtime rt, Path jar, String options,
             java.util.function.BiConsumer<List<CellRig.Ref>, List<CellRig.Ref>> traces) throws Exception {
+        return update(rt, jar, options, traces, 2000);
+    }
+
+    /**
+     * As above, with {@code quietRefs} references recorded without a change before the apply (the
+     * baseline of the releases not run; 2000 above), after 1000 seen, or fewer when {@code quietRefs}
+     * is small: ShadowStateIT must apply within its fade (10 s).
+     */
+    static Run update(Runtime rt, Path jar, String options,
+            java.util.function.BiConsumer<List<CellRig.Ref>, List<CellRig.Ref>> traces, int quietRefs) throws Exception {
         long robotPid = rt.pid("sim-robot");
         long guardPid = rt.pid("force-guard");
         long oldPid = rt.pid("tcp-correction");
@@ -125,13 +136,15 @@ class UpdateSetIT {
             rec.add(jp, CellRig.JointState::of, CellRig.JointState::seq, js::add);
             rec.add(sp, CellRig.Safety::of, CellRig.Safety::seq, safety::add);
             rec.start();
-            rt.waitUntil("the arm moving and 1000 references seen", T, () -> FailSafeIT.moving(js) && oldRef.size() > 1000);
+            int seen = Math.min(1000, 100 + quietRefs);
+            rt.waitUntil("the arm moving and " + seen + " references seen", T,
+                    () -> FailSafeIT.moving(js) && oldRef.size() > seen);
             assertTrue(CellRig.awaitingReset(rt).isEmpty(), "before: " + CellRig.awaitingReset(rt));
             // the same span without a change: what this machine gives sim-robot anyway
             Map<String, Object> quiet0 = ChangeSetIT.stats(rt, "sim-robot");
             int q = oldRef.size();
             int jsQuiet = js.size();
-            rt.waitUntil("2000 references without a change", T, () -> oldRef.size() > q + 2000);
+            rt.waitUntil(quietRefs + " references without a change", T, () -> oldRef.size() > q + quietRefs);
             Map<String, Object> robot0 = ChangeSetIT.stats(rt, "sim-robot");
             long quietOverruns = ChangeSetIT.delta(quiet0, robot0, "overruns");
             System.out.printf(Locale.ROOT, "UpdateSetIT: sim-robot over 2000 references before the apply, no change: "
