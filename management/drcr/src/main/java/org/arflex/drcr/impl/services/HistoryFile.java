@@ -61,7 +61,7 @@ final class HistoryFile {
      * @param uid the runtime's effective uid: the only owner a history file may have
      */
     HistoryFile(Path folder, long uid, Consumer<String> log) {
-        this.file = folder.resolve(NAME);
+        this.file = folder.toAbsolutePath().normalize().resolve(NAME); // the log names it whole
         this.uid = uid;
         this.log = log;
     }
