@@ -44,8 +44,8 @@ public interface ChangeSetService {
 
     /**
      * The outcomes of the sets applied in this runtime (refused ones included; dry runs not),
-     * newest first, at most 50, each with {@link ChangeSetDTO#finishedMillis}; in memory only
-     * (D46).
+     * newest first, at most 50, each with {@link ChangeSetDTO#finishedMillis} (D46); kept in the
+     * DRCR's data area across restarts of the DRCR and of the runtime (D66).
      */
     List<ChangeSetDTO> history();
 

@@ -75,6 +75,7 @@ public final class Activator implements BundleActivator {
     private org.arflex.drcr.impl.services.ManagementRegistrations registrations;
     private Cell cell;
     private Services services;
+    private org.arflex.drcr.impl.services.HistoryStore history;
     private ScheduledExecutorService ticker;
     private HeartbeatBridge bridge;
     private CellWatch watch;
@@ -194,7 +195,11 @@ public final class Activator implements BundleActivator {
         regs.add(ctx.registerService(DrcrService.class, services, null));
         regs.add(ctx.registerService(UpdateService.class, services, null));
         regs.add(ctx.registerService(ResourceManager.class, rm[0], null));
-        org.arflex.drcr.impl.services.ChangeSets changeSets = new org.arflex.drcr.impl.services.ChangeSets(cell, ctx, log);
+        // the change-set history, kept in the data area across restarts (D66)
+        history = org.arflex.drcr.impl.services.HistoryStore.open(java.util.Objects.requireNonNull(ctx.getDataFile(""),
+                "the framework has no data area for bundles").toPath(), Posix.LIBC.geteuid(), log);
+        org.arflex.drcr.impl.services.ChangeSets changeSets = new org.arflex.drcr.impl.services.ChangeSets(cell, ctx, log,
+                history);
         regs.add(ctx.registerService(org.arflex.drcr.ChangeSetService.class, changeSets, null));
         // updates in change sets (D38): the new version's jar through the same gate as a deploy
         org.arflex.drcr.impl.services.UpdateJars updateJars = new org.arflex.drcr.impl.services.UpdateJars(installer, gate,
@@ -365,6 +370,9 @@ public final class Activator implements BundleActivator {
             }
         }
         regs.clear();
+        if (history != null) {
+            history.close(10_000); // the last set's record on disk before the DRCR is gone
+        }
         if (registrar != null) {
             // its last registrations made (off the actor: a listener may call into the cell);
             // from here on the actor makes them itself, until they are closed

@@ -39,6 +39,9 @@ public interface Posix extends Library {
 
     int shm_unlink(String name) throws LastErrorException;
 
+    /** The effective user id of this process (never fails). */
+    int geteuid();
+
     /** Sets the process's file mode creation mask; returns the previous one (never fails). */
     int umask(int mask);
 

@@ -13,7 +13,9 @@ import org.arflex.drcr.impl.runtime.ChangeSetProgress;
  * The outcomes of the change sets applied in this runtime, newest first, at most {@link #MAX}
  * (D46): what the console's Change sets page shows as its history, whether the set came from
  * the console or from {@code arflex:change apply}, each with its update entries as the live
- * progress last showed them (D62). In memory only; a restart of the DRCR starts an empty history.
+ * progress last showed them (D62). With a {@link HistoryStore} (D66) it starts with what the
+ * store kept and has the store write it after each record, so a restart of the DRCR or of the
+ * runtime keeps it; without one (tests) it is in memory only.
  */
 final class ChangeSetHistory {
     /** Outcomes kept; the oldest goes first. */
@@ -21,9 +23,23 @@ final class ChangeSetHistory {
 
     private final Deque<ChangeSetDTO> entries = new ArrayDeque<>();
     private final LongSupplier clock;
+    private final HistoryStore store;
 
     ChangeSetHistory(LongSupplier wallClockMillis) {
+        this(wallClockMillis, null);
+    }
+
+    /** @param store where it is kept across restarts (its records are the start), or null: memory only */
+    ChangeSetHistory(LongSupplier wallClockMillis, HistoryStore store) {
         this.clock = wallClockMillis;
+        this.store = store;
+        if (store != null) {
+            for (ChangeSetDTO d : store.kept()) {
+                if (entries.size() < MAX) {
+                    entries.addLast(copy(d));
+                }
+            }
+        }
     }
 
     /**
@@ -42,6 +58,9 @@ final class ChangeSetHistory {
         entries.addFirst(copy(d));
         while (entries.size() > MAX) {
             entries.removeLast();
+        }
+        if (store != null) {
+            store.save(list()); // written off this thread; the newest list wins
         }
         return d;
     }

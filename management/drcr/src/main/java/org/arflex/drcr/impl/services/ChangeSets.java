@@ -62,9 +62,15 @@ public final class ChangeSets implements ChangeSetService {
     private volatile UpdatedBundles bundles;
     private volatile DeploymentSets deployments;
     /** The outcomes of the sets applied, for {@link #history} (D46). */
-    private final ChangeSetHistory history = new ChangeSetHistory(System::currentTimeMillis);
+    private final ChangeSetHistory history;
 
     public ChangeSets(Cell cell, BundleContext context, Consumer<String> log) {
+        this(cell, context, log, null);
+    }
+
+    /** @param kept where the history is kept across restarts (D66), or null: in memory only */
+    public ChangeSets(Cell cell, BundleContext context, Consumer<String> log, HistoryStore kept) {
+        this.history = new ChangeSetHistory(System::currentTimeMillis, kept);
         this.cell = cell;
         this.build = new ChangeSetBuild(cell, context, log);
         this.felix = new SetBundles(cell, context, log);

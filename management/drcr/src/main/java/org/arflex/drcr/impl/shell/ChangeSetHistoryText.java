@@ -9,7 +9,7 @@ import org.arflex.drcr.dto.ChangeSetDTO;
 import org.arflex.drcr.dto.UpdateProgressDTO;
 
 /**
- * {@code arflex:change history} (D62): the change sets applied in this runtime, newest first,
+ * {@code arflex:change history} (D62): the change sets in the history (kept across restarts, D66), newest first,
  * each with when it finished, its outcome and why, a line per update (its shadow run's or
  * window's last cycles, its worst deviation, its verdict), and the preparation and switch times
  * of a set switched in.
@@ -25,8 +25,7 @@ final class ChangeSetHistoryText {
     /** The newest {@code max} of {@code history} (newest first, as the service lists it). */
     static String of(List<ChangeSetDTO> history, int max) {
         if (history.isEmpty()) {
-            return "no change set was applied in this runtime (the history is kept in memory: a restart of the DRCR"
-                    + " empties it)";
+            return "no change set in the history (the newest 50 are kept in the DRCR's data area, across restarts)";
         }
         int n = Math.min(max, history.size());
         StringBuilder sb = new StringBuilder(String.format(Locale.ROOT, "%d of the %d change sets applied in this "

@@ -211,7 +211,8 @@ public final class Commands {
      * [window <cycles>] [shadow <cycles>] [envelope ...] [tolerance ...]} (D38, D42), in any number, e.g.
      * {@code change apply install teach uninstall trajectory}. {@code change progress}: where the
      * set being applied is, or how the last one ended (D53). {@code change history [<count>]}: the
-     * sets applied in this runtime, newest first, each update's last counters and verdict (D62).
+     * sets in the history (kept in the DRCR's data area across restarts, D66), newest first, each
+     * update's last counters and verdict (D62).
      */
     public String change(String... args) {
         return guard(() -> {

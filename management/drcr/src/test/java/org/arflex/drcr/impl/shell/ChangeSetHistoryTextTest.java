@@ -114,7 +114,7 @@ class ChangeSetHistoryTextTest {
         assertEquals("error: change history: '0' is not a count of sets (1 to 999)", cmd.change("history", "0"));
         assertEquals("error: change history: 'all' is not a count of sets (1 to 999)", cmd.change("history", "all"));
         kept[0] = List.of();
-        assertEquals("no change set was applied in this runtime (the history is kept in memory: a restart of the "
-                + "DRCR empties it)", cmd.change("history"));
+        assertEquals("no change set in the history (the newest 50 are kept in the DRCR's data area, across restarts)",
+                cmd.change("history"));
     }
 }
