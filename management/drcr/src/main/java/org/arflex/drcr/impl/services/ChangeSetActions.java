@@ -104,4 +104,41 @@ final class ChangeSetActions {
         }
         return out;
     }
+
+    /**
+     * The actions as one text per action, in the words the shell takes ({@code update c file:/c.jar
+     * <sha256> window 1000 shadow 200 tolerance corrected.q 1e-6}), whether they came as Gogo's
+     * words or one string per action: what a set's progress and history record. Actions that do
+     * not parse are returned as given (their refusal names them).
+     */
+    static List<String> normalized(List<String> actions) {
+        List<String[]> parsed;
+        try {
+            parsed = parse(actions);
+        } catch (IllegalArgumentException e) {
+            return actions;
+        }
+        List<String> out = new ArrayList<>();
+        for (String[] p : parsed) {
+            if (!p[0].equals("update")) {
+                out.add(String.join(" ", p));
+                continue;
+            }
+            StringBuilder sb = new StringBuilder("update ").append(p[1]).append(' ').append(p[2]);
+            if (!p[3].isEmpty()) {
+                sb.append(' ').append(p[3]);
+            }
+            if (!p[4].isEmpty()) {
+                sb.append(" window ").append(p[4]);
+            }
+            if (!p[5].isEmpty()) {
+                sb.append(" shadow ").append(p[5]);
+            }
+            for (int k = 6; k < p.length; k++) {
+                sb.append(' ').append(p[k]);
+            }
+            out.add(sb.toString());
+        }
+        return out;
+    }
 }

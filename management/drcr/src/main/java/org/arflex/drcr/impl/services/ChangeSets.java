@@ -111,7 +111,8 @@ public final class ChangeSets implements ChangeSetService {
     }
 
     @Override
-    public ChangeSetDTO plan(List<String> actions) {
+    public ChangeSetDTO plan(List<String> given) {
+        List<String> actions = ChangeSetActions.normalized(given);
         List<String[]> parsed;
         try {
             parsed = ChangeSetActions.parse(actions);
@@ -131,7 +132,8 @@ public final class ChangeSets implements ChangeSetService {
 
     @Override
     public ChangeSetDTO apply(List<String> actions) {
-        return history.record(applies.apply(actions));
+        // recorded one text per action, whether the shell gave words or the console whole actions
+        return history.record(applies.apply(ChangeSetActions.normalized(actions)));
     }
 
     @Override

@@ -22,6 +22,23 @@ class ChangeSetsParseTest {
     }
 
     @Test
+    void theActionsAreRecordedOneTextPerActionWhicheverWayTheyCame() {
+        String sha = "ab".repeat(32);
+        List<String> want = List.of("install teach", "update tcp-correction file:/x.jar " + sha
+                + " window 300 shadow 500 tolerance corrected.q 1e-6 envelope error.value 0 5", "set teach mass 30",
+                "update c file:/c.jar");
+        assertEquals(want, ChangeSetActions.normalized(List.of("install", "teach", "update", "tcp-correction", "file:/x.jar",
+                sha, "shadow", "500", "window", "300", "tolerance", "corrected.q", "1e-6", "envelope", "error.value", "0",
+                "5", "set", "teach", "mass", "30", "update", "c", "file:/c.jar")));
+        assertEquals(want, ChangeSetActions.normalized(List.of("install teach", "update tcp-correction file:/x.jar " + sha
+                + " window 300 shadow 500 tolerance corrected.q 1e-6 envelope error.value 0 5", "set teach mass 30; update c file:/c.jar")));
+        // the normal form parses to the same steps
+        assertEquals(flat(want), flat(ChangeSetActions.normalized(want)));
+        // what does not parse is kept as given, for its refusal to name
+        assertEquals(List.of("frobnicate", "x"), ChangeSetActions.normalized(List.of("frobnicate", "x")));
+    }
+
+    @Test
     void anUpdateTakesItsJarThenAnOptionalPinAndWindow() {
         String sha = "ab".repeat(32);
         assertEquals(List.of("update tcp-correction file:/x.jar   ", "uninstall b"),
