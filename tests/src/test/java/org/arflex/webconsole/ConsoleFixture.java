@@ -41,6 +41,7 @@ final class ConsoleFixture implements BeforeAllCallback, AfterAllCallback {
     private ChromeDriver driver;
     private Path profile;
     private Path screenshots;
+    private double up;
 
     private ConsoleFixture(String name, boolean withBrowser) {
         this.name = name;
@@ -77,6 +78,7 @@ final class ConsoleFixture implements BeforeAllCallback, AfterAllCallback {
 
     @Override
     public void beforeAll(ExtensionContext context) throws Exception {
+        long t0 = System.nanoTime();
         Path work = Path.of(System.getProperty("arflex.it.work", "target/it")).toAbsolutePath().resolve(name);
         CompletableFuture<ChromeDriver> chrome = null;
         if (withBrowser) {
@@ -90,6 +92,7 @@ final class ConsoleFixture implements BeforeAllCallback, AfterAllCallback {
         try {
             rt = new RuntimeUnderTest(work);
             rt.awaitUp(Duration.ofSeconds(90));
+            up = seconds(t0);
             runtimeId = jsonString(cell(), "runtimeId");
             for (String c : started) {
                 Path jar = org.arflex.it.Components.jar(c);
@@ -122,6 +125,12 @@ final class ConsoleFixture implements BeforeAllCallback, AfterAllCallback {
         if (loggedIn) {
             pages.login();
         }
+        // what a class of its own costs (D67): the runtime up, then with its components and browser
+        System.out.printf("ConsoleFixture %s: runtime up in %.1f s, ready in %.1f s%n", name, up, seconds(t0));
+    }
+
+    private static double seconds(long since) {
+        return (System.nanoTime() - since) / 1e9;
     }
 
     private ChromeDriver startChrome() {
@@ -137,6 +146,7 @@ final class ConsoleFixture implements BeforeAllCallback, AfterAllCallback {
 
     @Override
     public void afterAll(ExtensionContext context) throws Exception {
+        long t0 = System.nanoTime();
         try {
             if (driver != null) {
                 driver.quit();
@@ -151,6 +161,7 @@ final class ConsoleFixture implements BeforeAllCallback, AfterAllCallback {
         }
         // Nothing leaks: no child process, no shared memory or queue of this runtime.
         RuntimeUnderTest.assertNothingLeft(runtimeId);
+        System.out.printf("ConsoleFixture %s: stopped and checked in %.1f s%n", name, seconds(t0));
     }
 
     RuntimeUnderTest rt() {

@@ -123,6 +123,21 @@ final class ConsolePages {
                 + ".then(r => r.text().then(t => done(r.status + ' ' + t))).catch(e => done('error ' + e));", api);
     }
 
+    /**
+     * Clears the field and types {@code text} into it, again while the page redraws it (the
+     * element found is replaced or not yet interactable) until it took the text or {@link #WAIT}
+     * passed.
+     */
+    void typeInto(By by, String text) {
+        waiting().ignoring(org.openqa.selenium.StaleElementReferenceException.class)
+                .ignoring(org.openqa.selenium.ElementNotInteractableException.class).until(d -> {
+                    WebElement e = d.findElement(by);
+                    e.clear();
+                    e.sendKeys(text);
+                    return text.equals(e.getAttribute("value"));
+                });
+    }
+
     /** Opens the Deploy page, types the jar's {@code file:} URL and the pin, and clicks Fetch. */
     void fetchOnDeploy(Path jar, String pin) {
         open("arflex-deploy");

@@ -111,9 +111,8 @@ class WebConsoleWatchIT {
         PAGES.awaitText(By.id("arflex-debug-m0-target"), "sample-counter.count");
         PAGES.awaitText(By.id("arflex-debug-m1-target"), "sample-scaler.y");
         // A smaller window: applied by the monitor's RT half, then min/max/mean arrive.
-        WebElement win = PAGES.driver().findElement(By.id("arflex-debug-window"));
-        win.clear();
-        win.sendKeys("5");
+        // typed once the page lets it be (it redrew the field under the test once: "element not interactable")
+        PAGES.typeInto(By.id("arflex-debug-window"), "5");
         PAGES.driver().findElement(By.id("arflex-debug-window-apply")).click();
         PAGES.awaitText(By.id("arflex-debug-status"), "window applied by the RT half: 5");
         PAGES.awaitAtLeast(By.id("arflex-debug-m0-mean"), "data-index", 0);
