@@ -22,7 +22,7 @@ import org.openqa.selenium.chrome.ChromeOptions;
 /**
  * One console test class's runtime (child process, {@link RuntimeUnderTest}) in
  * {@code <arflex.it.work>/<name>}, optionally with sample components started or installed, and
- * optionally one headless Chromium driven by Selenium, started while the runtime comes up.
+ * optionally one headless Chromium driven by Selenium, started once the console answers (while the components start).
  * Registered on a static field ({@code @RegisterExtension}): started before the class's first
  * test, stopped after its last, then nothing of the runtime may be left (processes, shared
  * memory, queues). Its queries read the cell as the console's JSON API answers.
@@ -86,13 +86,19 @@ final class ConsoleFixture implements BeforeAllCallback, AfterAllCallback {
             screenshots = Path.of(System.getProperty("arflex.screenshots", "target/screenshots")).toAbsolutePath();
             Files.createDirectories(screenshots);
             profile = Files.createTempDirectory("arflex-chrome-");
-            chrome = CompletableFuture.supplyAsync(this::startChrome);
         }
         Throwable failed = null;
         try {
             rt = new RuntimeUnderTest(work);
             rt.awaitUp(Duration.ofSeconds(90));
             up = seconds(t0);
+            if (withBrowser) {
+                // Started once the console answers, not beside the runtime's start: chromedriver
+                // and Chromium take free ports of their own, and one of them could take the port
+                // the runtime was given before its Jetty binds it (a runtime whose console never
+                // answered was seen once with the two started side by side).
+                chrome = CompletableFuture.supplyAsync(this::startChrome);
+            }
             runtimeId = jsonString(cell(), "runtimeId");
             for (String c : started) {
                 Path jar = org.arflex.it.Components.jar(c);
