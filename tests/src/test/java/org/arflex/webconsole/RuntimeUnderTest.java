@@ -67,10 +67,9 @@ final class RuntimeUnderTest implements AutoCloseable {
         this.runtimeDir = work.resolve("runtime");
         this.home = work.resolve("home");
         this.log = work.resolve("runtime.log");
-        copyTree(assembled, runtimeDir);
-        deleteTree(runtimeDir.resolve("felix-cache"));
-        deleteTree(runtimeDir.resolve("cell"));
-        // No demonstration cell: the tests install their own components through the console.
+        // No bundle cache of the assembly's, and no demonstration cell (the tests install their
+        // own components through the console): neither is copied (D67: one runtime per test class).
+        copyTree(assembled, runtimeDir, List.of("felix-cache", "cell"));
         Files.writeString(runtimeDir.resolve("conf/cell.gosh"), "# the browser tests install their own components\n");
         // The freshly built console bundle replaces any copy the assembly already carries.
         for (String dir : List.of("bundle", "console")) {
@@ -286,9 +285,10 @@ final class RuntimeUnderTest implements AutoCloseable {
         }
     }
 
-    private static void copyTree(Path from, Path to) throws IOException {
+    /** Copies {@code from} to {@code to} but for the top-level entries named in {@code leftOut}. */
+    private static void copyTree(Path from, Path to, List<String> leftOut) throws IOException {
         try (Stream<Path> s = Files.walk(from)) {
-            for (Path p : s.toList()) {
+            for (Path p : s.filter(p -> p.equals(from) || !leftOut.contains(from.relativize(p).getName(0).toString())).toList()) {
                 Path t = to.resolve(from.relativize(p).toString());
                 if (Files.isDirectory(p)) {
                     Files.createDirectories(t);
