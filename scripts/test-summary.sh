@@ -26,6 +26,27 @@ for f in "${reports[@]}"; do
 done
 
 passed=$((total - failed - skipped))
+if [ "$failed" -gt 0 ] && command -v python3 >/dev/null; then
+  # What failed and why, from the reports themselves: CI keeps only the end of the output.
+  python3 - "${reports[@]}" <<'PY' || true
+import sys, xml.etree.ElementTree as ET
+for f in sys.argv[1:]:
+    try:
+        root = ET.parse(f).getroot()
+    except ET.ParseError as e:
+        print(f"FAILED to read {f}: {e}")
+        continue
+    for case in root.iter("testcase"):
+        for kind in ("failure", "error"):
+            for el in case.findall(kind):
+                msg = (el.get("message") or el.text or "").strip().splitlines()
+                out = case.findtext("system-out") or ""
+                if len(" ".join(msg)) < 20:  # CTest's "Failed": the test's own FAIL lines
+                    msg += [l for l in out.splitlines() if "FAIL" in l][:3]
+                text = " | ".join(l.strip() for l in msg[:6])[:1500]
+                print(f"FAILED {case.get('classname', '')}.{case.get('name', '')} ({kind}): {text}")
+PY
+fi
 echo "${#reports[@]} test reports read"
 if [ "$skipped" -gt 0 ]; then
   echo "${passed} passed, ${failed} failed, ${skipped} skipped"
