@@ -107,8 +107,14 @@ static int configure(struct arflex_component *c, void *user)
 			goto out_fail;
 	}
 	if (getenv("ARFLEX_PROBE_READOPT")) { /* D61: the adopt hook re-adopts too, or refuses */
-		r = arflex_component_readopt(c, strcmp(getenv("ARFLEX_PROBE_READOPT"), "refuse")
-							? adopt : readopt_refuse);
+		const char *how = getenv("ARFLEX_PROBE_READOPT");
+		arflex_readopt_fn fn = adopt;
+
+		if (!strcmp(how, "refuse"))
+			fn = readopt_refuse;
+		else if (!strcmp(how, "null"))
+			fn = NULL; /* D70: registered, but no hook */
+		r = arflex_component_readopt(c, fn);
 		if (r)
 			goto out_fail;
 	}

@@ -174,11 +174,62 @@ static void readopt_refusals_leave_the_half_as_it_was(void **state)
 	th_assert_clean(rid);
 }
 
+/* D70: a half advertises that it can re-adopt (ARFLEX_FLAG_READOPT in ctl.flags) once READY
+ * when its configure registered a re-adopt hook, refusing one or not: the DRCR reads it before a
+ * shadow run's START, so that a shadowed update of a half that could not take the state at the
+ * switch is refused up front. A half without the hook does not advertise it; neither does one
+ * that registered NULL. */
+static void readopt_capability_is_advertised_at_ready(void **state)
+{
+	struct arflex_host a, b, c, d;
+
+	(void)state;
+	setup_ids("racap");
+	probe_state = true;
+	assert_int_equal(probe_host(&a, "old", 0, 0, true), 0);
+	assert_int_equal(probe_host(&b, "1-old", 0, 0, true), 0);
+	assert_int_equal(probe_host(&c, "2-old", 0, 0, true), 0);
+	assert_int_equal(probe_host(&d, "3-old", 0, 0, true), 0);
+	probe_state = false;
+	spawn_ready(&a); /* no re-adopt hook */
+	make_env("ARFLEX_PROBE_READOPT=take");
+	spawn_ready(&b);
+	make_env("ARFLEX_PROBE_READOPT=refuse");
+	spawn_ready(&c);
+	make_env("ARFLEX_PROBE_READOPT=null");
+	spawn_ready(&d);
+	assert_int_equal(arflex_ctl_state(a.ctl), ARFLEX_STATE_READY);
+	assert_false(arflex_ctl_flags(a.ctl) & ARFLEX_FLAG_READOPT);
+	assert_true(arflex_ctl_flags(b.ctl) & ARFLEX_FLAG_READOPT);
+	assert_true(arflex_ctl_flags(c.ctl) & ARFLEX_FLAG_READOPT);
+	assert_false(arflex_ctl_flags(d.ctl) & ARFLEX_FLAG_READOPT);
+	/* kept while running, and what the flag says is what READOPT answers */
+	assert_int_equal(arflex_host_start(&a, T_CALL), 0);
+	assert_int_equal(arflex_host_start(&b, T_CALL), 0);
+	assert_true(wait_out(&a, updates_above, 20, false));
+	assert_true(wait_out(&b, updates_above, 5, false));
+	assert_true(arflex_ctl_flags(b.ctl) & ARFLEX_FLAG_READOPT);
+	assert_false(arflex_ctl_flags(a.ctl) & ARFLEX_FLAG_READOPT);
+	assert_int_equal(arflex_host_readopt(&b, arflex_host_state(&a)->name, T_CALL), 0);
+
+	shutdown_ok(&a);
+	shutdown_ok(&b);
+	shutdown_ok(&c);
+	shutdown_ok(&d);
+	arflex_host_destroy(&a);
+	arflex_host_destroy(&b);
+	arflex_host_destroy(&c);
+	arflex_host_destroy(&d);
+	unlink(logpath);
+	th_assert_clean(rid);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(readopt_takes_the_newest_value_while_running),
 		cmocka_unit_test(readopt_refusals_leave_the_half_as_it_was),
+		cmocka_unit_test(readopt_capability_is_advertised_at_ready),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);

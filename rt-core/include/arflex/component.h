@@ -192,7 +192,9 @@ typedef int (*arflex_readopt_fn)(struct arflex_component *c, void *user,
  * only. A negative return is the READOPT's reply (the manager then keeps the old half and stops
  * this one: fail closed); the hook must leave the half's state as it was when it refuses. A
  * half without the hook refuses READOPT (-EOPNOTSUPP). For a component whose adopt hook may
- * run between two updates, the adopt hook itself. Configure only. Returns 0 or -EINVAL.
+ * run between two updates, the adopt hook itself. Configure only. Returns 0 or -EINVAL. A hook
+ * registered when configure returns is advertised in the control block before READY
+ * (ARFLEX_FLAG_READOPT, D70): the manager runs a half in shadow only when it can re-adopt.
  */
 ARFLEX_API int arflex_component_readopt(struct arflex_component *c, arflex_readopt_fn fn);
 /** True when the state segment is open (arflex_component_state returned 0). */

@@ -80,6 +80,9 @@ enum arflex_ctl_flag {
 	ARFLEX_FLAG_AFFINITY = 1u << 4,       /**< CPU affinity applied */
 	ARFLEX_FLAG_DMA_LATENCY = 1u << 5,    /**< /dev/cpu_dma_latency held at 0 */
 	ARFLEX_FLAG_SUPERVISOR_LOST = 1u << 6, /**< supervisor pipe (fd 0) reached EOF: orphaned */
+	/** D70: configure registered a re-adopt hook (arflex_component_readopt): the RUNNING half
+	 *  can take a state block again (READOPT). Set before READY, kept until the process exits. */
+	ARFLEX_FLAG_READOPT = 1u << 7,
 };
 
 /** Bits of config.cfg_flags (manager, before spawn). */

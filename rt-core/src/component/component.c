@@ -304,6 +304,7 @@ int arflex_component_main(int argc, char **argv, const struct arflex_component_o
 		c->task.o.poll = arflex_comp_rt_poll;
 		c->task.o.poll_ns = ARFLEX_TASK_POLL_NS(c->task.o.period_ns);
 	}
+	arflex_comp_readopt_advertise(c);
 	STORE(&c->ctl->state, ARFLEX_STATE_READY);
 
 	arflex_comp_serve_loop(c, &got_signal);

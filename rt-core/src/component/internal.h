@@ -148,6 +148,8 @@ void arflex_comp_state_close(struct arflex_component *c);
  * unmap) and its taking at a cycle boundary (RT thread: no blocking, allocation or printing). */
 int arflex_comp_readopt_cmd(struct arflex_component *c, const struct arflex_msg *m);
 void arflex_comp_readopt_take(struct arflex_component *c);
+/* D70: ARFLEX_FLAG_READOPT when configure registered a re-adopt hook (main thread, before READY). */
+void arflex_comp_readopt_advertise(struct arflex_component *c);
 
 /* supervisor.c (ABI.md 6.2, DECISIONS.md D10) */
 #define ARFLEX_ORPHAN_POLL_NS 10000000u /* mailbox wakes every 10 ms once the supervisor is lost */

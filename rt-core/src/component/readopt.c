@@ -17,6 +17,15 @@ int arflex_component_readopt(struct arflex_component *c, arflex_readopt_fn fn)
 	return 0;
 }
 
+/* D70: after configure, before READY (main thread): the control block says whether this half
+ * can re-adopt once running, so that the manager knows it before a shadow run's START rather
+ * than at the switch. Cleared at attach with the other RT bits (a restart configures afresh). */
+void arflex_comp_readopt_advertise(struct arflex_component *c)
+{
+	if (c->readopt.fn)
+		__atomic_or_fetch(&c->ctl->flags, ARFLEX_FLAG_READOPT, __ATOMIC_RELEASE);
+}
+
 static void release(struct arflex_component *c)
 {
 	if (c->readopt.src) {
