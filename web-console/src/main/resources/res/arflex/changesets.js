@@ -186,7 +186,8 @@
         rows, 'No set applied yet.'));
   }
 
-  const VERDICT_TEXT = {'committed': 'committed', 'rolled-back': 'rolled back', 'rejected-in-shadow': 'rejected in shadow'};
+  const VERDICT_TEXT = {'committed': 'committed', 'rolled-back': 'rolled back', 'rejected-in-shadow': 'rejected in shadow',
+    'refused': 'refused before its shadow run'};
 
   /** An update's verdict in words; a cancelled one says whose rejection cancelled it (its why, D62). */
   function verdictText(u, running) {

@@ -32,9 +32,10 @@ public class UpdateProgressDTO {
     public double tolerance;
     /**
      * Its own verdict once known: {@code committed} (its window is over without a rollback),
-     * {@code rolled-back} (in its window or at the switch), {@code rejected-in-shadow}, or
-     * {@code cancelled} (another update of the set was rejected in its shadow run, so the set was
-     * abandoned: {@link #why} names it and its reason, D62); null before, and for an update the
+     * {@code rolled-back} (in its window or at the switch), {@code rejected-in-shadow},
+     * {@code refused} (its new half, READY, could not run in shadow: D70, no re-adopt hook), or
+     * {@code cancelled} (another update of the set was rejected in its shadow run, or refused
+     * before it, so the set was abandoned: {@link #why} names it and its reason, D62); null before, and for an update the
      * set's outcome ended without a verdict of its own (the set refused or torn down).
      */
     public String verdict;

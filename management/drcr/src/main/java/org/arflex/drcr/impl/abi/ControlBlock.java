@@ -115,6 +115,8 @@ public final class ControlBlock implements AutoCloseable {
     public static final int FLAG_RESET_REQUIRED = Layout.FLAG_RESET_REQUIRED;
     /** The RT half saw EOF on its supervisor pipe (fd 0): it is an orphan (ABI.md 6.2). */
     public static final int FLAG_SUPERVISOR_LOST = Layout.FLAG_SUPERVISOR_LOST;
+    /** D70: the half registered a re-adopt hook: it can take a state block again while it runs (READOPT). */
+    public static final int FLAG_READOPT = Layout.FLAG_READOPT;
     public static final int CFG_MOVES_HARDWARE = Layout.CFG_MOVES_HARDWARE;
     public static final int CFG_NO_MLOCK = Layout.CFG_NO_MLOCK;
     public static final int CFG_NO_DMA_LATENCY = Layout.CFG_NO_DMA_LATENCY;

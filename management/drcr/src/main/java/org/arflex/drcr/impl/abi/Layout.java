@@ -44,6 +44,7 @@ public final class Layout {
     public static final int FLAG_AFFINITY = 16;
     public static final int FLAG_DMA_LATENCY = 32;
     public static final int FLAG_SUPERVISOR_LOST = 64;
+    public static final int FLAG_READOPT = 128;
     public static final int CFG_MOVES_HARDWARE = 1;
     public static final int CFG_NO_MLOCK = 2;
     public static final int CFG_NO_DMA_LATENCY = 4;

@@ -36,6 +36,8 @@ public final class ChangeSetProgress {
     public static final String REJECTED_IN_SHADOW = "rejected-in-shadow";
     /** An update whose set another update's shadow run rejected (D62): it did not happen, not for its own reason. */
     public static final String CANCELLED = "cancelled";
+    /** An update refused once its new half was READY, before its shadow run (D70: it cannot re-adopt). */
+    public static final String REFUSED = "refused";
 
     private final LongSupplier clock;
     private volatile ChangeSetProgressDTO shown;
@@ -215,7 +217,7 @@ public final class ChangeSetProgress {
 
         /**
          * The update of {@code component} has its own verdict ({@code committed},
-         * {@code rolled-back} or {@code rejected-in-shadow}), {@code why}, after {@code cycle}
+         * {@code rolled-back}, {@code rejected-in-shadow} or {@code refused}), {@code why}, after {@code cycle}
          * cycles of its shadow run or window: its entry says so; the set's phase and step are
          * unchanged (D60).
          */
@@ -244,6 +246,21 @@ public final class ChangeSetProgress {
          * {@code cancelled}, naming it and the reason (D62), its counters kept.
          */
         public void rejectedInShadow(String component, String refusal, String reason, long cycle) {
+            ended(component, REJECTED_IN_SHADOW, refusal, ShadowReport.cancelled(component, reason), cycle);
+        }
+
+        /**
+         * The update of {@code component} was refused once its new half was READY, before its
+         * shadow run (D70), for {@code reason} ({@code refusal}: the set's refusal line): its entry
+         * says {@code refused}, every other update without a verdict of its own {@code cancelled},
+         * naming it and the reason, as {@link #rejectedInShadow}.
+         */
+        public void refused(String component, String refusal, String reason) {
+            ended(component, REFUSED, refusal, ReadoptCheck.cancelled(component, reason), 0);
+        }
+
+        /** {@code component}'s verdict ends the set: the updates without one are cancelled by {@code cancelled}. */
+        private void ended(String component, String verdict, String refusal, String cancelled, long cycle) {
             synchronized (ChangeSetProgress.this) {
                 if (owner != this || !running || indexOf(component) < 0) {
                     return;
@@ -252,11 +269,11 @@ public final class ChangeSetProgress {
                     if (updates[i].verdict == null && !updates[i].component.equals(component)) {
                         UpdateProgressDTO u = copy(updates[i]);
                         u.verdict = CANCELLED;
-                        u.why = ShadowReport.cancelled(component, reason);
+                        u.why = cancelled;
                         updates[i] = u;
                     }
                 }
-                verdict(component, REJECTED_IN_SHADOW, refusal, cycle); // publishes them all in one snapshot
+                verdict(component, verdict, refusal, cycle); // publishes them all in one snapshot
             }
         }
 

@@ -14,8 +14,9 @@ import org.arflex.planner.Plan;
  * old configuration runs and the planner still holds the old state; an update that declares a
  * shadow run (D42) then runs in shadow ({@link ShadowRun}); then {@link SwitchTurn} switches the
  * whole set in one actor turn. A preparation that fails (a spawn fails, a half never gets READY
- * or exits before the switch), or a rejected shadow run, tears down everything prepared
- * ({@link #abandon}), and the old configuration has not been touched.
+ * or exits before the switch), a new half that could not take the state again at the switch of
+ * its shadow run (D70, {@link ReadoptCheck}: refused once READY), or a rejected shadow run, tears
+ * down everything prepared ({@link #abandon}), and the old configuration has not been touched.
  */
 final class SetRun {
     final ChangeSet set;
@@ -160,6 +161,15 @@ final class SetRun {
             return;
         }
         prepared.put(inst, half);
+        String cannot = nexts.get(inst.name) == inst ? ReadoptCheck.problem(set, cell.find(inst.name), inst, half) : null;
+        if (cannot != null) { // D70: known at READY, before its shadow run's START
+            RtHalf running = oldHalves.get(inst.name);
+            String refusal = "update " + inst.name + ": refused: " + cannot + "; nothing changed"
+                    + (running == null ? "" : " (pid " + running.pid() + " runs " + inst.name + " on)");
+            progress.refused(inst.name, refusal, cannot);
+            abandon(refusal, "refused before its shadow run: " + inst.name);
+            return;
+        }
         log.accept("arflex: change set: " + inst.name + " READY (pid " + half.pid() + ", spawn to READY "
                 + tookNs / 1000 + " us), not started yet");
         half.exit().thenAccept(ex -> cell.actor().submit(() -> exitedEarly(inst, half, ex)));

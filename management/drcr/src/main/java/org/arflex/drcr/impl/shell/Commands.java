@@ -208,7 +208,8 @@ public final class Commands {
      * {@code change apply <actions>} applies it all or nothing; actions are
      * {@code install <component>} (its bundle installed, not started), {@code uninstall <component>},
      * {@code set <component> <parameter> <value>} and {@code update <component> <jar URL> [<sha256>]
-     * [window <cycles>] [shadow <cycles>] [envelope ...] [tolerance ...]} (D38, D42), in any number, e.g.
+     * [window <cycles>] [shadow <cycles>] [envelope ...] [tolerance ...]} (D38, D42; a shadow run of a
+     * component with a state block needs a new half that can re-adopt it, D70), in any number, e.g.
      * {@code change apply install teach uninstall trajectory}. {@code change progress}: where the
      * set being applied is, or how the last one ended (D53). {@code change history [<count>]}: the
      * sets in the history (kept in the DRCR's data area across restarts, D66), newest first, each
@@ -218,7 +219,9 @@ public final class Commands {
         return guard(() -> {
             String usage = "usage: change plan|apply <action>... | change progress | change history [<count>] (actions: install <component>, uninstall <component>,"
                     + " set <component> <parameter> <value>, update <component> <jar URL> [<sha256>] [window <cycles>]"
-                    + " [shadow <cycles>] [envelope <port>.<field> <min> <max>]... [tolerance <port>.<field> <max difference>]...)";
+                    + " [shadow <cycles>] [envelope <port>.<field> <min> <max>]... [tolerance <port>.<field> <max difference>]...;"
+                    + " shadow: a component with a state block only when its new RT half registers a re-adopt hook"
+                    + " (arflex_component_readopt), else the update is refused once that half is READY: apply it with shadow 0)";
             if (changeSets != null && args.length == 1 && args[0].equals("progress")) {
                 return ChangeSetProgressText.of(changeSets.progress(), System.currentTimeMillis());
             }

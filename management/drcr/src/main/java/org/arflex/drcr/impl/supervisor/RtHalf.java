@@ -103,6 +103,14 @@ public interface RtHalf {
     /** Control block flags. */
     int flags();
 
+    /**
+     * True when the half advertises a re-adopt hook (ControlBlock.FLAG_READOPT, set by its
+     * configure before READY, D70): once running it can take a state block again (READOPT, D61).
+     */
+    default boolean canReadopt() {
+        return (flags() & ControlBlock.FLAG_READOPT) != 0;
+    }
+
     /** Rejected values per input in this run (ControlBlock.inputRejects); empty when gone. */
     default java.util.Map<String, Long> inputRejects(java.util.Collection<String> inputs) {
         return java.util.Map.of();

@@ -83,6 +83,7 @@ class ControlBlockLayoutTest {
         expect.put("ARFLEX_FLAG_SAFE_ACTIVE", (long) ControlBlock.FLAG_SAFE_ACTIVE);
         expect.put("ARFLEX_FLAG_RESET_REQUIRED", (long) ControlBlock.FLAG_RESET_REQUIRED);
         expect.put("ARFLEX_FLAG_SUPERVISOR_LOST", (long) ControlBlock.FLAG_SUPERVISOR_LOST);
+        expect.put("ARFLEX_FLAG_READOPT", (long) ControlBlock.FLAG_READOPT);
         expect.put("ARFLEX_CFG_MOVES_HARDWARE", (long) ControlBlock.CFG_MOVES_HARDWARE);
         expect.put("ARFLEX_CFG_NO_MLOCK", (long) ControlBlock.CFG_NO_MLOCK);
         expect.put("ARFLEX_CFG_NO_DMA_LATENCY", (long) ControlBlock.CFG_NO_DMA_LATENCY);

@@ -105,8 +105,77 @@ class CellShadowStateTest {
         assertTrue(fake.openOutputs.containsKey("/arflex.t.stage.state"), "the old half keeps its state segment");
     }
 
+    /**
+     * D70: a new half that registers no re-adopt hook could not take the running half's state at
+     * the switch; its update is refused once it is READY, before its shadow run's START, the verdict
+     * naming the component, the reason and what to do. Nothing that ran is touched.
+     */
+    @Test
+    void aShadowedUpdateWhoseNewHalfCannotReadoptIsRefusedOnceReadyBeforeItsShadowRun() throws Exception {
+        rig.runningCell("50us", TRAJ);
+        FakeLauncher.FakeHalf oldHalf = fake.running.get("stage");
+        String bindingsBefore = fake.events.stream().filter(e -> e.startsWith("user ")).toList().toString();
+        fake.noReadoptHook.add("1-stage");
+        int mark = fake.events.size();
+        CompletableFuture<ChangeSetResult> f = rig.actor.call(() -> cell.applyChangeSet(UpdateRig.update(
+                parse("stage", "stage", IN_SRC + OUT, "1.1.0", TRAJ), 50, 100,
+                List.of(new ChangeSet.Tolerance("y", "value", 0.01)))), 0);
+        rig.stepUntil("the outcome", f::isDone);
+        ChangeSetResult r = f.join();
+        assertFalse(r.applied(), r.text());
+        List<String> ev = rig.since(mark);
+        java.util.regex.Matcher pid = java.util.regex.Pattern.compile("its new RT half \\(pid (\\d+)\\)").matcher(r.refusal());
+        assertTrue(pid.find() && ev.contains("1-stage LAUNCH"), r.refusal() + " " + ev);
+        long newPid = Long.parseLong(pid.group(1));
+        assertTrue(newPid != oldHalf.pid, r.refusal());
+        assertEquals("update stage: refused: its new RT half (pid " + newPid + ") registers no re-adopt hook "
+                + "(arflex_component_readopt), so it cannot take the running half's state block arflex.TrajectoryState "
+                + "1.0 again at the switch of a shadow run; apply it without a shadow run (shadow 0; the new half then "
+                + "adopts the state at its START), or give its RT half a re-adopt hook; nothing changed (pid " + oldHalf.pid
+                + " runs stage on)", r.refusal());
+        // known at READY: never started, never re-adopted, never compared
+        assertFalse(ev.contains("1-stage START"), ev::toString);
+        assertTrue(ev.stream().noneMatch(e -> e.contains("READOPT")), ev::toString);
+        assertTrue(rig.log.stream().noneMatch(l -> l.contains("runs in shadow")), rig.log::toString);
+        // the old half keeps the component, nothing waits for a reset, no consumer moved
+        assertEquals(oldHalf.pid, cell.instance("stage").orElseThrow().half.pid());
+        assertEquals("1.0.0", cell.instance("stage").orElseThrow().contract().version().toString());
+        assertEquals(State.ACTIVE, rig.state("stage"));
+        assertFalse(cell.instance("stage").orElseThrow().awaitingReset, "nothing waits for a reset");
+        assertFalse(ev.stream().anyMatch(e -> e.startsWith("stage ")), "the old half untouched: " + ev);
+        assertEquals(bindingsBefore, fake.events.stream().filter(e -> e.startsWith("user ")).toList().toString());
+        rig.stepUntil("the refused half stopped and its segments gone", () -> !fake.running.containsKey("1-stage")
+                && !fake.openOutputs.containsKey(NEW_Y) && !fake.openOutputs.containsKey("/arflex.t.1-stage.state"));
+        assertTrue(fake.openOutputs.containsKey("/arflex.t.stage.state"), "the old half keeps its state segment");
+        // the progress and the history: the set refused, its update's entry says why
+        rig.stepUntil("the progress done", () -> !cell.changeSetProgress().snapshot().running);
+        var p = cell.changeSetProgress().snapshot();
+        assertEquals("refused", p.outcome);
+        assertEquals(r.refusal(), p.why);
+        assertEquals("refused", p.updates[0].verdict);
+        assertEquals(r.refusal(), p.updates[0].why);
+    }
+
+    /** D70: the same new half without a shadow run needs no re-adopt: it adopts at its START and commits. */
+    @Test
+    void theSameUpdateWithoutAShadowRunIsApplied() throws Exception {
+        rig.runningCell("50us", TRAJ);
+        fake.noReadoptHook.add("1-stage");
+        CompletableFuture<ChangeSetResult> f = rig.actor.call(() -> cell.applyChangeSet(UpdateRig.update(
+                parse("stage", "stage", IN_SRC + OUT, "1.1.0", TRAJ), 50, 0, List.of())), 0);
+        rig.stepUntil("the switch", f::isDone);
+        ChangeSetResult r = f.join();
+        assertTrue(r.applied(), r.text());
+        assertTrue(fake.events.contains("1-stage ADOPT /arflex.t.stage.state"), fake.events::toString);
+        fake.running.get("1-stage").stats = cycles(60, 0);
+        rig.look();
+        rig.stepUntil("the verdict", () -> r.verdict().isDone());
+        assertTrue(r.verdict().join().contains("update stage: committed"), r.verdict().join());
+    }
+
     @Test
     void aShadowRunWithoutAStateBlockHasNothingToReadopt() throws Exception {
+        fake.noReadoptHook.add("1-stage"); // D70: and so needs no re-adopt hook
         CompletableFuture<ChangeSetResult> f = intoShadow("");
         ChangeSetResult r = pass(f);
         assertTrue(r.applied(), r.text());

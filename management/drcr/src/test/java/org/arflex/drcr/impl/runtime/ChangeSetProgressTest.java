@@ -349,6 +349,25 @@ class ChangeSetProgressTest {
         assertEquals(p.why, p.updates[1].why);
     }
 
+    /** D70: an update refused once its new half is READY cancels the set's other updates, as a rejection does. */
+    @Test
+    void everyOtherUpdateIsCancelledWhenOneIsRefusedBeforeItsShadowRun() {
+        ChangeSetProgress progress = new ChangeSetProgress(() -> 1_000);
+        ChangeSetProgress.Apply a = progress.begin(List.of("update a x", "update b y shadow 50"));
+        a.claim(List.of("a", "b"));
+        a.phase(ChangeSetProgress.PREPARING, "1 of 2 new RT halves READY");
+        String why = "its new RT half (pid 7) registers no re-adopt hook (arflex_component_readopt), so ...";
+        String refusal = "update b: refused: " + why + "; nothing changed (pid 3 runs b on)";
+        a.refused("b", refusal, why);
+        a.done(ChangeSetProgress.outcomeOf(false, refusal, null, false), refusal);
+        ChangeSetProgressDTO p = progress.snapshot();
+        assertEquals("refused", p.outcome);
+        assertEquals(List.of("cancelled", "refused"), List.of(p.updates[0].verdict, p.updates[1].verdict));
+        assertEquals("cancelled: update b was refused before its shadow run (" + why + ")", p.updates[0].why);
+        assertEquals(refusal, p.updates[1].why);
+        assertEquals(List.of(0L, 0L), List.of(p.updates[0].cycle, p.updates[1].cycle));
+    }
+
     @Test
     void everyUpdateWithoutAVerdictOfItsOwnIsCancelledWhenAnotherIsRejectedInShadow() {
         ChangeSetProgress progress = new ChangeSetProgress(() -> 1_000);

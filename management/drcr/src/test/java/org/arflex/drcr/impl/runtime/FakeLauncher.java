@@ -28,6 +28,8 @@ final class FakeLauncher implements RtLauncher {
     final Map<String, String> refuseAdopt = new java.util.concurrent.ConcurrentHashMap<>();
     /** Instance id -> why its READOPT is refused (D61; tests set it). */
     final Map<String, String> refuseReadopt = new java.util.concurrent.ConcurrentHashMap<>();
+    /** Instances whose half registers no re-adopt hook (D70: no ControlBlock.FLAG_READOPT); tests set it. */
+    final Set<String> noReadoptHook = java.util.concurrent.ConcurrentHashMap.newKeySet();
     /** Instances whose START is refused (the half died before it, say); tests set it. */
     final Set<String> refuseStart = java.util.concurrent.ConcurrentHashMap.newKeySet();
     /** Instances whose next launches fail. */
@@ -159,6 +161,11 @@ final class FakeLauncher implements RtLauncher {
         @Override
         public int flags() {
             return flags;
+        }
+
+        @Override
+        public boolean canReadopt() { // a fake half has the hook unless the test says otherwise (D70)
+            return !noReadoptHook.contains(inst);
         }
 
         @Override

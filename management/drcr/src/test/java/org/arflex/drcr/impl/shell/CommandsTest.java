@@ -331,7 +331,9 @@ class CommandsTest {
     void changeWithoutActionsPrintsItsUsage() {
         String usage = "usage: change plan|apply <action>... | change progress | change history [<count>] (actions: install <component>, uninstall <component>,"
                 + " set <component> <parameter> <value>, update <component> <jar URL> [<sha256>] [window <cycles>]"
-                + " [shadow <cycles>] [envelope <port>.<field> <min> <max>]... [tolerance <port>.<field> <max difference>]...)";
+                + " [shadow <cycles>] [envelope <port>.<field> <min> <max>]... [tolerance <port>.<field> <max difference>]...;"
+                + " shadow: a component with a state block only when its new RT half registers a re-adopt hook"
+                + " (arflex_component_readopt), else the update is refused once that half is READY: apply it with shadow 0)";
         assertEquals(usage, cmd.change());
         assertEquals(usage, cmd.change("apply"));
         assertEquals(usage, cmd.change("do", "install", "x"));
