@@ -35,6 +35,9 @@ import org.junit.jupiter.api.Test;
  *       the new half.
  * </ul>
  *
+ * <p>Before update a, the same jar with a shadow run is refused up front (D70: vision's RT half
+ * registers no re-adopt hook; {@link #shadowRefusedUpFront}).
+ *
  * <p>Then 1.0.2 with {@code set vision calibrate 1} in the same set: the new half adopts the block
  * and, asked to, calibrates again from the board, as a half without a state does at its first
  * frames. The same comparison is printed for it (the step a fresh calibration makes, which the
@@ -141,11 +144,17 @@ class VisionStateIT {
             long robotPid = rt.pid("sim-robot");
             long guardPid = rt.pid("force-guard");
             long corrPid = rt.pid("tcp-correction");
+            Path v101 = VisionChangeSetIT.version(VISION, "vision", dir, "1.0.1");
+
+            // D70: with a shadow run the update is refused once its new half is READY, before the
+            // run: vision's RT half registers no re-adopt hook, so it could not take the running
+            // half's state at the switch. The same jar without a shadow run is update a below.
+            shadowRefusedUpFront(rt, v101);
 
             // a window of 100 cycles (20 s, some 40 frame sets of the 500 ms cameras): frame sets
             // both halves measured from the same detections to compare, when both halves
             // took the same frame set (same stamp) at all: 47 of 121 in one run, 1 in the next
-            Update a = update(rt, "vision", "1-vision", VisionChangeSetIT.version(VISION, "vision", dir, "1.0.1"), 100, "");
+            Update a = update(rt, "vision", "1-vision", v101, 100, "");
             assertTrue(a.out().contains("update vision: committed"), a.out());
             // the seq goes on: the first pose is the one after the seq its block was taken at
             VState adopted = a.newStates().get(0);
@@ -197,6 +206,46 @@ class VisionStateIT {
             assertEquals(corrPid, rt.pid("tcp-correction"));
             assertTrue(rt.cmd("arflex:info vision").contains("1.0.2"), rt.cmd("arflex:info vision"));
         }
+    }
+
+    /**
+     * D70: {@code update vision <jar> shadow 300 window 100} on the moving arm is refused up front
+     * with a verdict naming vision, the missing re-adopt hook and what to do; the old half keeps
+     * its pid and the bindings, sim-robot runs no safe cycle, nothing awaits a reset, the history
+     * keeps the verdict, and the refused half's process and segments go.
+     */
+    static void shadowRefusedUpFront(Runtime rt, Path jar) throws Exception {
+        long visionPid = rt.pid("vision");
+        String bindings = rt.cmd("arflex:bindings");
+        Map<String, Object> robot0 = ChangeSetIT.stats(rt, "sim-robot");
+        int logMark = rt.logMark();
+        long t0 = System.nanoTime();
+        String out = rt.cmd("arflex:change apply update vision file:" + jar + " " + sha256(jar) + " shadow 300 window 100");
+        long ms = (System.nanoTime() - t0) / 1_000_000;
+        String verdict = "update vision: refused: its new RT half (pid ";
+        String why = ") registers no re-adopt hook (arflex_component_readopt), so it cannot take the running half's "
+                + "state block arflex.VisionState 1.0 again at the switch of a shadow run; apply it without a shadow run "
+                + "(shadow 0; the new half then adopts the state at its START), or give its RT half a re-adopt hook; "
+                + "nothing changed "
+                + "(pid " + visionPid + " runs vision on)";
+        assertTrue(out.startsWith("error: ") && out.contains(verdict) && out.contains(why), out);
+        List<String> log = rt.logSince(logMark);
+        assertTrue(log.stream().noneMatch(l -> l.contains("runs in shadow") || l.contains("READOPT")),
+                "no shadow run began: " + String.join("\n", log));
+        assertEquals(visionPid, rt.pid("vision"), "the old half keeps the component");
+        assertEquals(bindings, rt.cmd("arflex:bindings"), "no consumer moved");
+        assertEquals(0, ChangeSetIT.delta(robot0, ChangeSetIT.stats(rt, "sim-robot"), "safeCycles"),
+                "sim-robot ran safe cycles");
+        assertEquals(List.of(), CellRig.awaitingReset(rt));
+        assertEquals(List.of(), CellRig.awaitingCommand(rt));
+        String history = rt.cmd("arflex:change history 1");
+        assertTrue(history.contains("outcome: refused: " + verdict) && history.contains(why)
+                && history.contains("update vision: no shadow run or window; refused"), history);
+        rt.waitUntil("the refused half's process and segments gone", T, () -> Runtime.rtProcesses(rt.rid).stream()
+                .noneMatch(p -> p.contains("--instance 1-vision ")) && Files.list(Path.of("/dev/shm"))
+                .noneMatch(f -> f.getFileName().toString().startsWith("arflex." + rt.rid + ".1-vision.")));
+        System.out.printf(Locale.ROOT, "VisionStateIT: a shadowed update refused up front in %d ms (command): %s%n", ms,
+                out.lines().filter(l -> l.contains(verdict)).findFirst().orElse(out));
     }
 
     static double maxDiff(double[] x, double[] y) {

@@ -33,7 +33,7 @@ final class ReadoptCheck {
                 + "adopts the state at its START), or give its RT half a re-adopt hook";
     }
 
-    /** The verdict of another update of the set, which this refusal of {@code refused}'s cancelled (as D62's). */
+    /** What another update of the set says when the refusal of {@code refused} cancelled it (as D62's for a rejection). */
     static String cancelled(String refused, String reason) {
         return "cancelled: update " + refused + " was refused before its shadow run (" + reason + ")";
     }
