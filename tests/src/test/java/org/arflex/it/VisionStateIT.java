@@ -35,10 +35,8 @@ import org.junit.jupiter.api.Test;
  *       the new half.
  * </ul>
  *
- * <p>Before update a, the same jar with a shadow run is refused up front (D70: vision's RT half
- * registers no re-adopt hook; {@link #shadowRefusedUpFront}).
- *
- * <p>Then 1.0.2 with {@code set vision calibrate 1} in the same set: the new half adopts the block
+ * <p>Then 1.0.2 with a shadow run is refused up front (D70: vision's RT half registers no
+ * re-adopt hook; {@link #shadowRefusedUpFront}), and then 1.0.2 with {@code set vision calibrate 1} in the same set: the new half adopts the block
  * and, asked to, calibrates again from the board, as a half without a state does at its first
  * frames. The same comparison is printed for it (the step a fresh calibration makes, which the
  * block spares), and its calibrations are asserted to have run (the check above would see one).
@@ -144,17 +142,11 @@ class VisionStateIT {
             long robotPid = rt.pid("sim-robot");
             long guardPid = rt.pid("force-guard");
             long corrPid = rt.pid("tcp-correction");
-            Path v101 = VisionChangeSetIT.version(VISION, "vision", dir, "1.0.1");
-
-            // D70: with a shadow run the update is refused once its new half is READY, before the
-            // run: vision's RT half registers no re-adopt hook, so it could not take the running
-            // half's state at the switch. The same jar without a shadow run is update a below.
-            shadowRefusedUpFront(rt, v101);
 
             // a window of 100 cycles (20 s, some 40 frame sets of the 500 ms cameras): frame sets
             // both halves measured from the same detections to compare, when both halves
             // took the same frame set (same stamp) at all: 47 of 121 in one run, 1 in the next
-            Update a = update(rt, "vision", "1-vision", v101, 100, "");
+            Update a = update(rt, "vision", "1-vision", VisionChangeSetIT.version(VISION, "vision", dir, "1.0.1"), 100, "");
             assertTrue(a.out().contains("update vision: committed"), a.out());
             // the seq goes on: the first pose is the one after the seq its block was taken at
             VState adopted = a.newStates().get(0);
@@ -185,9 +177,15 @@ class VisionStateIT {
                         + " in this run: the same-frames comparison was not made");
             }
 
+            // D70: with a shadow run the update is refused once its new half is READY, before the
+            // run: vision's RT half registers no re-adopt hook, so it could not take the running
+            // half's state at the switch. The same jar without a shadow run is update b below.
+            // (After update a, not before it: the cell is past the cameras' start-up by then.)
+            Path v102 = VisionChangeSetIT.version(VISION, "vision", dir, "1.0.2");
+            shadowRefusedUpFront(rt, "2-vision", v102);
+
             // contrast: the same update with a calibration asked for, as a half without the block would
-            Update b = update(rt, "1-vision", "2-vision", VisionChangeSetIT.version(VISION, "vision", dir, "1.0.2"), 60,
-                    " set vision calibrate 1");
+            Update b = update(rt, "1-vision", "2-vision", v102, 60, " set vision calibrate 1");
             assertTrue(b.out().contains("update vision: committed"), b.out());
             VState before = b.oldStates().get(b.oldStates().size() - 1);
             VState after = b.newStates().get(b.newStates().size() - 1);
@@ -214,7 +212,7 @@ class VisionStateIT {
      * its pid and the bindings, sim-robot runs no safe cycle, nothing awaits a reset, the history
      * keeps the verdict, and the refused half's process and segments go.
      */
-    static void shadowRefusedUpFront(Runtime rt, Path jar) throws Exception {
+    static void shadowRefusedUpFront(Runtime rt, String newId, Path jar) throws Exception {
         long visionPid = rt.pid("vision");
         String bindings = rt.cmd("arflex:bindings");
         Map<String, Object> robot0 = ChangeSetIT.stats(rt, "sim-robot");
@@ -242,8 +240,8 @@ class VisionStateIT {
         assertTrue(history.contains("outcome: refused: " + verdict) && history.contains(why)
                 && history.contains("update vision: no shadow run or window; refused"), history);
         rt.waitUntil("the refused half's process and segments gone", T, () -> Runtime.rtProcesses(rt.rid).stream()
-                .noneMatch(p -> p.contains("--instance 1-vision ")) && Files.list(Path.of("/dev/shm"))
-                .noneMatch(f -> f.getFileName().toString().startsWith("arflex." + rt.rid + ".1-vision.")));
+                .noneMatch(p -> p.contains("--instance " + newId + " ")) && Files.list(Path.of("/dev/shm"))
+                .noneMatch(f -> f.getFileName().toString().startsWith("arflex." + rt.rid + "." + newId + ".")));
         System.out.printf(Locale.ROOT, "VisionStateIT: a shadowed update refused up front in %d ms (command): %s%n", ms,
                 out.lines().filter(l -> l.contains(verdict)).findFirst().orElse(out));
     }
