@@ -36,8 +36,9 @@ import org.junit.jupiter.api.Test;
  * </ul>
  *
  * <p>Then 1.0.2 with a shadow run is refused up front (D70: vision's RT half registers no
- * re-adopt hook; {@link #shadowRefusedUpFront}), and then 1.0.2 with {@code set vision calibrate 1} in the same set: the new half adopts the block
- * and, asked to, calibrates again from the board, as a half without a state does at its first
+ * re-adopt hook; {@link #shadowRefusedUpFront}), and the same 1.0.2 without one, with
+ * {@code set vision calibrate 1} in the same set: the new half adopts the block and, asked to,
+ * calibrates again from the board, as a half without a state does at its first
  * frames. The same comparison is printed for it (the step a fresh calibration makes, which the
  * block spares), and its calibrations are asserted to have run (the check above would see one).
  * Throughout: the guard NORMAL, no safe cycle of sim-robot, nothing awaits a reset, the other
@@ -224,8 +225,7 @@ class VisionStateIT {
         String why = ") registers no re-adopt hook (arflex_component_readopt), so it cannot take the running half's "
                 + "state block arflex.VisionState 1.0 again at the switch of a shadow run; apply it without a shadow run "
                 + "(shadow 0; the new half then adopts the state at its START), or give its RT half a re-adopt hook; "
-                + "nothing changed "
-                + "(pid " + visionPid + " runs vision on)";
+                + "nothing changed (pid " + visionPid + " runs vision on)";
         assertTrue(out.startsWith("error: ") && out.contains(verdict) && out.contains(why), out);
         List<String> log = rt.logSince(logMark);
         assertTrue(log.stream().noneMatch(l -> l.contains("runs in shadow") || l.contains("READOPT")),
