@@ -360,8 +360,13 @@ class VisionStateIT {
                     e.subList(Math.max(0, errAfter - 4), e.size()).stream()
                             .map(s -> String.format(Locale.ROOT, "%.3f", s.value())).toList());
             Map<String, Object> robot1 = ChangeSetIT.stats(rt, "sim-robot");
-            assertNull(safety.snapshot().stream().filter(s -> s.mode() != CellRig.Safety.NORMAL).findFirst().orElse(null),
-                    "the guard left NORMAL");
+            CellRig.Safety trip = CellRig.tripped(safety.snapshot());
+            if (trip != null) {
+                printTrip(trip, safety.snapshot(), js.snapshot(), t0);
+                System.out.println("VisionStateIT: sim-robot over the update: overruns " + ChangeSetIT.delta(robot0, robot1,
+                        "overruns") + ", stats before " + robot0 + ", after " + robot1);
+            }
+            assertNull(trip, "the guard left NORMAL");
             assertEquals(0, ChangeSetIT.delta(robot0, robot1, "safeCycles"), "sim-robot ran safe cycles");
             return new Update(out, o, n, oldStates.snapshot(), newStates.snapshot(), same, compared);
         } finally {
@@ -369,6 +374,30 @@ class VisionStateIT {
                 p.close();
             }
         }
+    }
+
+    /** What led to a trip of the guard: its force and the arm's speed over the 200 ms before it (every 10th sample). */
+    static void printTrip(CellRig.Safety trip, List<CellRig.Safety> ss, List<CellRig.JointState> js, long applyNs) {
+        StringBuilder b = new StringBuilder(String.format(Locale.ROOT, "VisionStateIT: the guard tripped %.1f ms after the "
+                + "apply began: %s%n", (trip.tNs() - applyNs) / 1e6, trip));
+        int k = 0;
+        for (CellRig.Safety s : ss) {
+            if (s.tNs() > trip.tNs() - 200_000_000L && s.tNs() <= trip.tNs() && k++ % 10 == 0) {
+                b.append(String.format(Locale.ROOT, "  guard %+.1f ms: %.1f N%n", (s.tNs() - trip.tNs()) / 1e6, s.forceNorm()));
+            }
+        }
+        k = 0;
+        CellRig.JointState prev = null;
+        for (CellRig.JointState j : js) {
+            if (j.tNs() > trip.tNs() - 200_000_000L && j.tNs() <= trip.tNs() + 20_000_000L) {
+                if (k++ % 10 == 0 || (prev != null && j.seq() != prev.seq() + 1)) {
+                    b.append(String.format(Locale.ROOT, "  robot %+.1f ms: seq %d, max speed %.4f rad/s%n",
+                            (j.tNs() - trip.tNs()) / 1e6, j.seq(), j.maxSpeed()));
+                }
+                prev = j;
+            }
+        }
+        System.out.print(b);
     }
 
     static String sha256(Path f) throws Exception {
