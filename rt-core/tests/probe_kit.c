@@ -152,3 +152,13 @@ void shutdown_ok(struct arflex_host *h)
 	assert_int_equal(WEXITSTATUS(arflex_host_exit_status(h)), 0);
 	assert_int_equal(arflex_ctl_state(h->ctl), ARFLEX_STATE_EXITED);
 }
+
+void finish_probes(struct arflex_host *const *hosts, size_t n)
+{
+	for (size_t i = 0; i < n; i++)
+		shutdown_ok(hosts[i]);
+	for (size_t i = 0; i < n; i++)
+		arflex_host_destroy(hosts[i]);
+	unlink(logpath);
+	th_assert_clean(rid);
+}

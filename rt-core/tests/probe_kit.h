@@ -54,5 +54,11 @@ bool binding_is(const struct probe_out *o, uint64_t b);
 uint64_t binding_of(struct arflex_host *h);
 void spawn_ready(struct arflex_host *h);
 void shutdown_ok(struct arflex_host *h);
+/* The end of a case: each probe shut down cleanly (shutdown_ok) and destroyed, the log removed,
+ * nothing of the rid left (th_assert_clean). */
+void finish_probes(struct arflex_host *const *hosts, size_t n);
+#define FINISH_PROBES(...)                                                                    \
+	finish_probes((struct arflex_host *const[]){ __VA_ARGS__ },                           \
+		      sizeof((struct arflex_host *const[]){ __VA_ARGS__ }) / sizeof(struct arflex_host *))
 
 #endif

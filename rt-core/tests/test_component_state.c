@@ -111,14 +111,7 @@ static void state_published_and_adopted_once(void **state)
 	assert_int_equal(arflex_ctl_state(c.ctl), ARFLEX_STATE_READY);
 	assert_int_equal(arflex_port_destroy(&old), 0);
 
-	shutdown_ok(&a);
-	shutdown_ok(&b);
-	shutdown_ok(&c);
-	arflex_host_destroy(&a);
-	arflex_host_destroy(&b);
-	arflex_host_destroy(&c);
-	unlink(logpath);
-	th_assert_clean(rid);
+	FINISH_PROBES(&a, &b, &c);
 }
 
 /* D57: arflex_component_adopt_prepare: the hook runs at the ADOPT with the value published
@@ -164,14 +157,7 @@ static void adopt_prepare_runs_at_the_adopt(void **state)
 	assert_int_equal(o.adopt_calls, 0);
 	assert_int_equal(o.prepare_calls, 0);
 
-	shutdown_ok(&a);
-	shutdown_ok(&b);
-	shutdown_ok(&c);
-	arflex_host_destroy(&a);
-	arflex_host_destroy(&b);
-	arflex_host_destroy(&c);
-	unlink(logpath);
-	th_assert_clean(rid);
+	FINISH_PROBES(&a, &b, &c);
 }
 
 int main(void)

@@ -92,12 +92,7 @@ static void readopt_takes_the_newest_value_while_running(void **state)
 	assert_true(read_out(&b, &o));
 	assert_int_equal(o.adopt_calls, 1);
 
-	shutdown_ok(&a);
-	shutdown_ok(&b);
-	arflex_host_destroy(&a);
-	arflex_host_destroy(&b);
-	unlink(logpath);
-	th_assert_clean(rid);
+	FINISH_PROBES(&a, &b);
 }
 
 /* Every re-adopt the half cannot take is refused with its reason, and the half runs on with its
@@ -164,14 +159,7 @@ static void readopt_refusals_leave_the_half_as_it_was(void **state)
 	assert_int_equal(arflex_port_destroy(&empty), 0);
 	assert_int_equal(arflex_port_destroy(&other), 0);
 
-	shutdown_ok(&a);
-	shutdown_ok(&b);
-	shutdown_ok(&c);
-	arflex_host_destroy(&a);
-	arflex_host_destroy(&b);
-	arflex_host_destroy(&c);
-	unlink(logpath);
-	th_assert_clean(rid);
+	FINISH_PROBES(&a, &b, &c);
 }
 
 /* D70: a half advertises that it can re-adopt (ARFLEX_FLAG_READOPT in ctl.flags) once READY
@@ -212,16 +200,7 @@ static void readopt_capability_is_advertised_at_ready(void **state)
 	assert_false(arflex_ctl_flags(a.ctl) & ARFLEX_FLAG_READOPT);
 	assert_int_equal(arflex_host_readopt(&b, arflex_host_state(&a)->name, T_CALL), 0);
 
-	shutdown_ok(&a);
-	shutdown_ok(&b);
-	shutdown_ok(&c);
-	shutdown_ok(&d);
-	arflex_host_destroy(&a);
-	arflex_host_destroy(&b);
-	arflex_host_destroy(&c);
-	arflex_host_destroy(&d);
-	unlink(logpath);
-	th_assert_clean(rid);
+	FINISH_PROBES(&a, &b, &c, &d);
 }
 
 int main(void)
