@@ -158,6 +158,10 @@ final class SetAdmission {
         if (!u.contract().name().equals(n)) {
             return "the new version's contract is of '" + u.contract().name() + "'";
         }
+        if (inst.half != null && !inst.launching && !starter.launching(n) && stops.pending(n)) {
+            return "'" + n + "': a half it ran before is still stopping; apply the set again once it is gone "
+                    + "(arflex:list shows one process of it)";
+        }
         if (inst.half == null || inst.launching || stops.pending(n) || starter.launching(n)) {
             return "'" + n + "' has no running RT half to update (" + inst.life.state() + "); install or update it "
                     + "outside a change set";

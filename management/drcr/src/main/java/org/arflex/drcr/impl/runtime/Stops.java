@@ -170,6 +170,22 @@ final class Stops {
         return CompletableFuture.allOf(fs.toArray(CompletableFuture[]::new));
     }
 
+    /**
+     * Completes when the stops of these instances are recorded (see {@link Batch#done}): their
+     * names are no longer {@link #pending}; at once for an instance not stopping. Actor thread.
+     */
+    CompletableFuture<Void> recorded(Collection<Instance> instances) {
+        actor.checkThread();
+        List<CompletableFuture<Void>> fs = new ArrayList<>();
+        for (Instance i : instances) {
+            Batch b = stopping.get(i);
+            if (b != null) {
+                fs.add(b.done);
+            }
+        }
+        return CompletableFuture.allOf(fs.toArray(CompletableFuture[]::new));
+    }
+
     /** Completes when every batch submitted so far is recorded (any thread). */
     CompletableFuture<Void> idle() {
         return CompletableFuture.allOf(inFlight.stream().map(b -> b.done).toArray(CompletableFuture[]::new));

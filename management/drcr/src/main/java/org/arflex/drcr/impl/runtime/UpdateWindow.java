@@ -1,5 +1,6 @@
 package org.arflex.drcr.impl.runtime;
 
+import java.util.List;
 import java.util.Map;
 import java.util.concurrent.CompletableFuture;
 import java.util.function.Consumer;
@@ -44,7 +45,18 @@ final class UpdateWindow {
         this.cell = cell;
         this.handOver = new WindowHandOver(owner, cell, stops, segments, log);
         this.log = log;
-        this.report = new WindowReport(cell, log, progress, set, next.name, verdict);
+        // the verdict (and with it the command that applied the set) once the half that goes is
+        // gone and recorded: a set applied next finds the component with one half, not refused
+        // for a stop still pending (a CI run: "'vision' has no running RT half to update")
+        CompletableFuture<String> decided = new CompletableFuture<>();
+        this.report = new WindowReport(cell, log, progress, set, next.name, decided);
+        decided.whenComplete((v, e) -> stops.recorded(List.of(old, next)).whenComplete((x, y) -> {
+            if (e != null) {
+                verdict.completeExceptionally(e);
+            } else {
+                verdict.complete(v);
+            }
+        }));
         this.warm = warm;
         this.set = set;
         this.update = update;

@@ -104,6 +104,25 @@ class CellUpdateSetTest {
                 && !fake.openOutputs.containsKey("/arflex.t.1-stage.out.y"));
     }
 
+    /**
+     * A CI run: the next set, applied as soon as the command that committed an update returned,
+     * was refused ("'vision' has no running RT half to update") while the old half still stopped.
+     * The verdict now comes once the old half's stop is recorded.
+     */
+    @Test
+    void theVerdictComesOnceTheOldHalfIsGoneSoASetAppliedNextIsAdmitted() throws Exception {
+        rig.boundCell();
+        ChangeSetResult r = rig.apply(update(50));
+        assertTrue(r.applied(), r.text());
+        fake.running.get("1-stage").stats = cycles(50, 0);
+        rig.look();
+        rig.stepUntil("the verdict", () -> r.verdict().isDone());
+        assertTrue(r.verdict().join().startsWith("update stage: committed"), r.verdict().join());
+        assertFalse(fake.running.containsKey("stage"), "the old half is gone when the verdict comes: " + fake.events);
+        ChangeSetResult next = actor.call(() -> cell.planChangeSet(update(0)), 0);
+        assertTrue(next.admitted(), next.text());
+    }
+
     @Test
     void aNewVersionThatCrashesInItsWindowIsRolledBackWithoutARestart() throws Exception {
         rig.boundCell();
