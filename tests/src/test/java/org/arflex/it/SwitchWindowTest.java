@@ -75,4 +75,43 @@ class SwitchWindowTest {
         assertThrows(AssertionError.class, () -> w.assertNoReleaseLost("test", states(499, 600)));
         assertThrows(AssertionError.class, () -> w.assertNoReleaseLost("test", List.of()));
     }
+
+    /** Releases 2000, 3000, ... 9000 not run: the machine's own single stalls, 8 in the 10 s recorded. */
+    private static final long[] MACHINE = {2000, 3000, 4000, 5000, 6000, 7000, 8000, 9000};
+
+    private static long[] with(long[] base, long... more) {
+        long[] all = java.util.Arrays.copyOf(base, base.length + more.length);
+        System.arraycopy(more, 0, all, base.length, more.length);
+        return all;
+    }
+
+    @Test
+    void aStallAroundTheTurnLikeTheMachinesOwnPassesAndOneLongerOrOneMoreFails() {
+        SwitchWindow w = SwitchWindow.of(List.of(LINE)); // counted from 498 to 503.8 ms
+        // 8 single stalls in ~10 s: ~0.05 expected in the turn's 5 ms; one is the machine's (p > 1e-3), two are not
+        assertEquals(1, SwitchWindow.allowedStalls(w.losses(states(0, 10_000, MACHINE), false), 5));
+        w.assertNoReleaseLost("test", states(0, 10_000, with(MACHINE, 501)));
+        AssertionError longer = assertThrows(AssertionError.class,
+                () -> w.assertNoReleaseLost("test", states(0, 10_000, with(MACHINE, 500, 501))));
+        org.junit.jupiter.api.Assertions.assertTrue(longer.getMessage().contains("did not run 2 releases")
+                && longer.getMessage().contains("lost 8 releases in 8 stalls (longest 1)"), longer.getMessage());
+        assertThrows(AssertionError.class, () -> w.assertNoReleaseLost("test", states(0, 10_000, with(MACHINE, 499, 502))));
+    }
+
+    @Test
+    void aStallAroundTheTurnFailsOnAMachineThatShowedNoneOrTooLittleToKnow() {
+        SwitchWindow w = SwitchWindow.of(List.of(LINE));
+        assertThrows(AssertionError.class, () -> w.assertNoReleaseLost("test", states(0, 10_000, 501)));
+        // 1.5 s of baseline with stalls in it: too short to know the machine's rate
+        assertEquals(0, SwitchWindow.allowedStalls(w.losses(states(0, 1_500, 100, 900, 1200), false), 5));
+        assertThrows(AssertionError.class, () -> w.assertNoReleaseLost("test", states(0, 1_500, 100, 900, 1200, 501)));
+    }
+
+    @Test
+    void theAllowanceGrowsWithTheMachinesRateAndTheTurnsLength() {
+        SwitchWindow.Losses quiet = new SwitchWindow.Losses(12, 12, 1, 10_000); // 1.2 stalls per 1000 ms
+        assertEquals(1, SwitchWindow.allowedStalls(quiet, 30)); // lambda 0.036: P(>1) 6.4e-4
+        assertEquals(4, SwitchWindow.allowedStalls(new SwitchWindow.Losses(200, 200, 3, 10_000), 30)); // lambda 0.6: P(>4) 3.4e-4
+        assertEquals(0, SwitchWindow.allowedStalls(new SwitchWindow.Losses(0, 0, 0, 60_000), 30));
+    }
 }
