@@ -381,8 +381,8 @@ class ReconfigBench {
                 + "p99 %s us, >200 us %s, ovr %d (quiet %s us, %s, %d) | not run %d of %d, %d in a row (quiet %d of %d) | "
                 + "at the turn %s | jump %.3f mrad (before %.3f) | force %.1f N  safe %s  resets %d  restarts %d%s",
                 r.example(), r.rep(), r.ok() ? "ok" : "FAIL", num(r.prepMs()), num(r.switchMs()), r.cmdMs(),
-                CellChurnBench.Tally.num(r.window().quantileUs(0.99)), over(r.window()),
-                r.window().overruns, CellChurnBench.Tally.num(r.quiet().quantileUs(0.99)),
+                p99(r.window()), over(r.window()),
+                r.window().overruns, p99(r.quiet()),
                 over(r.quiet()), r.quiet().overruns, r.missed(), r.releases(), r.longest(),
                 r.quietMissed(), r.quietReleases(), r.turnMissed() < 0 ? "-" : r.turnMissed() + " of " + r.turnReleases(),
                 r.jump() * 1e3, r.jumpBefore() * 1e3, r.force(),
@@ -396,6 +396,21 @@ class ReconfigBench {
     static String over(CellChurnBench.Tally t) {
         return t.overflow > 0 || t.binNs == 0 ? Long.toString(t.overflow)
                 : "0 (max " + CellChurnBench.Tally.num(t.maxUs()) + " us)";
+    }
+
+    /** rt-core's latency histogram: ARFLEX_HIST_BINS (control.h) bins of the control block's bin width. */
+    static final int HIST_BINS = 2000;
+
+    /**
+     * The p99 wake-up latency in us for the table: "> R" when it lies beyond the histogram's range
+     * R (more than 1 % of the wake-ups later than it), "-" without wake-ups.
+     */
+    static String p99(CellChurnBench.Tally t) {
+        double v = t.quantileUs(0.99);
+        if (v == Double.POSITIVE_INFINITY) {
+            return "> " + num(HIST_BINS * t.binNs / 1e3);
+        }
+        return num(v);
     }
 
     static String num(double d) {
@@ -424,7 +439,7 @@ class ReconfigBench {
                     num(rs.stream().mapToDouble(Row::prepMs).filter(Double::isFinite).max().orElse(Double.NaN)),
                     num(rs.stream().mapToDouble(Row::switchMs).filter(Double::isFinite).max().orElse(Double.NaN)),
                     num(rs.stream().mapToDouble(Row::cmdMs).max().orElse(Double.NaN)),
-                    CellChurnBench.Tally.num(w.quantileUs(0.99)), CellChurnBench.Tally.num(q.quantileUs(0.99)),
+                    p99(w), p99(q),
                     over(w), over(q), w.overruns, q.overruns,
                     rs.stream().mapToLong(Row::missed).sum(), rel, rate * rel,
                     rs.stream().mapToDouble(Row::jump).max().orElse(0) * 1e3,
