@@ -8,6 +8,7 @@ set -euo pipefail
 PACKAGES=(
   openjdk-17-jdk-headless maven          # Java build (Java 17: SPI Fly/Jetty break on 25)
   gcc g++ cmake ninja-build pkg-config   # native build
+  ccache                                 # compiler cache: the suite's two native builds (D76)
   libexpat1-dev                          # the host API reads contracts (rt-core host_contract.h)
   libcmocka-dev libgtest-dev             # C and C++ unit tests
   libmujoco-dev libqhull-dev             # physics (MuJoCo's CMake config needs qhull)
