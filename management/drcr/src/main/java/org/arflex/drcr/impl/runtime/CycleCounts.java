@@ -5,8 +5,8 @@ import org.arflex.drcr.impl.supervisor.RtHalf;
 
 /**
  * The counters of an update's two halves from a baseline on, for its shadow run (D42) and its
- * rollback window (D38): the new half's cycles since, and each half's overruns and deadline
- * misses since. Reads both halves' control blocks; a half that is gone reads as null. Actor
+ * rollback window (D38): the new half's cycles since, and each half's late cycles since (an
+ * overrun or a deadline miss; one cycle that did both counts once, {@link LateCycles}, D73). Reads both halves' control blocks; a half that is gone reads as null. Actor
  * thread.
  */
 final class CycleCounts {
@@ -34,8 +34,8 @@ final class CycleCounts {
         ControlBlock.Stats n = newStats();
         ControlBlock.Stats o = oldStats();
         cycles0 = n == null ? 0 : n.cycles();
-        newBad0 = bad(n);
-        oldBad0 = bad(o);
+        newBad0 = LateCycles.of(n, next.contract.taskType());
+        oldBad0 = LateCycles.of(o, old.contract.taskType());
     }
 
     /** The new half's control block now, or null when it is gone or unreadable. */
@@ -62,17 +62,17 @@ final class CycleCounts {
         return lastCycles;
     }
 
-    /** The new half's overruns and deadline misses since the baseline, from {@code n}. */
+    /** The new half's late cycles since the baseline, from {@code n}. */
     long newBad(ControlBlock.Stats n) {
-        return bad(n) - newBad0;
+        return LateCycles.of(n, next.contract.taskType()) - newBad0;
     }
 
-    /** The old half's overruns and deadline misses since the baseline, from {@code o}. */
+    /** The old half's late cycles since the baseline, from {@code o}. */
     long oldBad(ControlBlock.Stats o) {
-        return bad(o) - oldBad0;
+        return LateCycles.of(o, old.contract.taskType()) - oldBad0;
     }
 
-    /** Whether the new half had more than the old one plus {@link ChangeSetExecutor#OVERRUN_ALLOWANCE}. */
+    /** Whether the new half had more late cycles than the old one plus {@link ChangeSetExecutor#OVERRUN_ALLOWANCE}. */
     static boolean beyondAllowance(long newBad, long oldBad) {
         return newBad > oldBad + ChangeSetExecutor.OVERRUN_ALLOWANCE;
     }
@@ -83,9 +83,5 @@ final class CycleCounts {
         } catch (RuntimeException e) {
             return null;
         }
-    }
-
-    static long bad(ControlBlock.Stats s) {
-        return s == null ? 0 : s.overruns() + s.deadlineMisses();
     }
 }

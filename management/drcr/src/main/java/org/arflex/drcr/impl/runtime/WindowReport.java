@@ -76,7 +76,7 @@ final class WindowReport {
     /** The window is at {@code cycles} of {@code window}. */
     void cycle(long cycles, long window, long pid, long newBad, long oldBad) {
         progress.cycles(ChangeSetProgress.WINDOW, String.format(Locale.ROOT, "update %s: rollback "
-                + "window, cycle %d of %d of pid %d (%d overruns or deadline misses, the old version %d)", name,
+                + "window, cycle %d of %d of pid %d (%d cycles late, the old version %d)", name,
                 cycles, window, pid, newBad, oldBad), name, cycles, window, null, 0, 0);
     }
 
@@ -91,7 +91,7 @@ final class WindowReport {
     }
 
     static String committed(long cycles, long newBad, long oldBad) {
-        return String.format(Locale.ROOT, "committed: the new version ran %d cycles (%d overruns or "
-                + "deadline misses, the old one %d)", cycles, newBad, oldBad);
+        return String.format(Locale.ROOT, "committed: the new version ran %d cycles (%d cycles late, "
+                + "the old one %d)", cycles, newBad, oldBad);
     }
 }

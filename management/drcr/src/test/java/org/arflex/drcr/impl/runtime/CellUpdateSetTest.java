@@ -208,6 +208,57 @@ class CellUpdateSetTest {
                 "the consumer is back on the old half before the new one stops: " + fake.events);
     }
 
+    /**
+     * D73: rt-core counts a cycle that ended after its deadline (= its period here) both as an
+     * overrun and as a deadline miss. Two late cycles of the new half against none of the old
+     * are within the allowance (2 cycles), not 4 beyond it; CI's StateConversionIT rolled a
+     * good tcp-correction back for "4 of its first 310 cycles (the old one: 0)". A version late
+     * in every 10th cycle is still rolled back at its third, in the same words.
+     */
+    @Test
+    void aCycleThatOverranAndMissedItsDeadlineIsOneLateCycle() throws Exception {
+        rig.boundCell();
+        FakeLauncher.FakeHalf oldHalf = fake.running.get("stage");
+        oldHalf.stats = UpdateRig.late(5000, 1);
+        ChangeSetResult r = rig.apply(update(1000));
+        FakeLauncher.FakeHalf newHalf = fake.running.get("1-stage");
+        newHalf.stats = UpdateRig.late(10, 0);
+        rig.look();
+        oldHalf.stats = UpdateRig.late(5310, 1);
+        newHalf.stats = UpdateRig.late(310, ChangeSetExecutor.OVERRUN_ALLOWANCE);
+        rig.look();
+        assertFalse(r.verdict().isDone(), () -> "rolled back: " + r.verdict().join());
+        oldHalf.stats = UpdateRig.late(6000, 1);
+        newHalf.stats = UpdateRig.late(1000, ChangeSetExecutor.OVERRUN_ALLOWANCE);
+        rig.look();
+        rig.stepUntil("the verdict", () -> r.verdict().isDone());
+        assertEquals("update stage: committed: the new version ran 1000 cycles (" + ChangeSetExecutor.OVERRUN_ALLOWANCE
+                + " cycles late, the old one 0)", r.verdict().join());
+    }
+
+    @Test
+    void aVersionLateInEveryTenthCycleIsRolledBackAtItsThird() throws Exception {
+        rig.boundCell();
+        FakeLauncher.FakeHalf oldHalf = fake.running.get("stage");
+        oldHalf.stats = UpdateRig.late(5000, 1);
+        ChangeSetResult r = rig.apply(update(1000));
+        FakeLauncher.FakeHalf newHalf = fake.running.get("1-stage");
+        newHalf.stats = UpdateRig.late(10, 0);
+        rig.look();
+        oldHalf.stats = UpdateRig.late(5020, 1);
+        newHalf.stats = UpdateRig.late(30, 2);
+        rig.look();
+        assertFalse(r.verdict().isDone(), () -> "rolled back: " + r.verdict().join());
+        oldHalf.stats = UpdateRig.late(5030, 1);
+        newHalf.stats = UpdateRig.late(40, 3);
+        rig.look();
+        rig.stepUntil("the verdict", () -> r.verdict().isDone());
+        assertTrue(r.verdict().join().contains("rolled back after 40 cycles of the new version (file:/x/stage-1.1.jar): "
+                + "the new version overran or missed its deadline in 3 of its first 40 cycles (the old one, on the same "
+                + "inputs: 0)"), r.verdict().join());
+        assertEquals(oldHalf.pid, cell.instance("stage").orElseThrow().half.pid());
+    }
+
     /** An arflex.Sample payload: seq, t_ns, value. */
     private static byte[] sample(double value) {
         return UpdateRig.sample(7, 1000, value);
