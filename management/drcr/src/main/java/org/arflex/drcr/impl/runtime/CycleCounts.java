@@ -6,8 +6,9 @@ import org.arflex.drcr.impl.supervisor.RtHalf;
 /**
  * The counters of an update's two halves from a baseline on, for its shadow run (D42) and its
  * rollback window (D38): the new half's cycles since, and each half's late cycles since (an
- * overrun or a deadline miss; one cycle that did both counts once, {@link LateCycles}, D73). Reads both halves' control blocks; a half that is gone reads as null. Actor
- * thread.
+ * overrun or a deadline miss; one cycle that did both counts once, {@link LateCycles}, D73),
+ * and how many of those were the machine's ({@link MachineStalls}). Reads both halves' control
+ * blocks; a half that is gone reads as null. Actor thread.
  */
 final class CycleCounts {
     private final Instance next;
@@ -20,8 +21,45 @@ final class CycleCounts {
     private long lastCycles;
     private long newBad0;
     private long oldBad0;
+    private final MachineStalls stalls;
+    private long lastNewLate;
+    private long lastOldLate;
 
-    CycleCounts(Instance next, RtHalf nextHalf, Instance old, RtHalf oldHalf, boolean neverBack) {
+    /**
+     * Both halves' late cycles since the baseline, and how many of each were in a stall of the
+     * machine (D73): the rest are the half's own.
+     */
+    record Late(long newLate, long oldLate, long newMachine, long oldMachine, MachineStalls stalls) {
+        long newOwn() {
+            return newLate - newMachine;
+        }
+
+        long oldOwn() {
+            return oldLate - oldMachine;
+        }
+
+        /** Whether the new half's own late cycles exceed the old one's plus {@link ChangeSetExecutor#OVERRUN_ALLOWANCE}. */
+        boolean beyondAllowance() {
+            return CycleCounts.beyondAllowance(newOwn(), oldOwn());
+        }
+
+        /**
+         * What was not counted, e.g. {@code "; not counted: 3 late cycles of the new one and 4
+         * of the old one in the same looks as a late cycle of sim-robot (priority 80) on CPU 0,
+         * the machine's"}; empty when nothing was left out.
+         */
+        String notCounted() {
+            if (newMachine == 0 && oldMachine == 0) {
+                return "";
+            }
+            return "; not counted: " + newMachine + " late cycles of the new one and " + oldMachine + " of the old "
+                    + "one in the same looks (" + ChangeSetExecutor.WATCH_MS + " ms) as a late cycle of "
+                    + stalls.witnesses() + " on CPU " + stalls.cpu() + ", the machine's";
+        }
+    }
+
+    CycleCounts(Cell cell, Instance next, RtHalf nextHalf, Instance old, RtHalf oldHalf, boolean neverBack) {
+        this.stalls = new MachineStalls(cell, next);
         this.next = next;
         this.nextHalf = nextHalf;
         this.old = old;
@@ -36,6 +74,23 @@ final class CycleCounts {
         cycles0 = n == null ? 0 : n.cycles();
         newBad0 = LateCycles.of(n, next.contract.taskType());
         oldBad0 = LateCycles.of(o, old.contract.taskType());
+        lastNewLate = 0;
+        lastOldLate = 0;
+        stalls.baseline();
+    }
+
+    /**
+     * One look (D73): both halves' late cycles since the baseline from {@code n} and {@code o}
+     * (read before this call, so a stall that made them late shows in the other halves'
+     * counters already), those in a stall of the machine counted apart.
+     */
+    Late look(ControlBlock.Stats n, ControlBlock.Stats o) {
+        long newLate = n == null ? lastNewLate : newBad(n);
+        long oldLate = o == null ? lastOldLate : oldBad(o);
+        stalls.look(Math.max(0, newLate - lastNewLate), Math.max(0, oldLate - lastOldLate));
+        lastNewLate = newLate;
+        lastOldLate = oldLate;
+        return new Late(newLate, oldLate, stalls.newMachine(), stalls.oldMachine(), stalls);
     }
 
     /** The new half's control block now, or null when it is gone or unreadable. */

@@ -53,10 +53,10 @@ final class ShadowReport {
         return "cancelled: update " + rejected + " was rejected in shadow (" + reason + ")";
     }
 
-    static String overran(long newBad, long cycles, long oldBad) {
+    static String overran(CycleCounts.Late late, long cycles) {
         return String.format(Locale.ROOT, "it overran or missed its deadline in %d of its %d cycles (the running "
-                + "version, on the same inputs: %d; allowed %d more)", newBad, cycles, oldBad,
-                ChangeSetExecutor.OVERRUN_ALLOWANCE);
+                + "version, on the same inputs: %d; allowed %d more%s)", late.newOwn(), cycles, late.oldOwn(),
+                ChangeSetExecutor.OVERRUN_ALLOWANCE, late.notCounted());
     }
 
     static String noneCompared(long cycles, List<ChangeSet.Tolerance> tolerances) {
