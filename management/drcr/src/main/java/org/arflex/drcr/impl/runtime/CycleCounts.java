@@ -29,13 +29,14 @@ final class CycleCounts {
      * Both halves' late cycles since the baseline, and how many of each were in a stall of the
      * machine (D73): the rest are the half's own.
      */
-    record Late(long newLate, long oldLate, long newMachine, long oldMachine, MachineStalls stalls) {
+    record Late(long newLate, long oldLate, long newMachine, long oldMachine, long oldBehindNew, MachineStalls stalls) {
         long newOwn() {
             return newLate - newMachine;
         }
 
+        /** The old half's late cycles set against the new one's: neither the machine's nor maybe the new one's doing. */
         long oldOwn() {
-            return oldLate - oldMachine;
+            return oldLate - oldMachine - oldBehindNew;
         }
 
         /** Whether the new half's own late cycles exceed the old one's plus {@link ChangeSetExecutor#OVERRUN_ALLOWANCE}. */
@@ -49,17 +50,20 @@ final class CycleCounts {
          * the machine's"}; empty when nothing was left out.
          */
         String notCounted() {
+            String behind = oldBehindNew == 0 ? "" : "; not set against the new one's: " + oldBehindNew + " late cycles "
+                    + "of the old one in the same looks (" + ChangeSetExecutor.WATCH_MS + " ms) as the new one's, which "
+                    + "may have delayed it on its CPU";
             if (newMachine == 0 && oldMachine == 0) {
-                return "";
+                return behind;
             }
             return "; not counted: " + newMachine + " late cycles of the new one and " + oldMachine + " of the old "
                     + "one in the same looks (" + ChangeSetExecutor.WATCH_MS + " ms) as a late cycle of "
-                    + stalls.witnesses() + " on CPU " + stalls.cpu() + ", the machine's";
+                    + stalls.witnesses() + " on CPU " + stalls.cpu() + ", the machine's" + behind;
         }
     }
 
     CycleCounts(Cell cell, Instance next, RtHalf nextHalf, Instance old, RtHalf oldHalf, boolean neverBack) {
-        this.stalls = new MachineStalls(cell, next);
+        this.stalls = new MachineStalls(cell, next, old);
         this.next = next;
         this.nextHalf = nextHalf;
         this.old = old;
@@ -90,7 +94,7 @@ final class CycleCounts {
         stalls.look(Math.max(0, newLate - lastNewLate), Math.max(0, oldLate - lastOldLate));
         lastNewLate = newLate;
         lastOldLate = oldLate;
-        return new Late(newLate, oldLate, stalls.newMachine(), stalls.oldMachine(), stalls);
+        return new Late(newLate, oldLate, stalls.newMachine(), stalls.oldMachine(), stalls.oldBehindNew(), stalls);
     }
 
     /** The new half's control block now, or null when it is gone or unreadable. */

@@ -318,6 +318,37 @@ class CellUpdateSetTest {
                 r.verdict().join());
     }
 
+    /**
+     * D73, found on the real runtime: a version late in every 10th cycle, at the old half's
+     * priority on its CPU, delays the old half as often (71 and 73 late cycles in 706) and was
+     * committed. The old half's late cycles in the looks the new one was late in are not set
+     * against the new one's; in other looks they are.
+     */
+    @Test
+    void aLateVersionThatDelaysTheOldHalfAsOftenIsRolledBack() throws Exception {
+        rig.boundCell();
+        FakeLauncher.FakeHalf oldHalf = fake.running.get("stage");
+        oldHalf.stats = UpdateRig.late(5000, 0);
+        ChangeSetResult r = rig.apply(update(1000));
+        FakeLauncher.FakeHalf newHalf = fake.running.get("1-stage");
+        newHalf.stats = UpdateRig.late(10, 0);
+        rig.look();
+        oldHalf.stats = UpdateRig.late(5015, 1); // alone: set against the new one's
+        newHalf.stats = UpdateRig.late(15, 0);
+        rig.look();
+        for (int k = 1; k <= 4 && !r.verdict().isDone(); k++) {
+            oldHalf.stats = UpdateRig.late(5015 + 10L * k, 1 + k);
+            newHalf.stats = UpdateRig.late(15 + 10L * k, k);
+            rig.look();
+        }
+        rig.stepUntil("the verdict", () -> r.verdict().isDone());
+        assertTrue(r.verdict().join().contains("the new version overran or missed its deadline in 4 of its first 55 "
+                + "cycles (the old one, on the same inputs: 1; not set against the new one's: 4 late cycles of the old "
+                + "one in the same looks (10 ms) as the new one's, which may have delayed it on its CPU)"),
+                r.verdict().join());
+        assertEquals(oldHalf.pid, cell.instance("stage").orElseThrow().half.pid());
+    }
+
     /** D73: a version late every 10th cycle is not excused by a stall now and then. */
     @Test
     void aVersionLateInEveryTenthCycleIsRolledBackDespiteAStall() throws Exception {
