@@ -314,12 +314,15 @@ static void env_var_makes_every_nth_cycle_late(void **state)
 		arflex_host_kill(&h, SIGKILL);
 	arflex_host_destroy(&h);
 	th_assert_clean(rid);
+	print_message("late every 5: %llu cycles, %llu overruns, %llu deadline misses\n", (unsigned long long)cycles,
+		      (unsigned long long)overruns, (unsigned long long)misses);
 	assert_int_equal(start, 0);
 	assert_int_equal(down, 0);
 	assert_true(cycles >= 100);
-	/* one in 5, each counted as an overrun and a deadline miss; the machine may add one or two */
-	assert_true(misses >= cycles / 5 && misses <= cycles / 5 + 3);
-	assert_true(overruns >= cycles / 5 && overruns <= cycles / 5 + 3);
+	/* one in 5, each counted as an overrun and a deadline miss; a loaded machine adds some (a
+	 * quiet one: none, 20 of 101 in four runs) */
+	assert_true(misses >= cycles / 5 && misses <= cycles / 5 + 10);
+	assert_true(overruns >= cycles / 5 && overruns <= cycles / 5 + 10);
 }
 
 static void env_var_enables_injection(void **state)
