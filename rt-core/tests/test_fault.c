@@ -269,6 +269,62 @@ static void env_var_crashes_after_cycles(void **state)
 	assert_int_equal(cycles, 19);
 }
 
+/* ARFLEX_FAULT_LATE_EVERY_CYCLES=n (D73): every n-th update after the START spins past the next
+ * release: one late cycle (an overrun and a missed deadline, counted in both) in n, nothing else.
+ * What the update tests' "late in every 10th cycle" version does to a half. */
+static char env_late[64];
+
+static void env_var_makes_every_nth_cycle_late(void **state)
+{
+	struct arflex_host_output out;
+	struct arflex_param_slot p;
+	struct arflex_host_opts o;
+	struct arflex_host h;
+	int k = 0, start, down;
+	uint64_t cycles = 0, overruns, misses, deadline;
+
+	(void)state;
+	th_rid(rid, sizeof(rid), "flate");
+	fill_opts(&o, &p, &out, "probe");
+	out.spec.type.elem_size = PROBE_OUT_BYTES;
+	for (char **e = environ; *e && k < 250; e++)
+		if (strncmp(*e, "ARFLEX_", 7))
+			envp[k++] = *e;
+	snprintf(env_late, sizeof(env_late), "ARFLEX_FAULT_LATE_EVERY_CYCLES=%d", 5);
+	envp[k++] = env_late;
+	envp[k] = NULL;
+	assert_int_equal(arflex_host_create(&h, &o), 0);
+	assert_int_equal(arflex_host_spawn(&h, ARFLEX_PROBE_EXE, NULL, envp), 0);
+	assert_int_equal(arflex_host_wait_state(&h, ARFLEX_STATE_READY, 10 * SEC), 0);
+	start = arflex_host_start(&h, 2 * SEC);
+	deadline = arflex_sys_now_ns() + 10 * SEC;
+	while (start == 0 && arflex_sys_now_ns() < deadline &&
+	       (cycles = __atomic_load_n(&h.ctl->stats.cycles, __ATOMIC_ACQUIRE)) < 100)
+		arflex_sys_sleep_until(arflex_sys_now_ns() + 1000000u);
+	if (start == 0)
+		arflex_host_stop(&h, 2 * SEC);
+	cycles = h.ctl->stats.cycles;
+	overruns = h.ctl->stats.overruns;
+	misses = h.ctl->stats.deadline_misses;
+	/* the half is shut down before anything is asserted: a failure leaves no process */
+	down = arflex_host_shutdown(&h, 2 * SEC);
+	if (down == 0)
+		down = arflex_host_wait_exit(&h, 10 * SEC);
+	else
+		arflex_host_kill(&h, SIGKILL);
+	arflex_host_destroy(&h);
+	th_assert_clean(rid);
+	print_message("late every 5: %llu cycles, %llu overruns, %llu deadline misses\n", (unsigned long long)cycles,
+		      (unsigned long long)overruns, (unsigned long long)misses);
+	assert_int_equal(start, 0);
+	assert_int_equal(down, 0);
+	assert_true(cycles >= 100);
+	/* one in 5, each counted as an overrun and a deadline miss; a loaded machine adds some (a
+	 * quiet one: none, 20 of 101 in four runs) */
+	assert_true(misses >= cycles / 5 && misses <= cycles / 5 + 10);
+	assert_true(overruns >= cycles / 5 && overruns <= cycles / 5 + 10);
+}
+
 static void env_var_enables_injection(void **state)
 {
 	(void)state;
@@ -302,6 +358,7 @@ int main(void)
 		cmocka_unit_test(component_attach_every_call_fails),
 		cmocka_unit_test(env_var_refuses_start),
 		cmocka_unit_test(env_var_crashes_after_cycles),
+		cmocka_unit_test(env_var_makes_every_nth_cycle_late),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);

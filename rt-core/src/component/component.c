@@ -194,6 +194,28 @@ static void fault_crash_env(struct arflex_component *c)
 	fprintf(stderr, "arflex: %s: test fault: SIGSEGV in update %lld after each START\n", c->name, n);
 }
 
+/* The test fault of a late cycle (D73): ARFLEX_FAULT_LATE_EVERY_CYCLES=<n>, 1..10^9, makes every
+ * n-th update after each START spin until 100 us past the next release: one late cycle (an
+ * overrun and a missed deadline) every n cycles, as a version too slow now and then would be.
+ * Only the update tests' deliberately late versions set it; nothing shipped does. */
+static void fault_late_env(struct arflex_component *c)
+{
+	const char *s = getenv("ARFLEX_FAULT_LATE_EVERY_CYCLES");
+	char *end;
+	long long n;
+
+	if (!s || !*s)
+		return;
+	n = strtoll(s, &end, 10);
+	if (*end || n < 1 || n > 1000000000LL) {
+		fprintf(stderr, "arflex: %s: ARFLEX_FAULT_LATE_EVERY_CYCLES=%s ignored (a count 1..10^9)\n",
+			c->name, s);
+		return;
+	}
+	c->fault_late_every = (uint64_t)n;
+	fprintf(stderr, "arflex: %s: test fault: every %lld-th update after each START ends late\n", c->name, n);
+}
+
 int arflex_component_main(int argc, char **argv, const struct arflex_component_ops *ops)
 {
 	static struct arflex_component comp;
@@ -216,6 +238,7 @@ int arflex_component_main(int argc, char **argv, const struct arflex_component_o
 		return r > 0 ? ARFLEX_EXIT_OK : ARFLEX_EXIT_USAGE;
 	fault_start_env(c);
 	fault_crash_env(c);
+	fault_late_env(c);
 
 	memset(&sa, 0, sizeof(sa));
 	sa.sa_handler = on_signal;

@@ -120,6 +120,14 @@ int arflex_comp_rt_cycle(void *arg, uint64_t release_ns)
 			sigaction(SIGSEGV, &dfl, NULL);
 			raise(SIGSEGV);
 		}
+		if (c->fault_late_every && ++c->fault_late_updates % c->fault_late_every == 0) {
+			/* the test fault (D73): this cycle ends past its next release, so past its
+			 * deadline too (one late cycle); spins, as a too slow update would */
+			uint64_t until = release_ns + ctl->config.period_ns + 100000u;
+
+			while (arflex_sys_now_ns() < until)
+				;
+		}
 	}
 	return r < 0 ? r : 0;
 }
@@ -131,6 +139,7 @@ int arflex_comp_rt_start(void *arg)
 
 	c->safe = false;
 	c->fault_updates = 0;
+	c->fault_late_updates = 0;
 	c->clk_binding = 0; /* the first poll takes the clock's binding as new */
 	c->clk_seen = 0;
 	memset(&c->hbw, 0, sizeof(c->hbw));

@@ -50,6 +50,16 @@ final class FaultyVersions {
         return withFault(dir, bundle, exeEntry, "ARFLEX_FAULT_READOPT_ERRNO", errno, who, "refusing every READOPT");
     }
 
+    /**
+     * As {@link #crashingAfterCycles}, with rt-core's test fault {@code
+     * ARFLEX_FAULT_LATE_EVERY_CYCLES=<cycles>} (D73): every {@code cycles}-th update after a START
+     * spins until 100 us past the next release, one late cycle in {@code cycles}.
+     */
+    static byte[] lateEvery(Path dir, Path bundle, String exeEntry, int cycles, String who) throws IOException {
+        return withFault(dir, bundle, exeEntry, "ARFLEX_FAULT_LATE_EVERY_CYCLES", cycles, who,
+                "late in every " + cycles + "th cycle after each START");
+    }
+
     private static byte[] withFault(Path dir, Path bundle, String exeEntry, String fault, int value, String who,
                                     String what) throws IOException {
         String file = exeEntry.substring(exeEntry.lastIndexOf('/') + 1);

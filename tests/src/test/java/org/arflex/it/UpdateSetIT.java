@@ -371,4 +371,33 @@ class UpdateSetIT {
             assertTrue(r.jump() <= ChangeSetIT.JUMP_BOUND, "reference step " + r.jump() + " rad per source cycle");
         }
     }
+
+    /**
+     * D73: a version late in every 10th cycle (rt-core's test fault ARFLEX_FAULT_LATE_EVERY_CYCLES=10:
+     * that update spins past the next release) is rolled back early in its window on the moving
+     * arm, however the machine's stalls are counted; the old half runs the component again.
+     */
+    @Test
+    void aVersionLateInEveryTenthCycleIsRolledBackEarlyInItsWindow() throws Exception {
+        CellRig.assertBuilt(CellRig.SIM_ROBOT, CellRig.TRAJECTORY, CellRig.FORCE_GUARD, CellRig.TCP_CORRECTION);
+        try (Runtime rt = new Runtime("update-late")) {
+            FailSafeIT.movingCell(rt);
+            Path dir = Files.createDirectories(rt.dir.resolve("versions"));
+            Path jar = version(dir, "1.0.3-late", FaultyVersions.lateEvery(dir, CellRig.TCP_CORRECTION, EXE, 10,
+                    "UpdateSetIT"));
+            Run r = update(rt, jar, 1000);
+            String verdict = r.out().lines().filter(l -> l.contains("update tcp-correction:")).reduce("", (a, b) -> b);
+            System.out.println("UpdateSetIT: a version late in every 10th cycle: " + verdict);
+            java.util.regex.Matcher m = java.util.regex.Pattern.compile("rolled back after (\\d+) cycles of the new "
+                    + "version \\([^)]*\\): the new version overran or missed its deadline in (\\d+) of its first").matcher(verdict);
+            assertTrue(m.find(), r.out());
+            assertTrue(Long.parseLong(m.group(1)) <= 200, "rolled back after " + m.group(1) + " cycles: " + verdict);
+            assertEquals(r.oldPid(), rt.pid("tcp-correction"), "the old half runs the component again");
+            rt.awaitState("ACTIVE", T, "tcp-correction", "sim-robot", "force-guard", "trajectory");
+            assertTrue(CellRig.armFollows(rt, "trajectory"), rt.cmd("arflex:bindings"));
+            rt.waitUntil("the late version's process and segment gone", T, () -> Runtime.rtProcesses(rt.rid).stream()
+                    .noneMatch(p -> p.contains("--instance 1-tcp-correction ")) && !Files.exists(
+                    rt.segment("1-tcp-correction", "corrected")));
+        }
+    }
 }

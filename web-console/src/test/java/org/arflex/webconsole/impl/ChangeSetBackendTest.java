@@ -273,9 +273,9 @@ class ChangeSetBackendTest {
         assertEquals("the new version (pid 77) exited: killed by signal 11", back.get("why"));
 
         Map<String, Object> committed = ChangeSetOutcome.of(answer(true, null, TEACH_PLAN
-                + "update tcp-correction: passed its shadow run of 201 cycles (0 overruns or deadline misses, the running "
+                + "update tcp-correction: passed its shadow run of 201 cycles (0 cycles late, the running "
                 + "version 0; 8 values compared)\n"
-                + "update tcp-correction: committed: the new version ran 1000 cycles (0 overruns or deadline misses, the "
+                + "update tcp-correction: committed: the new version ran 1000 cycles (0 cycles late, the "
                 + "old one 0)\n"));
         assertEquals("committed", committed.get("outcome"));
         assertEquals(2, ((List<?>) committed.get("updates")).size());

@@ -8,7 +8,7 @@ import org.arflex.drcr.impl.supervisor.RtHalf;
  * the new half
  * <ul>
  * <li>overruns or misses its deadline in more cycles than the running version in the same time,
- * plus {@link ChangeSetExecutor#OVERRUN_ALLOWANCE} ({@link CycleCounts});</li>
+ * plus {@link ChangeSetExecutor#OVERRUN_ALLOWANCE}, the machine's stalls apart ({@link CycleCounts}, D73);</li>
  * <li>gives an output value outside an envelope ({@link Envelopes}), or a field whose value
  * differs from the running version's by more than its tolerance ({@link ShadowComparison});</li>
  * <li>stops cycling for its heartbeat timeout, or has not run its cycles within four times their
@@ -34,7 +34,7 @@ final class ShadowChecks {
         this.cell = cell;
         this.update = update;
         this.next = next;
-        this.counts = new CycleCounts(next, nextHalf, old, oldHalf, true);
+        this.counts = new CycleCounts(cell, next, nextHalf, old, oldHalf, true);
         this.comparison = new ShadowComparison(cell, update.tolerances(), old, oldHalf, next);
     }
 
@@ -55,14 +55,13 @@ final class ShadowChecks {
         if (cycles != before) {
             limits.progressed(nowMs);
         }
-        long newBad = counts.newBad(n);
-        long oldBad = counts.oldBad(counts.oldStats());
-        return new Look(cycles, cycles != before, newBad, oldBad, why(nowMs, cycles, newBad, oldBad));
+        CycleCounts.Late late = counts.look(n, counts.oldStats());
+        return new Look(cycles, cycles != before, late.newLate(), late.oldLate(), why(nowMs, cycles, late));
     }
 
-    private String why(long nowMs, long cycles, long newBad, long oldBad) {
-        if (CycleCounts.beyondAllowance(newBad, oldBad)) {
-            return ShadowReport.overran(newBad, cycles, oldBad);
+    private String why(long nowMs, long cycles, CycleCounts.Late late) {
+        if (late.beyondAllowance()) {
+            return ShadowReport.overran(late, cycles);
         }
         String outside = Envelopes.outside(cell, next, update.envelopes());
         if (outside != null) {

@@ -23,7 +23,7 @@ final class ShadowReport {
         ChangeSet.Tolerance t = worst < 0 ? null : update.tolerances().get(worst);
         double largest = worst < 0 ? 0 : cmp.largest(worst);
         progress.cycles(ChangeSetProgress.SHADOW, String.format(Locale.ROOT, "update %s: shadow run of pid %d, cycle %d "
-                + "of %d, %d values compared, %d overruns or deadline misses%s", name, pid, cycles,
+                + "of %d, %d values compared, %d cycles late%s", name, pid, cycles,
                 update.shadow(), cmp.compared(), bad, t == null ? "" : String.format(Locale.ROOT,
                         ", worst %s.%s %.3g from the running version's (tolerance %s)", t.port(), t.field(),
                         largest, t.abs())), name, cycles, update.shadow(),
@@ -34,7 +34,7 @@ final class ShadowReport {
     static String passed(List<ChangeSet.Tolerance> tolerances, ShadowComparison cmp, long cycles, long newBad,
                          long oldBad) {
         StringBuilder sb = new StringBuilder(String.format(Locale.ROOT, "passed its shadow run of %d cycles "
-                + "(%d overruns or deadline misses, the running version %d; %d values compared", cycles, newBad,
+                + "(%d cycles late, the running version %d; %d values compared", cycles, newBad,
                 oldBad, cmp.compared()));
         for (int i = 0; i < tolerances.size(); i++) {
             ChangeSet.Tolerance t = tolerances.get(i);
@@ -53,10 +53,10 @@ final class ShadowReport {
         return "cancelled: update " + rejected + " was rejected in shadow (" + reason + ")";
     }
 
-    static String overran(long newBad, long cycles, long oldBad) {
+    static String overran(CycleCounts.Late late, long cycles) {
         return String.format(Locale.ROOT, "it overran or missed its deadline in %d of its %d cycles (the running "
-                + "version, on the same inputs: %d; allowed %d more)", newBad, cycles, oldBad,
-                ChangeSetExecutor.OVERRUN_ALLOWANCE);
+                + "version, on the same inputs: %d; allowed %d more%s)", late.newOwn(), cycles, late.oldOwn(),
+                ChangeSetExecutor.OVERRUN_ALLOWANCE, late.notCounted());
     }
 
     static String noneCompared(long cycles, List<ChangeSet.Tolerance> tolerances) {

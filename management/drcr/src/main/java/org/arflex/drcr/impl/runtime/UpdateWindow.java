@@ -11,8 +11,8 @@ import org.arflex.drcr.impl.supervisor.RtHalf;
 /**
  * An update after its switch (D38): the old half keeps running on its inputs, unread, for
  * {@code window} cycles of the new one; a crash of the new half, an output outside an envelope
- * ({@link Envelopes}), or more overruns and deadline misses than the old had in the same cycles
- * (plus {@link ChangeSetExecutor#OVERRUN_ALLOWANCE}, {@link CycleCounts}) rolls the component
+ * ({@link Envelopes}), or more late cycles than the old had in the same cycles, the machine's
+ * stalls apart (plus {@link ChangeSetExecutor#OVERRUN_ALLOWANCE}, {@link CycleCounts}, D73) rolls the component
  * back: the old half is the component's again and its consumers are bound back to its segments
  * (each at its next cycle boundary), the new half stops. Else the old half stops when the window
  * is over ({@link WindowHandOver} does either; the texts are {@link WindowReport}'s). Actor thread.
@@ -64,7 +64,7 @@ final class UpdateWindow {
         this.oldHalf = oldHalf;
         this.next = next;
         this.nextHalf = next.half;
-        this.counts = nextHalf == null ? null : new CycleCounts(next, nextHalf, old, oldHalf, false);
+        this.counts = nextHalf == null ? null : new CycleCounts(cell, next, nextHalf, old, oldHalf, false);
     }
 
     void begin() {
@@ -120,15 +120,16 @@ final class UpdateWindow {
         ControlBlock.Stats n = counts.newStats();
         ControlBlock.Stats o = counts.oldStats();
         long cycles = cyclesNow();
-        long newBad = counts.newBad(n);
-        long oldBad = counts.oldBad(o);
+        CycleCounts.Late late = counts.look(n, o);
+        long newBad = late.newLate();
+        long oldBad = late.oldLate();
         String outside = Envelopes.outside(cell, next, update.envelopes());
         if (outside != null) {
             rollback(outside, System.nanoTime());
-        } else if (CycleCounts.beyondAllowance(newBad, oldBad)) {
-            rollback(WindowReport.overran(newBad, cycles, oldBad), System.nanoTime());
+        } else if (late.beyondAllowance()) {
+            rollback(WindowReport.overran(late, cycles), System.nanoTime());
         } else if (cycles >= update.window() || cell.config().monotonicNs().getAsLong() - tEndNs >= 0) {
-            end(WindowReport.committed(cycles, newBad, oldBad), cycles);
+            end(WindowReport.committed(cycles, late), cycles);
         } else {
             if (cycles != lastPublished) {
                 lastPublished = cycles;

@@ -76,7 +76,7 @@ final class WindowReport {
     /** The window is at {@code cycles} of {@code window}. */
     void cycle(long cycles, long window, long pid, long newBad, long oldBad) {
         progress.cycles(ChangeSetProgress.WINDOW, String.format(Locale.ROOT, "update %s: rollback "
-                + "window, cycle %d of %d of pid %d (%d overruns or deadline misses, the old version %d)", name,
+                + "window, cycle %d of %d of pid %d (%d cycles late, the old version %d)", name,
                 cycles, window, pid, newBad, oldBad), name, cycles, window, null, 0, 0);
     }
 
@@ -85,13 +85,15 @@ final class WindowReport {
                 + "): no rollback possible any more";
     }
 
-    static String overran(long newBad, long cycles, long oldBad) {
+    /** The new half's own late cycles were too many (D38, D73): what was counted, and what not. */
+    static String overran(CycleCounts.Late late, long cycles) {
         return String.format(Locale.ROOT, "the new version overran or missed its deadline in %d "
-                + "of its first %d cycles (the old one, on the same inputs: %d)", newBad, cycles, oldBad);
+                + "of its first %d cycles (the old one, on the same inputs: %d%s)", late.newOwn(), cycles,
+                late.oldOwn(), late.notCounted());
     }
 
-    static String committed(long cycles, long newBad, long oldBad) {
-        return String.format(Locale.ROOT, "committed: the new version ran %d cycles (%d overruns or "
-                + "deadline misses, the old one %d)", cycles, newBad, oldBad);
+    static String committed(long cycles, CycleCounts.Late late) {
+        return String.format(Locale.ROOT, "committed: the new version ran %d cycles (%d cycles late, "
+                + "the old one %d%s)", cycles, late.newOwn(), late.oldOwn(), late.notCounted());
     }
 }

@@ -89,7 +89,7 @@ class CellShadowRunTest {
         rig.look();
         rig.stepUntil("the verdict", () -> r.verdict().isDone());
         String v = r.verdict().join();
-        assertTrue(v.startsWith("update stage: passed its shadow run of 100 cycles (0 overruns or deadline misses, the "
+        assertTrue(v.startsWith("update stage: passed its shadow run of 100 cycles (0 cycles late, the "
                 + "running version 0; 1 values compared, y.value at most 0.00400 from the running version's (tolerance "
                 + "0.01))\nupdate stage: committed: the new version ran 60 cycles"), v);
         rig.stepUntil("the old half stopped", () -> !fake.running.containsKey("stage")
@@ -165,7 +165,11 @@ class CellShadowRunTest {
         FakeLauncher.FakeHalf newHalf = fake.running.get("1-stage");
         newHalf.stats = cycles(20, 0);
         rig.look();
-        oldHalf.stats = cycles(9080, 5); // one more for the running version in the same time
+        // one more for the running version in the same time, in a look without one of the new
+        // half's (D73: one in the same look as the new half's may be the new half's doing)
+        oldHalf.stats = cycles(9050, 5);
+        newHalf.stats = cycles(50, 0);
+        rig.look();
         newHalf.stats = cycles(80, 1 + 1 + ChangeSetExecutor.OVERRUN_ALLOWANCE);
         rig.look();
         rig.stepUntil("the outcome", f::isDone);
@@ -175,6 +179,30 @@ class CellShadowRunTest {
                 + "inputs: 1; allowed " + ChangeSetExecutor.OVERRUN_ALLOWANCE + " more); nothing changed (pid "
                 + oldHalf.pid + " runs stage on)", r.refusal());
         assertFalse(fake.events.contains("user BIND x " + NEW_Y), fake.events::toString);
+        rig.stepUntil("the new half stopped", () -> !fake.running.containsKey("1-stage"));
+    }
+
+    /** D73: in shadow too, a cycle that overran and missed its deadline counts once. */
+    @Test
+    void inShadowALateCycleCountsOnceAndAThirdBeyondTheRunningVersionRejects() throws Exception {
+        rig.boundCell();
+        FakeLauncher.FakeHalf oldHalf = fake.running.get("stage");
+        oldHalf.stats = UpdateRig.late(9000, 4);
+        CompletableFuture<ChangeSetResult> f = applyIntoShadow(update(200, 1000, List.of()));
+        FakeLauncher.FakeHalf newHalf = fake.running.get("1-stage");
+        newHalf.stats = UpdateRig.late(20, 0);
+        rig.look();
+        oldHalf.stats = UpdateRig.late(9100, 4);
+        newHalf.stats = UpdateRig.late(100, ChangeSetExecutor.OVERRUN_ALLOWANCE);
+        rig.look();
+        assertFalse(f.isDone(), () -> "rejected: " + f.join().text());
+        newHalf.stats = UpdateRig.late(120, ChangeSetExecutor.OVERRUN_ALLOWANCE + 1);
+        rig.look();
+        rig.stepUntil("the outcome", f::isDone);
+        assertEquals("update stage: rejected in shadow after 120 cycles: it overran or missed its deadline in "
+                + (ChangeSetExecutor.OVERRUN_ALLOWANCE + 1) + " of its 120 cycles (the running version, on the same "
+                + "inputs: 0; allowed " + ChangeSetExecutor.OVERRUN_ALLOWANCE + " more); nothing changed (pid "
+                + oldHalf.pid + " runs stage on)", f.join().refusal());
         rig.stepUntil("the new half stopped", () -> !fake.running.containsKey("1-stage"));
     }
 

@@ -119,7 +119,7 @@ class ChangeSetProgressTest {
         assertEquals(0.004, p.worstDeviation, 1e-9);
         assertEquals(0.01, p.tolerance);
         assertTrue(p.step.startsWith("update stage: shadow run of pid " + newHalf.pid + ", cycle 40 of 100, 1 values "
-                + "compared, 0 overruns or deadline misses, worst y.value 0.00400 from the running version's (tolerance "
+                + "compared, 0 cycles late, worst y.value 0.00400 from the running version's (tolerance "
                 + "0.01)"), p.step);
         // a set of one update: its one entry says what the fields above say (D60)
         assertEquals(1, p.updates.length);

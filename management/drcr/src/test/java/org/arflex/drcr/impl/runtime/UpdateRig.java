@@ -70,6 +70,14 @@ final class UpdateRig extends SteppedCell {
         return new ControlBlock.Stats(n, overruns, 0, 0, 0, 0, 0, 0, 0, 0);
     }
 
+    /**
+     * Counters of a 1 ms half with {@code late} late cycles (D73): each overran its period and
+     * missed its deadline, as rt-core counts a cycle late beyond deadline = period.
+     */
+    static ControlBlock.Stats late(long n, long late) {
+        return new ControlBlock.Stats(n, late, late, 0, 0, 0, 0, 0, 0, 0);
+    }
+
     /** An arflex.Sample payload: seq, t_ns, value. */
     static byte[] sample(long seq, long tNs, double value) {
         return ByteBuffer.allocate(24).order(ByteOrder.LITTLE_ENDIAN).putLong(seq).putLong(tNs).putDouble(value).array();

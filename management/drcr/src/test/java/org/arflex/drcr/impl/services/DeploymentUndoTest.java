@@ -86,7 +86,7 @@ class DeploymentUndoTest {
         assertEquals(List.of("update tcp-correction did not start at the switch"), DeploymentUndo.notHeld(
                 "update tcp-correction: the new version did not start\n", List.of("tcp-correction")));
         assertEquals(List.of(), DeploymentUndo.notHeld("update tcp-correction: committed: the new version ran 300 "
-                + "cycles (0 overruns or deadline misses, the old one 0)\n", List.of("tcp-correction")));
+                + "cycles (0 cycles late, the old one 0)\n", List.of("tcp-correction")));
         assertEquals(List.of(), DeploymentUndo.notHeld("warning: no verdict of the rollback window yet: timeout\n",
                 List.of("tcp-correction")), "no verdict: nothing is taken back on a guess");
         assertEquals(List.of(), DeploymentUndo.notHeld(ROLLED_BACK, List.of("tcp")), "another component's name");
