@@ -171,6 +171,24 @@ static void fault_start_env(struct arflex_component *c)
 	fprintf(stderr, "arflex: %s: test fault: every START is refused with errno %ld\n", c->name, n);
 }
 
+/* A test fault's count from the environment variable @var: 1..10^9, else 0 (unset, or said
+ * ignored on stderr). */
+static uint64_t fault_count_env(const struct arflex_component *c, const char *var)
+{
+	const char *s = getenv(var);
+	char *end;
+	long long n;
+
+	if (!s || !*s)
+		return 0;
+	n = strtoll(s, &end, 10);
+	if (*end || n < 1 || n > 1000000000LL) {
+		fprintf(stderr, "arflex: %s: %s=%s ignored (a count 1..10^9)\n", c->name, var, s);
+		return 0;
+	}
+	return (uint64_t)n;
+}
+
 /* The test fault of a crash counted in cycles (D68): ARFLEX_FAULT_CRASH_AFTER_CYCLES=<n>,
  * 1..10^9, makes the RT thread raise SIGSEGV in its n-th update after each START, whatever the
  * time its spawn, READY and START took (a crash "a fixed time after the spawn" fell before the
@@ -178,20 +196,10 @@ static void fault_start_env(struct arflex_component *c)
  * set it; nothing shipped does. */
 static void fault_crash_env(struct arflex_component *c)
 {
-	const char *s = getenv("ARFLEX_FAULT_CRASH_AFTER_CYCLES");
-	char *end;
-	long long n;
-
-	if (!s || !*s)
-		return;
-	n = strtoll(s, &end, 10);
-	if (*end || n < 1 || n > 1000000000LL) {
-		fprintf(stderr, "arflex: %s: ARFLEX_FAULT_CRASH_AFTER_CYCLES=%s ignored (a count 1..10^9)\n",
-			c->name, s);
-		return;
-	}
-	c->fault_crash_after = (uint64_t)n;
-	fprintf(stderr, "arflex: %s: test fault: SIGSEGV in update %lld after each START\n", c->name, n);
+	c->fault_crash_after = fault_count_env(c, "ARFLEX_FAULT_CRASH_AFTER_CYCLES");
+	if (c->fault_crash_after)
+		fprintf(stderr, "arflex: %s: test fault: SIGSEGV in update %llu after each START\n", c->name,
+			(unsigned long long)c->fault_crash_after);
 }
 
 /* The test fault of a late cycle (D73): ARFLEX_FAULT_LATE_EVERY_CYCLES=<n>, 1..10^9, makes every
@@ -200,20 +208,10 @@ static void fault_crash_env(struct arflex_component *c)
  * Only the update tests' deliberately late versions set it; nothing shipped does. */
 static void fault_late_env(struct arflex_component *c)
 {
-	const char *s = getenv("ARFLEX_FAULT_LATE_EVERY_CYCLES");
-	char *end;
-	long long n;
-
-	if (!s || !*s)
-		return;
-	n = strtoll(s, &end, 10);
-	if (*end || n < 1 || n > 1000000000LL) {
-		fprintf(stderr, "arflex: %s: ARFLEX_FAULT_LATE_EVERY_CYCLES=%s ignored (a count 1..10^9)\n",
-			c->name, s);
-		return;
-	}
-	c->fault_late_every = (uint64_t)n;
-	fprintf(stderr, "arflex: %s: test fault: every %lld-th update after each START ends late\n", c->name, n);
+	c->fault_late_every = fault_count_env(c, "ARFLEX_FAULT_LATE_EVERY_CYCLES");
+	if (c->fault_late_every)
+		fprintf(stderr, "arflex: %s: test fault: every %llu-th update after each START ends late\n",
+			c->name, (unsigned long long)c->fault_late_every);
 }
 
 int arflex_component_main(int argc, char **argv, const struct arflex_component_ops *ops)

@@ -160,14 +160,7 @@ final class Stops {
 
     /** Completes when the stops of these instances have settled (see {@link Batch#settled}); actor thread. */
     CompletableFuture<Void> settled(Collection<Instance> instances) {
-        List<CompletableFuture<Void>> fs = new ArrayList<>();
-        for (Instance i : instances) {
-            Batch b = stopping.get(i);
-            if (b != null) {
-                fs.add(b.settled);
-            }
-        }
-        return CompletableFuture.allOf(fs.toArray(CompletableFuture[]::new));
+        return all(instances, b -> b.settled);
     }
 
     /**
@@ -176,14 +169,14 @@ final class Stops {
      */
     CompletableFuture<Void> recorded(Collection<Instance> instances) {
         actor.checkThread();
-        List<CompletableFuture<Void>> fs = new ArrayList<>();
-        for (Instance i : instances) {
-            Batch b = stopping.get(i);
-            if (b != null) {
-                fs.add(b.done);
-            }
-        }
-        return CompletableFuture.allOf(fs.toArray(CompletableFuture[]::new));
+        return all(instances, b -> b.done);
+    }
+
+    /** {@code which} future of the batch each of these instances stops in, all of them. */
+    private CompletableFuture<Void> all(Collection<Instance> instances,
+                                        java.util.function.Function<Batch, CompletableFuture<Void>> which) {
+        return CompletableFuture.allOf(instances.stream().map(stopping::get).filter(java.util.Objects::nonNull)
+                .map(which).toArray(CompletableFuture[]::new));
     }
 
     /** Completes when every batch submitted so far is recorded (any thread). */
