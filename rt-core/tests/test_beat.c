@@ -138,6 +138,22 @@ static void bridges_a_silence_within_the_grace(void **state)
 	assert_true(stats().max_silence_ns >= 10 * MS);
 }
 
+/* D75: the writer's own lateness is kept, so a lost heartbeat can be told from a late writer */
+static void keeps_its_own_longest_gap_and_last_round(void **state)
+{
+	uint64_t t0 = mono(), r;
+
+	(void)state;
+	assert_int_equal(arflex_beat_start(2 * MS, 2000 * MS, 0), 0);
+	AWAIT(stats().rounds >= 3, true);
+	/* two rounds or more: a gap between them of at least about one period */
+	assert_true(stats().max_gap_ns >= MS);
+	assert_true(stats().last_round_ns >= t0 && stats().last_round_ns <= mono());
+	r = stats().rounds;
+	AWAIT(stats().rounds > r, true);
+	assert_true(stats().last_round_ns >= t0 + 2 * MS);
+}
+
 static void a_removed_block_is_never_written(void **state)
 {
 	uint64_t r;
@@ -186,6 +202,7 @@ int main(void)
 		cmocka_unit_test_teardown(writes_every_block_while_alive, teardown),
 		cmocka_unit_test_teardown(withholds_after_the_grace_and_resumes, teardown),
 		cmocka_unit_test_teardown(bridges_a_silence_within_the_grace, teardown),
+		cmocka_unit_test_teardown(keeps_its_own_longest_gap_and_last_round, teardown),
 		cmocka_unit_test_teardown(a_removed_block_is_never_written, teardown),
 		cmocka_unit_test_teardown(slots_are_bounded, teardown),
 		cmocka_unit_test_teardown(fifo_as_asked_or_says_why_not, teardown),

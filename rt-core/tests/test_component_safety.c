@@ -34,6 +34,9 @@ static void safe_when_heartbeat_stops(void **state)
 	assert_true(arflex_ctl_flags(h.ctl) & ARFLEX_FLAG_SAFE_ACTIVE);
 	assert_false(arflex_ctl_flags(h.ctl) & ARFLEX_FLAG_RESET_REQUIRED);
 	assert_true(h.ctl->warnings[ARFLEX_WARN_SAFE] >= 1);
+	/* D75: the cause is said: the heartbeat, not a reset */
+	assert_true(h.ctl->warnings[ARFLEX_WARN_HB_LOST] >= 1);
+	assert_int_equal(h.ctl->warnings[ARFLEX_WARN_RESET], 0);
 	assert_true(read_out(&h, &o));
 	assert_int_equal(o.safe_firsts, 1);
 	/* heartbeat back: without "moves hardware" the component resumes by itself */
@@ -60,6 +63,9 @@ static void moves_hardware_needs_operator_reset(void **state)
 	assert_int_equal(arflex_host_start(&h, T_CALL), 0);
 	assert_true(wait_out(&h, safe_above, 3, false));
 	assert_true(arflex_ctl_flags(h.ctl) & ARFLEX_FLAG_RESET_REQUIRED);
+	/* D75: the reset was latched for the heartbeat: that is the cause said */
+	assert_true(h.ctl->warnings[ARFLEX_WARN_HB_LOST] >= 1);
+	assert_int_equal(h.ctl->warnings[ARFLEX_WARN_RESET], 0);
 	assert_int_equal(arflex_host_reset(&h, T_CALL), -EAGAIN); /* heartbeat still stale */
 	/* fresh heartbeat alone does not resume motion */
 	assert_true(read_out(&h, &o));
@@ -100,6 +106,9 @@ static void component_requires_reset(void **state)
 	assert_true(read_out(&h, &o));
 	assert_int_equal(o.updates, 5); /* none after the one that latched */
 	assert_int_equal(o.safe_firsts, 1);
+	/* D75: safe mode for the component's own latch, not for the heartbeat (none is judged) */
+	assert_int_equal(h.ctl->warnings[ARFLEX_WARN_RESET], 1);
+	assert_int_equal(h.ctl->warnings[ARFLEX_WARN_HB_LOST], 0);
 	safe_before = o.safe_calls;
 	assert_int_equal(arflex_host_reset(&h, T_CALL), 0);
 	assert_true(wait_out(&h, updates_above, 15, false));

@@ -35,6 +35,8 @@ struct arflex_beat_stats {
 	uint64_t last_silence_ns;     /**< the manager's silence at the last round */
 	uint32_t registered;          /**< control blocks registered now */
 	int32_t fifo;                 /**< SCHED_FIFO priority of the thread, 0 if SCHED_OTHER */
+	uint64_t max_gap_ns;          /**< the writer's own longest time between two rounds (D75) */
+	uint64_t last_round_ns;       /**< CLOCK_MONOTONIC of its last round, 0 before the first */
 };
 
 /**

@@ -126,6 +126,9 @@ enum arflex_warn_kind {
 	ARFLEX_WARN_INPUT = 9,       /**< an input read failed (retries exhausted, bad header) */
 	ARFLEX_WARN_SAFE = 10,       /**< safe mode entered (heartbeat lost or reset required) */
 	ARFLEX_WARN_FORGED = 11,     /**< a mailbox request with a wrong token was ignored */
+	ARFLEX_WARN_HB_LOST = 12,    /**< the runtime heartbeat went stale (safe mode, D75) */
+	ARFLEX_WARN_RESET = 13,      /**< safe mode for RESET_REQUIRED alone: set by the
+				      *   component itself (a latched trip) or its manager (D75) */
 };
 
 /** Causes of ctl->hold (bits 0..7). Detail (bits 8..15): for SAFETY_INPUT the enum

@@ -45,6 +45,12 @@ static struct timespec to_ts(uint64_t ns)
 static void beat_round(uint64_t now, uint64_t *seen_alive)
 {
 	uint64_t alive = LOAD(&alive_ns), silence = now > alive ? now - alive : 0;
+	uint64_t last = LOAD(&st.last_round_ns);
+
+	/* D75: the writer's own lateness, told apart from the manager's silence */
+	if (last && now > last && now - last > LOAD(&st.max_gap_ns))
+		STORE(&st.max_gap_ns, now - last);
+	STORE(&st.last_round_ns, now);
 
 	if (alive != *seen_alive) {
 		uint64_t gap = alive - *seen_alive;
@@ -233,4 +239,6 @@ void arflex_beat_stats(struct arflex_beat_stats *out)
 	out->last_silence_ns = LOAD(&st.last_silence_ns);
 	out->registered = __atomic_load_n(&st.registered, __ATOMIC_RELAXED);
 	out->fifo = __atomic_load_n(&st.fifo, __ATOMIC_RELAXED);
+	out->max_gap_ns = LOAD(&st.max_gap_ns);
+	out->last_round_ns = LOAD(&st.last_round_ns);
 }

@@ -14,10 +14,13 @@
 static void check_heartbeat(struct arflex_component *c, uint64_t now)
 {
 	struct arflex_ctl *ctl = c->ctl;
-	bool stale, want;
+	bool stale, want, hb_lost;
 
 	stale = arflex_hb_judge(&c->hbw, LOAD(&ctl->runtime_hb_ns), now, ctl->config.period_ns,
 				ctl->config.hb_timeout_ns);
+	hb_lost = stale;
+	if (stale && !LOAD(&c->hb_stale)) /* D75: each loss counted, so the log says the cause */
+		__atomic_add_fetch(&ctl->warnings[ARFLEX_WARN_HB_LOST], 1, __ATOMIC_RELAXED);
 	STORE(&c->hb_stale, stale);
 	c->lost_seen = (LOAD(&ctl->flags) & ARFLEX_FLAG_SUPERVISOR_LOST) != 0;
 	stale = stale || c->lost_seen;
@@ -30,6 +33,8 @@ static void check_heartbeat(struct arflex_component *c, uint64_t now)
 		c->safe_first = true;
 		__atomic_or_fetch(&ctl->flags, ARFLEX_FLAG_SAFE_ACTIVE, __ATOMIC_RELEASE);
 		__atomic_add_fetch(&ctl->warnings[ARFLEX_WARN_SAFE], 1, __ATOMIC_RELAXED);
+		if (!hb_lost && !c->lost_seen) /* RESET_REQUIRED alone: a latch, not the heartbeat */
+			__atomic_add_fetch(&ctl->warnings[ARFLEX_WARN_RESET], 1, __ATOMIC_RELAXED);
 	} else if (!want && c->safe) {
 		c->safe = false;
 		__atomic_and_fetch(&ctl->flags, ~(uint32_t)ARFLEX_FLAG_SAFE_ACTIVE,

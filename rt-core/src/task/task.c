@@ -24,8 +24,11 @@ static const char *const warn_names[ARFLEX_WARN_KINDS] = {
 	[ARFLEX_WARN_UPDATE] = "update hook returned an error",
 	[ARFLEX_WARN_PARAM] = "parameter request rejected",
 	[ARFLEX_WARN_INPUT] = "input read failed",
-	[ARFLEX_WARN_SAFE] = "safe mode entered (runtime heartbeat lost or operator reset required)",
+	[ARFLEX_WARN_SAFE] = "safe mode entered",
 	[ARFLEX_WARN_FORGED] = "mailbox request with a wrong token ignored",
+	[ARFLEX_WARN_HB_LOST] = "runtime heartbeat lost (unchanged for longer than its timeout): safe mode",
+	[ARFLEX_WARN_RESET] = "operator reset required (latched by the component itself, e.g. a trip, or set "
+			      "by its manager), not a lost heartbeat: safe mode",
 };
 
 const char *arflex_warn_name(unsigned kind)

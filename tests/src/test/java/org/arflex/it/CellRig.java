@@ -425,6 +425,18 @@ final class CellRig {
         static final int NORMAL = 0;
         static final int PROTECTIVE_STOP = 2;
 
+        /** The names of the flags set (arflex.SafetyState): a force trip, a lost heartbeat, a reset awaited (D75). */
+        String causes() {
+            String[] names = {"FORCE_LIMIT", "HEARTBEAT_LOST", "RESET_REQUIRED"};
+            java.util.StringJoiner j = new java.util.StringJoiner("|");
+            for (int b = 0; b < names.length; b++) {
+                if ((flags & (1 << b)) != 0) {
+                    j.add(names[b]);
+                }
+            }
+            return j.length() == 0 ? "no flag" : j.toString();
+        }
+
         static Safety of(java.nio.ByteBuffer v) {
             return v == null ? null
                     : new Safety(v.getLong(0), v.getLong(8), v.getInt(16), v.getInt(20), v.getDouble(24), v.getDouble(32),

@@ -194,7 +194,10 @@ class UpdateSetIT {
                 if (tripped != null || worst.forceNorm() > 100) {
                     System.out.println("UpdateSetIT: the runtime since the apply:\n" + String.join("\n", rt.logSince(logMark)));
                 }
-                assertNull(tripped, "the guard left NORMAL: " + tripped);
+                if (tripped != null) { // D75: what led to it (a force trip or a lost heartbeat, the robot's seq gaps)
+                    VisionStateIT.printTrip("UpdateSetIT", tripped, ss, js.snapshot(), t0);
+                }
+                assertNull(tripped, () -> "the guard left NORMAL (" + tripped.causes() + "): " + tripped);
                 int robotFlags = CellPorts.ctlFlags(Path.of("/dev/shm/arflex." + rt.rid + ".sim-robot.ctl"));
                 assertEquals(0, robotFlags & CellPorts.FLAG_SAFE_ACTIVE, "sim-robot in safe mode");
                 assertEquals(List.of(), CellRig.awaitingReset(rt));

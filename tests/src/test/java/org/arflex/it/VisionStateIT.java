@@ -362,7 +362,7 @@ class VisionStateIT {
             Map<String, Object> robot1 = ChangeSetIT.stats(rt, "sim-robot");
             CellRig.Safety trip = CellRig.tripped(safety.snapshot());
             if (trip != null) {
-                printTrip(trip, safety.snapshot(), js.snapshot(), t0);
+                printTrip("VisionStateIT", trip, safety.snapshot(), js.snapshot(), t0);
                 System.out.println("VisionStateIT: sim-robot over the update: overruns " + ChangeSetIT.delta(robot0, robot1,
                         "overruns") + ", stats before " + robot0 + ", after " + robot1);
             }
@@ -377,9 +377,10 @@ class VisionStateIT {
     }
 
     /** What led to a trip of the guard: its force and the arm's speed over the 200 ms before it (every 10th sample). */
-    static void printTrip(CellRig.Safety trip, List<CellRig.Safety> ss, List<CellRig.JointState> js, long applyNs) {
-        StringBuilder b = new StringBuilder(String.format(Locale.ROOT, "VisionStateIT: the guard tripped %.1f ms after the "
-                + "apply began: %s%n", (trip.tNs() - applyNs) / 1e6, trip));
+    static void printTrip(String who, CellRig.Safety trip, List<CellRig.Safety> ss, List<CellRig.JointState> js,
+            long applyNs) {
+        StringBuilder b = new StringBuilder(String.format(Locale.ROOT, "%s: the guard tripped %.1f ms after the apply began"
+                + " (%s): %s%n", who, (trip.tNs() - applyNs) / 1e6, trip.causes(), trip));
         int k = 0;
         for (CellRig.Safety s : ss) {
             if (s.tNs() > trip.tNs() - 200_000_000L && s.tNs() <= trip.tNs() && k++ % 10 == 0) {

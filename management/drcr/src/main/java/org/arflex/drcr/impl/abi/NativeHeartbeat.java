@@ -36,7 +36,8 @@ public final class NativeHeartbeat {
     }
 
     /** struct arflex_beat_stats. */
-    @Structure.FieldOrder({"rounds", "withheld", "bridged", "maxSilenceNs", "lastSilenceNs", "registered", "fifo"})
+    @Structure.FieldOrder({"rounds", "withheld", "bridged", "maxSilenceNs", "lastSilenceNs", "registered", "fifo",
+        "maxGapNs", "lastRoundNs"})
     public static final class Stats extends Structure {
         public long rounds;
         public long withheld;
@@ -45,6 +46,10 @@ public final class NativeHeartbeat {
         public long lastSilenceNs;
         public int registered;
         public int fifo;
+        /** The writer's own longest time between two rounds (D75). */
+        public long maxGapNs;
+        /** CLOCK_MONOTONIC of its last round, 0 before the first. */
+        public long lastRoundNs;
     }
 
     private static final int ETIMEDOUT = 110;

@@ -21,10 +21,13 @@ public final class HeartbeatBridge {
     public static final String ENTRY = "native/linux-x86_64/libarflex_beat.so";
     /** A bridged stall is logged when it is the longest yet and at least this long. */
     static final long REPORT_MS = 100;
+    /** The writer's own lateness is logged when it is the longest yet and at least this long (D75). */
+    static final long LATE_WRITER_MS = 50;
 
     private final NativeHeartbeat writer;
     private final Consumer<String> log;
     private long reportedNs;
+    private long reportedGapNs;
 
     private HeartbeatBridge(NativeHeartbeat writer, Consumer<String> log) {
         this.writer = writer;
@@ -97,6 +100,24 @@ public final class HeartbeatBridge {
                             + writer.graceMs() + " ms: the heartbeat was withheld") + " (" + s.withheld
                     + " rounds withheld so far)");
         }
+        String late = lateWriter(s.maxGapNs, reportedGapNs);
+        if (late != null) {
+            reportedGapNs = s.maxGapNs;
+            log.accept(late);
+        }
+    }
+
+    /**
+     * D75: the line that says the native writer itself ran late (its thread not run: the RT halves
+     * saw the heartbeat that much older whatever the JVM did), when {@code maxGapNs} is a new
+     * longest at or above {@link #LATE_WRITER_MS}; else null.
+     */
+    static String lateWriter(long maxGapNs, long reportedGapNs) {
+        if (maxGapNs <= reportedGapNs || maxGapNs < LATE_WRITER_MS * 1_000_000L) {
+            return null;
+        }
+        return "arflex: the native heartbeat writer ran " + maxGapNs / 1_000_000L + " ms after its round before (longest"
+                + " yet): its thread was not run, so every RT half saw the runtime heartbeat that much older";
     }
 
     /** Stops the writer. */

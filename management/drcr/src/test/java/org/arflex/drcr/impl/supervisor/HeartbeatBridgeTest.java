@@ -31,6 +31,16 @@ class HeartbeatBridgeTest {
     }
 
     @Test
+    void aLateWriterIsSaidOncePerNewLongestGap() {
+        assertEquals(null, HeartbeatBridge.lateWriter(20_000_000L, 0)); // on time
+        assertEquals(null, HeartbeatBridge.lateWriter(49_999_999L, 0));
+        String l = HeartbeatBridge.lateWriter(73_400_000L, 0);
+        assertTrue(l != null && l.contains("native heartbeat writer ran 73 ms after its round before"), l);
+        assertEquals(null, HeartbeatBridge.lateWriter(73_400_000L, 73_400_000L)); // said already
+        assertTrue(HeartbeatBridge.lateWriter(120_000_000L, 73_400_000L).contains("120 ms"));
+    }
+
+    @Test
     void offWhenTurnedOffAndSaysWhatThatMeans() {
         HeartbeatBridge b = open(e -> {
             throw new AssertionError("looked for " + e + " although off");
