@@ -105,9 +105,8 @@ struct arflex_component {
 	struct arflex_readopt readopt; /* D61 */
 	int fault_start_err;          /* test fault (D58): > 0 refuses every START with -it */
 	uint64_t fault_crash_after;   /* test fault (D68): > 0 raises SIGSEGV in that update after a START */
-	uint64_t fault_updates;       /* RT thread: updates run since the last START (for the fault above) */
+	uint64_t fault_updates;       /* RT thread: updates run since the last START (for the test faults) */
 	uint64_t fault_late_every;    /* test fault (D73): > 0 makes every that-many-th update after a START end late */
-	uint64_t fault_late_updates;  /* RT thread: updates run since the last START (for the fault above) */
 };
 
 /* One log line on stderr, one write (component.c). */

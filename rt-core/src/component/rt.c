@@ -117,7 +117,9 @@ int arflex_comp_rt_cycle(void *arg, uint64_t release_ns)
 		STORE(&ctl->stats.seq, seq + 2);
 	} else {
 		r = c->ops->update(c, c->ops->user, release_ns);
-		if (c->fault_crash_after && ++c->fault_updates >= c->fault_crash_after) {
+		if (c->fault_crash_after || c->fault_late_every)
+			c->fault_updates++; /* one count for every test fault: updates since the START */
+		if (c->fault_crash_after && c->fault_updates >= c->fault_crash_after) {
 			/* the test fault (D68): no allocation; the default action first, so that
 			 * a sanitizer's handler does not turn the crash into an exit */
 			struct sigaction dfl = { .sa_handler = SIG_DFL };
@@ -125,7 +127,7 @@ int arflex_comp_rt_cycle(void *arg, uint64_t release_ns)
 			sigaction(SIGSEGV, &dfl, NULL);
 			raise(SIGSEGV);
 		}
-		if (c->fault_late_every && ++c->fault_late_updates % c->fault_late_every == 0) {
+		if (c->fault_late_every && c->fault_updates % c->fault_late_every == 0) {
 			/* the test fault (D73): this cycle ends past its next release, so past its
 			 * deadline too (one late cycle); spins, as a too slow update would */
 			uint64_t until = release_ns + ctl->config.period_ns + 100000u;
@@ -144,7 +146,6 @@ int arflex_comp_rt_start(void *arg)
 
 	c->safe = false;
 	c->fault_updates = 0;
-	c->fault_late_updates = 0;
 	c->clk_binding = 0; /* the first poll takes the clock's binding as new */
 	c->clk_seen = 0;
 	memset(&c->hbw, 0, sizeof(c->hbw));
