@@ -25,7 +25,8 @@ import sys
 BEGIN = "<!-- decisions-index:begin (scripts/decisions-index.py writes this table) -->"
 END = "<!-- decisions-index:end -->"
 HEADER = ["| D | title | status |", "|---|---|---|"]
-FILE_NAME = re.compile(r"^D(\d{2,})-[a-z0-9]+(?:-[a-z0-9]+)*\.md$")
+FILE_NAME = re.compile(r"^D(\d{2,})-[A-Za-z0-9][A-Za-z0-9._-]*\.md$")
+LOOKS_LIKE_A_RECORD = re.compile(r"^D\d")
 TITLE = re.compile(r"^# D(\d{2,}): (\S.*)$")
 STATUS = re.compile(r"^Status: (accepted|superseded by D(\d{2,})|partial)(.*)$", re.IGNORECASE)
 ROW = re.compile(r"^\| \[D(\d+)\]\(")
@@ -79,10 +80,10 @@ def read_records(root):
     records, wrong, seen, numbers = {}, [], {}, set()
     for name in sorted(os.listdir(folder)):
         path = os.path.join(folder, name)
-        if not os.path.isfile(path) or not name.endswith(".md"):
+        if not os.path.isfile(path) or not LOOKS_LIKE_A_RECORD.match(name):
             continue
         if not FILE_NAME.match(name):
-            wrong.append("docs/decisions/%s: not a record's name (DNN-short-slug.md, lower case)" % name)
+            wrong.append("docs/decisions/%s: not a record's name (DNN-short-slug.md)" % name)
             continue
         rec, bad = read_record(folder, name)
         wrong.extend(bad)
