@@ -9,6 +9,13 @@
  *     until N cycles and check the plant converged to the setpoint; change the setpoint with
  *     SET_PARAM and check it converges again; SHUTDOWN; check the exit status and that no
  *     shared object, queue or child process is left.
+ *     Every value it publishes in its first 1500 cycles that the test reads (seq = cycle + 1)
+ *     is the legacy loop's after as many cycles, bit for bit (trace_legacy.c), and the two
+ *     loops' steps (trace_legacy.c, trace_ported.c) agree cycle by cycle over 3000 cycles with
+ *     a setpoint step that saturates the actuator.
+ *   test_template legacy <legacy-pi-velocity exe>
+ *     the legacy program for 1500 cycles: it exits 0, and each velocity it prints (every 500
+ *     cycles and at the end) is the one its own step computes in trace_legacy.c.
  *   test_template template <arflex-template exe>
  *     the skeleton (template.c): bind its input `in` to a provider segment made by the test,
  *     write values there, check out = gain * in with the input's seq; SHUTDOWN; nothing left.
@@ -29,6 +36,7 @@
 #include "arflex/host_contract.h"
 #include "arflex_types/sample.h"
 #include "helper.h" /* rt-core test kit: leak checks */
+#include "trace.h"
 
 #define SEC UINT64_C(1000000000)
 #define MS UINT64_C(1000000)
@@ -99,12 +107,123 @@ static int wait_seq(struct arflex_port *p, uint64_t min_seq, struct arflex_sampl
 	return -ETIMEDOUT;
 }
 
+/* The legacy loop's parameters and command (its constants; the contract's defaults). */
+static const struct trace_inputs LEGACY_INPUTS = { 1.0, 15.0, 1.0, 1L << 40, 1.0 };
+#define TRACE_N 3000
+static struct trace_step legacy_steps[TRACE_N], ported_steps[TRACE_N];
+
+/*
+ * As wait_seq, and every value read on the way whose seq is within the legacy trace must be
+ * the legacy loop's after seq cycles (its velocity, or its command when @command), bit for
+ * bit. *@compared counts the values compared.
+ */
+static int wait_seq_as_legacy(struct arflex_port *p, uint64_t min_seq, struct arflex_sample *v,
+			      bool command, long *compared)
+{
+	uint64_t deadline = arflex_sys_now_ns() + WAIT_TIMEOUT;
+	uint64_t last = 0;
+	struct arflex_sample s;
+
+	while (arflex_sys_now_ns() < deadline) {
+		if (arflex_state_read(p, &s, sizeof(s), NULL) == 1) {
+			if (s.seq != last && s.seq >= 1 && s.seq <= TRACE_N) {
+				const struct trace_step *t = &legacy_steps[s.seq - 1];
+				double want = command ? t->u : t->velocity;
+
+				last = s.seq;
+				(*compared)++;
+				if (s.value != want) {
+					fprintf(stderr, "FAIL: the ported loop's %s at seq %llu is %.17g, the legacy "
+						"loop's after %llu cycles %.17g\n", command ? "command" : "velocity",
+						(unsigned long long)s.seq, s.value, (unsigned long long)s.seq, want);
+					return -EDOM;
+				}
+			}
+			if (s.seq >= min_seq) {
+				*v = s;
+				return 0;
+			}
+		}
+		if (h.pid && arflex_ctl_state(h.ctl) != ARFLEX_STATE_RUNNING)
+			return -ECHILD;
+	}
+	return -ETIMEDOUT;
+}
+
+/* The two loops' steps, cycle by cycle on the same inputs: 0 when every one agrees. */
+static int compare_steps(uint64_t period_ns)
+{
+	/* setpoint 1, then 9 rad/s from cycle 1500: the actuator saturates (U_MAX 5) on the way */
+	const struct trace_inputs in = { 1.0, 15.0, 1.0, 1500, 9.0 };
+
+	trace_legacy(TRACE_N, &in, legacy_steps);
+	trace_ported(TRACE_N, &in, period_ns, ported_steps);
+	for (long i = 0; i < TRACE_N; i++) {
+		if (legacy_steps[i].velocity != ported_steps[i].velocity ||
+		    legacy_steps[i].u != ported_steps[i].u ||
+		    legacy_steps[i].saturated != ported_steps[i].saturated) {
+			fprintf(stderr, "FAIL: cycle %ld: legacy velocity %.17g u %.17g saturations %ld, "
+				"ported velocity %.17g u %.17g saturations %ld\n", i,
+				legacy_steps[i].velocity, legacy_steps[i].u, legacy_steps[i].saturated,
+				ported_steps[i].velocity, ported_steps[i].u, ported_steps[i].saturated);
+			return -1;
+		}
+	}
+	if (legacy_steps[TRACE_N - 1].saturated == 0) {
+		fprintf(stderr, "FAIL: the compared cycles never saturated the actuator\n");
+		return -1;
+	}
+	printf("rt.template: the ported loop's step equals the legacy one's in all %d cycles "
+	       "(%ld saturated)\n", TRACE_N, legacy_steps[TRACE_N - 1].saturated);
+	return 0;
+}
+
+static int case_legacy(const char *exe)
+{
+	char cmd[1024], line[256];
+	long compared = 0, n;
+	double vel;
+	bool done = false;
+	FILE *f;
+	int st;
+
+	trace_legacy(TRACE_N, &LEGACY_INPUTS, legacy_steps);
+	snprintf(cmd, sizeof(cmd), "'%s' 1500", exe);
+	f = popen(cmd, "r");
+	CHECK(f != NULL, "popen %s: %s", cmd, strerror(errno));
+	while (fgets(line, sizeof(line), f)) {
+		char want[64], got[64];
+		long at;
+
+		if (sscanf(line, "cycle %ld: velocity %63s", &n, got) == 2)
+			at = n; /* printed after the step of cycle n */
+		else if (sscanf(line, "done after %ld cycles: velocity %63s", &n, got) == 2)
+			at = n - 1, done = true;
+		else
+			continue;
+		CHECK(at >= 0 && at < TRACE_N, "line out of the trace: %s", line);
+		snprintf(want, sizeof(want), "%.6f", legacy_steps[at].velocity);
+		CHECK(strcmp(want, got) == 0, "the legacy program printed velocity %s where its step "
+		      "gives %s: %s", got, want, line);
+		compared++;
+	}
+	st = pclose(f);
+	CHECK(WIFEXITED(st) && WEXITSTATUS(st) == 0, "the legacy program's exit status %#x", st);
+	CHECK(done && compared == 4, "%ld velocities compared, the final line %s", compared,
+	      done ? "seen" : "missing");
+	vel = legacy_steps[1499].velocity;
+	CHECK(fabs(vel - 1.0) < 1e-3, "velocity %.6f after 1500 cycles, setpoint 1", vel);
+out:
+	return 0;
+}
+
 static int case_ported(const char *exe, const char *contract_path)
 {
 	struct arflex_host_opts o;
 	struct arflex_port vel;
 	struct arflex_sample v, u;
 	bool vel_open = false;
+	long compared = 0;
 	uint64_t applied;
 	char err[512];
 	int st;
@@ -124,9 +243,15 @@ static int case_ported(const char *exe, const char *contract_path)
 	CHECK(arflex_port_open(&vel, arflex_host_output_name(&h, "velocity"), false, false,
 			       ARFLEX_PORT_STATE, &sample_type) == 0, "open velocity");
 	vel_open = true;
+	CHECK(compare_steps(o.config.period_ns) == 0, "the ported loop's step is not the legacy one's");
+	trace_legacy(TRACE_N, &LEGACY_INPUTS, legacy_steps);
 	CHECK(arflex_host_start(&h, CALL_TIMEOUT) == 0, "START");
-	/* 1500 cycles of 1 ms: the closed loop settles to 1e-6 in ~1000. */
-	CHECK(wait_seq(&vel, 1500, &v) == 0, "no 1500 cycles");
+	/* 1500 cycles of 1 ms: the closed loop settles to 1e-6 in ~1000; each value read on the
+	 * way is the legacy loop's of the same cycle */
+	CHECK(wait_seq_as_legacy(&vel, 1500, &v, false, &compared) == 0, "no 1500 cycles as the legacy loop's");
+	CHECK(compared >= 10, "only %ld values of the ported loop read to compare", compared);
+	printf("rt.template.ported: %ld values of its first 1500 cycles read, each the legacy loop's\n",
+	       compared);
 	CHECK(fabs(v.value - 1.0) < 1e-3, "velocity %.6f after %llu cycles, setpoint 1",
 	      v.value, (unsigned long long)v.seq);
 	CHECK(arflex_state_read(arflex_host_output(&h, "command"), &u, sizeof(u), NULL) >= 0,
@@ -205,17 +330,21 @@ static bool leaked(const char *inst)
 
 int main(int argc, char **argv)
 {
-	bool ported;
+	bool ported, legacy;
 
 	ported = argc == 4 && strcmp(argv[1], "ported") == 0;
-	if (!ported && (argc != 3 || strcmp(argv[1], "template"))) {
+	legacy = argc == 3 && strcmp(argv[1], "legacy") == 0;
+	if (!ported && !legacy && (argc != 3 || strcmp(argv[1], "template"))) {
 		fprintf(stderr, "usage: %s ported <component executable> <contract.xml>\n"
-			"       %s template <component executable>\n", argv[0], argv[0]);
+			"       %s legacy <legacy-pi-velocity executable>\n"
+			"       %s template <component executable>\n", argv[0], argv[0], argv[0]);
 		return 2;
 	}
 	snprintf(rid, sizeof(rid), "t-tpl-%ld", (long)getpid());
 	if (ported)
 		case_ported(argv[2], argv[3]);
+	else if (legacy)
+		case_legacy(argv[2]);
 	else
 		case_template(argv[2]);
 	if (failures)

@@ -1,6 +1,5 @@
 package org.arflex.it;
 
-import static org.junit.jupiter.api.Assertions.assertTrue;
 
 import java.nio.file.DirectoryStream;
 import java.nio.file.Files;
@@ -386,6 +385,5 @@ class FaultBench {
         Files.writeString(out, json);
         System.out.println("JSON: " + out.toAbsolutePath());
         System.out.println("faults: " + pass + "/" + total + " scenarios pass, leaks " + leaks);
-        assertTrue(true);
     }
 }

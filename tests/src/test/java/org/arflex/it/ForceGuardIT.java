@@ -15,9 +15,10 @@ import org.junit.jupiter.api.Test;
  * built-in program in a loop, force-guard watches its joint torques and wrist wrench. A scripted
  * push above the threshold ({@code arflex:set sim-robot push_force_n 400}) puts the cell in a
  * protective stop in the cycle that reads it: no SafetyState value ever shows a contact force
- * above the limit in NORMAL mode, and the first PROTECTIVE_STOP comes at most two guard periods
+ * above the limit in NORMAL mode, and the first PROTECTIVE_STOP comes at most three guard periods
  * after the push shows in the wrist sensor (cycle timestamps of the two RT halves, not the
- * test's clock). The trajectory then decelerates along its path and its joint_ref stays
+ * test's clock: the same or the next guard cycle is two periods, and the stamps are write times,
+ * so the two tasks' wake-up latency adds; one period is allowed for it, see the assertion). The trajectory then decelerates along its path and its joint_ref stays
  * bit-identical for more than 1000 of its cycles, through the end of the push, until the
  * operator's {@code arflex:reset force-guard}; the motion resumes only after a fresh command
  * ({@code arflex:set trajectory run true}): a reset permits, it does not start (issue 15). The robot's drives take

@@ -290,40 +290,20 @@ final class Runtime implements AutoCloseable {
         });
     }
 
-    interface Cond {
-        boolean test() throws Exception;
+    interface Cond extends Polling.Cond {
     }
 
+    /** Returns when the condition held; fails on the deadline with arflex:list and the log, and when interrupted. */
     void waitUntil(String what, long timeoutMs, Cond c) {
-        long deadline = System.nanoTime() + timeoutMs * 1_000_000L;
-        Exception last = null;
-        long pollMs = 2;
-        while (System.nanoTime() - deadline < 0) {
+        Polling.until(what, timeoutMs, c, () -> {
+            String state;
             try {
-                if (c.test()) {
-                    return;
-                }
-            } catch (Exception e) {
-                last = e;
+                state = process.isAlive() ? cmd("arflex:list") : "(runtime exited)";
+            } catch (RuntimeException e) {
+                state = e.toString();
             }
-            try {
-                // poll interval of a condition with a deadline: 2 ms at first, then doubled up to
-                // 50 ms, so what is quick is seen quickly and a long wait costs the shell little
-                Thread.sleep(pollMs);
-                pollMs = Math.min(50, pollMs * 2);
-            } catch (InterruptedException e) {
-                Thread.currentThread().interrupt();
-                return;
-            }
-        }
-        String state;
-        try {
-            state = process.isAlive() ? cmd("arflex:list") : "(runtime exited)";
-        } catch (RuntimeException e) {
-            state = e.toString();
-        }
-        fail("timed out after " + timeoutMs + " ms waiting for " + what + (last != null ? " (last error " + last + ")" : "")
-                + "\n--- arflex:list\n" + state + "\n--- runtime output\n" + tail());
+            return "\n--- arflex:list\n" + state + "\n--- runtime output\n" + tail();
+        });
     }
 
     /** The pid of this runtime's JVM (found by its runtime id on the command line). */

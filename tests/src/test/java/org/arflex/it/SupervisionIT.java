@@ -58,6 +58,9 @@ class SupervisionIT {
      * go safe, survive their log lines to the dead JVM's pipe (no SIGPIPE), hold for the
      * contract's orphan hold (2 s by default), then exit and remove their objects themselves.
      */
+    /** The samples' contracts' orphan hold: fault/@orphanHold's default (ControlBlock.DEFAULT_ORPHAN_HOLD_NS). */
+    static final long ORPHAN_HOLD_MS = 2_000;
+
     @Test
     void rtHalvesOfACrashedRuntimeHoldThenLeaveNothing() throws Exception {
         String rid = "itorphan" + ProcessHandle.current().pid();
@@ -68,9 +71,13 @@ class SupervisionIT {
             long t0 = System.nanoTime();
             first.crash();
             List<String> orphans = Runtime.rtProcesses(rid);
-            if (System.nanoTime() - t0 < 1_500_000_000L) {
-                assertEquals(2, orphans.size(), "both hold after the crash: " + orphans);
-            }
+            long lookedMs = (System.nanoTime() - t0) / 1_000_000L;
+            // The look must come within the hold to show it: a look after it cannot tell a half
+            // that held from one that left at once, so it fails rather than passing unchecked
+            // (D82: the check was dropped when the machine was slow).
+            assertTrue(lookedMs < ORPHAN_HOLD_MS, "looked for the orphans " + lookedMs + " ms after the kill, after their "
+                    + ORPHAN_HOLD_MS + " ms hold: whether they held cannot be seen (the test machine stalled)");
+            assertEquals(2, orphans.size(), "both hold after the crash (" + lookedMs + " ms after the kill): " + orphans);
             first.waitUntil("the orphans exited and removed their objects", CellIT.T,
                     () -> Runtime.rtProcesses(rid).isEmpty() && first.shmObjects().isEmpty());
         }

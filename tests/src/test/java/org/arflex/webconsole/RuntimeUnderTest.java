@@ -16,6 +16,7 @@ import java.time.Duration;
 import java.util.Base64;
 import java.util.Comparator;
 import java.util.List;
+import java.util.Optional;
 import java.util.concurrent.TimeUnit;
 import java.util.function.BooleanSupplier;
 import java.util.stream.Stream;
@@ -241,6 +242,30 @@ final class RuntimeUnderTest implements AutoCloseable {
                     org.junit.jupiter.api.Assertions.assertTrue(left.isEmpty(), "left over in " + dir + ": " + left);
                 }
             }
+        }
+    }
+
+    /**
+     * The runtime JVM's threads ({@code jcmd <pid> Thread.print}), for a test that waited in
+     * vain for the console's answer: what the request's thread was blocked on.
+     */
+    String threadDump() {
+        Optional<ProcessHandle> jvm = process.descendants()
+                .filter(p -> p.info().command().map(c -> c.endsWith("/java")).orElse(false)).findFirst();
+        if (jvm.isEmpty()) {
+            return "(no runtime JVM found under " + process.pid() + ")";
+        }
+        try {
+            Process j = new ProcessBuilder("jcmd", String.valueOf(jvm.get().pid()), "Thread.print").redirectErrorStream(true)
+                    .start();
+            String out = new String(j.getInputStream().readAllBytes(), java.nio.charset.StandardCharsets.UTF_8);
+            j.waitFor(30, TimeUnit.SECONDS);
+            return out;
+        } catch (IOException e) {
+            return "(jcmd failed: " + e + ")";
+        } catch (InterruptedException e) {
+            Thread.currentThread().interrupt();
+            return "(interrupted)";
         }
     }
 

@@ -65,8 +65,11 @@ public final class Instance {
     volatile String hangReason;
     Actor.Cancellable restartTimer;
     volatile long measuredWcetNs;
-    /** Execution-time counters at the previous sampling of this RT half ({@link WcetMonitor}). */
-    long sampledExecCount, sampledExecSum, sampledExecOver;
+    /** Execution-time metric and WCET overruns at the previous sampling of this RT half ({@link WcetMonitor}). */
+    org.arflex.drcr.impl.abi.ControlBlock.Metric sampledExec;
+    long sampledExecOver;
+    /** The sustained level of the previous sampling window when it was above the WCET, else 0 (D82). */
+    long sustainedLevelNs;
     /** An isolated WCET exceedance of this instance was logged already. */
     boolean transientWcetLogged;
     /** Known to the planner (its bundle is started); false while only INSTALLED. */

@@ -11,6 +11,12 @@ import org.arflex.planner.Change;
  * the measured WCET and re-planned with ({@link #sustainedOverWcet}); an isolated one (a
  * preemption or a stall of the machine, which a wall-clock execution time includes) is logged
  * once and kept out of admission, so one spike cannot stop a component for good.
+ *
+ * <p>The value recorded is taken only from executions no single stall inflated (D82; D73's last
+ * finding: one stall made a half's measured WCET 4x its declared one and a change set's window
+ * inadmissible): each window's sustained level ({@link ExecWindow#levelNs}, the time as many
+ * executions reached as make an exceedance sustained), and only when two windows in a row were
+ * sustained, the lower of their two levels. The half's lifetime maximum is never used.
  */
 final class WcetMonitor {
 
@@ -36,29 +42,38 @@ final class WcetMonitor {
                 continue;
             }
             long wcet = inst.contract.timing().wcetNs();
-            ControlBlock.Stats s = h.stats(wcet);
-            if (s == null) {
+            ControlBlock.Detail d = h.detail(wcet);
+            if (d == null || d.stats() == null) {
                 continue;
             }
+            ControlBlock.Stats s = d.stats();
             over += s.execOverWcet();
-            if (s.execCount() < inst.sampledExecCount) {  // a new RT half counts from zero
-                inst.sampledExecCount = inst.sampledExecSum = inst.sampledExecOver = 0;
+            ControlBlock.Metric now = d.exec() != null ? d.exec()
+                    : new ControlBlock.Metric(s.execCount(), 0, s.execMaxNs(), s.execSumNs(), null);
+            if (inst.sampledExec != null && now.count() < inst.sampledExec.count()) {  // a new RT half counts from zero
+                inst.sampledExec = null;
+                inst.sampledExecOver = 0;
+                inst.sustainedLevelNs = 0;
             }
-            long dCount = s.execCount() - inst.sampledExecCount;
-            long dSum = s.execSumNs() - inst.sampledExecSum;
+            ExecWindow w = ExecWindow.between(inst.sampledExec, now);
             long dOver = s.execOverWcet() - inst.sampledExecOver;
-            inst.sampledExecCount = s.execCount();
-            inst.sampledExecSum = s.execSumNs();
+            long levelBefore = inst.sustainedLevelNs;
+            inst.sampledExec = now;
             inst.sampledExecOver = s.execOverWcet();
-            if (dCount <= 0 || s.execMaxNs() <= wcet) {
+            inst.sustainedLevelNs = 0;
+            if (w.cycles() <= 0 || s.execMaxNs() <= wcet) {
                 continue;
             }
-            if (sustainedOverWcet(wcet, dCount, dSum, dOver)) {
-                measured(inst, s.execMaxNs());
+            long level = sustainedOverWcet(wcet, w.cycles(), w.sumNs(), dOver) ? w.levelNs(sustainedCycles(w.cycles())) : 0;
+            if (level > wcet) {
+                inst.sustainedLevelNs = level;
+                if (levelBefore > wcet) {
+                    measured(inst, Math.min(levelBefore, level));
+                }
             } else if (dOver > 0 && !inst.transientWcetLogged) {
                 inst.transientWcetLogged = true;
                 log.accept("arflex: " + inst.name + ": execution time up to " + s.execMaxNs() + " ns above declared WCET "
-                        + wcet + " ns in isolated cycles (" + dOver + " of " + dCount + "); not re-planned (logged once)");
+                        + wcet + " ns in isolated cycles (" + dOver + " of " + w.cycles() + "); not re-planned (logged once)");
             }
         }
         return over;
@@ -71,7 +86,7 @@ final class WcetMonitor {
         }
         inst.measuredWcetNs = ns;
         log.accept("arflex: " + inst.name + ": measured execution time " + ns + " ns above declared WCET "
-                + inst.contract.timing().wcetNs() + " ns; re-planning");
+                + inst.contract.timing().wcetNs() + " ns (sustained in two sampling windows in a row); re-planning");
         cell.apply(Change.measuredWcet(inst.name, ns));
     }
 
@@ -89,7 +104,11 @@ final class WcetMonitor {
             return true;
         }
         long histRangeNs = (long) ControlBlock.HIST_BINS * ControlBlock.HIST_BIN_NS;
-        return wcetNs < histRangeNs
-                && over >= Math.max(SUSTAINED_MIN_CYCLES, (long) Math.ceil(cycles * SUSTAINED_FRACTION));
+        return wcetNs < histRangeNs && over >= sustainedCycles(cycles);
+    }
+
+    /** How many cycles of a window of {@code cycles} make an exceedance sustained: 1 %, at least 3. */
+    static long sustainedCycles(long cycles) {
+        return Math.max(SUSTAINED_MIN_CYCLES, (long) Math.ceil(cycles * SUSTAINED_FRACTION));
     }
 }

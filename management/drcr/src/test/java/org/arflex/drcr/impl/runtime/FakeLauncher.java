@@ -57,6 +57,8 @@ final class FakeLauncher implements RtLauncher {
         int hold;
         /** What stats() reports; tests set it. */
         ControlBlock.Stats stats = new ControlBlock.Stats(0, 0, 0, 0, 0, 0, 0, 0, 0, 0);
+        /** The execution-time metric detail() reports with {@link #stats}, or null (no histogram). */
+        ControlBlock.Metric exec;
 
         FakeHalf(Spec s) {
             inst = s.instance();
@@ -186,6 +188,11 @@ final class FakeLauncher implements RtLauncher {
         @Override
         public ControlBlock.Stats stats(long wcetNs) {
             return stats;
+        }
+
+        @Override
+        public ControlBlock.Detail detail(long wcetNs) {
+            return new ControlBlock.Detail(stats, null, exec);
         }
 
         @Override
