@@ -11,13 +11,14 @@
 // else. The TRUE TCP offset is read only afterwards, to score the result.
 //
 // Usage: arflex-pivot-calibration [--poses N] [--frames K] [--width W --height H]
-//                                 [--noise SIGMA] [--tilt-deg D] [--tool ID]
+//                                 [--noise SIGMA] [--tilt-deg D] [--pivot X,Y,Z] [--tool ID]
 //                                 [--tool-name NAME]
-//                                 [--out FILE] [--check TOL_MM]
-// --frames: frames per orientation pooled into one estimate (2); --tilt-deg: the tool's
-// tilt about the pivot's vertical and horizontal axes (25); --out: writes the tool
+//                                 [--out FILE] [--check TOL_MM] [--unweighted]
+// --frames: frames per orientation pooled into one estimate (1); --tilt-deg: the tool's
+// tilt about the pivot's vertical and horizontal axes (35); --pivot X,Y,Z: the divot (1.9,0,0.6); --out: writes the tool
 // calibration file (tool_calibration.h); --check: exit status 1 when the recovered offset is
-// further than TOL_MM from the TRUE one (the ctest vision.calib.sim_pivot), 2 on bad
+// further than TOL_MM from the TRUE one; --unweighted: every pose weighs the same (default:
+// 1 / the pose estimate's reprojection RMS^2) (the ctest vision.calib.sim_pivot), 2 on bad
 // arguments, 3 when the set is refused or vision fails.
 #include <algorithm>
 #include <array>
@@ -48,16 +49,18 @@ namespace vision = arflex::vision;
 namespace calib = arflex::vision::calib;
 
 struct Options {
-  int poses = 16;
-  int frames = 2;
+  int poses = 24;
+  int frames = 1;
   int width = 1280;
   int height = 1024;
   double noise = 2.0;
-  double tilt_deg = 25.0;
+  double tilt_deg = 35.0;
+  Eigen::Vector3d pivot{1.9, 0.0, 0.6};  // the divot (m, cell frame)
   int tool = 1;                    // tool id: the gripper
   std::string tool_name = "tool-gripper";
   std::string out;
   double check_mm = -1;  // < 0: no check
+  bool weighted = true;  // weigh each pose by 1 / its reprojection RMS^2 (--unweighted: all 1)
 };
 
 // The tag's printed face in its parent frame (the simulator's tag is a 1 mm box).
@@ -198,6 +201,10 @@ std::vector<Eigen::Matrix3d> Orientations(const Eigen::Vector3d& pivot, int n, d
 bool ParseArgs(int argc, char** argv, Options* o) {
   for (int i = 1; i < argc; ++i) {
     const std::string k = argv[i];
+    if (k == "--unweighted") {
+      o->weighted = false;
+      continue;
+    }
     if (i + 1 >= argc) {
       std::fprintf(stderr, "pivot-calibration: %s needs a value (or is unknown)\n", k.c_str());
       return false;
@@ -209,6 +216,16 @@ bool ParseArgs(int argc, char** argv, Options* o) {
     }
     if (k == "--out") {
       o->out = v;
+      continue;
+    }
+    if (k == "--pivot") {
+      double x, y, z;
+      char extra;
+      if (std::sscanf(v.c_str(), "%lf,%lf,%lf%c", &x, &y, &z, &extra) != 3 || !std::isfinite(x + y + z)) {
+        std::fprintf(stderr, "pivot-calibration: --pivot: '%s' is not x,y,z (m)\n", v.c_str());
+        return false;
+      }
+      o->pivot = Eigen::Vector3d(x, y, z);
       continue;
     }
     char* end = nullptr;
@@ -253,12 +270,19 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "pivot-calibration: %s\n", error.c_str());
     return 3;
   }
-  const Eigen::Vector3d pivot(1.9, 0.0, 0.6);
+  const Eigen::Vector3d pivot = o.pivot;
   std::printf("arflex-pivot-calibration: %d orientations about (%.2f, %.2f, %.2f) m, tilt %.0f deg, "
               "%dx%d, noise %.1f DN, %d frame(s) x 4 cameras per orientation\n",
               o.poses, pivot.x(), pivot.y(), pivot.z(), o.tilt_deg, o.width, o.height, o.noise, o.frames);
-  std::printf("%4s %6s %5s %6s %9s\n", "pose", "views", "tags", "rms px", "valid");
+  // Scoring only: the TRUE and nominal offsets (diagnostics per pose and the final score).
+  const auto& cfg = sim.cell().config();
+  const Eigen::Vector3d nominal(cfg.arm.tcp_offset[0], cfg.arm.tcp_offset[1], cfg.arm.tcp_offset[2]);
+  const auto& d = sim.cell().errors().offset_error[arflex::sim::kNumJoints];
+  const Eigen::Vector3d truth = nominal + Eigen::Vector3d(d[0], d[1], d[2]);
+  std::printf("%4s %6s %5s %6s %14s %16s %9s\n", "pose", "views", "tags", "rms px", "tip err (mm)",
+              "tip sigma (mm)", "valid");
   std::vector<Eigen::Isometry3d> measured;
+  std::vector<double> weights;
   JointVector q = {0.0, 0.3, 0.3, 0.0, 0.6, 0.0};
   const std::vector<Eigen::Matrix3d> orientations = Orientations(pivot, o.poses, o.tilt_deg);
   for (int i = 0; i < o.poses; ++i) {
@@ -267,21 +291,27 @@ int main(int argc, char** argv) {
       return 3;
     }
     const vision::PoseEstimate e = sim.MeasureMarker(o.frames, 1 + i);
-    std::printf("%4d %6d %5d %6.3f %9s\n", i, e.n_views, e.n_tags, e.rms_px, e.valid ? "yes" : e.reason);
-    if (e.valid) measured.push_back(e.pose);
+    // Diagnostics (TRUE used to score only): where this measured marker pose puts the TRUE
+    // tip against the pivot, and the estimate's own sigma at the tip.
+    Eigen::Isometry3d tip = Eigen::Isometry3d::Identity();
+    tip.translation() = nominal;
+    const double sigma = std::sqrt(vision::TransformEstimate(e, tip).covariance.topLeftCorner<3, 3>().trace());
+    std::printf("%4d %6d %5d %6.3f %14.4f %16.4f %9s\n", i, e.n_views, e.n_tags, e.rms_px,
+                1e3 * (e.pose * truth - pivot).norm(), 1e3 * sigma, e.valid ? "yes" : e.reason);
+    if (e.valid) {
+      measured.push_back(e.pose);
+      // Each pose weighs by its reprojection residual (1 / rms^2, floored at 0.01 px): a pose
+      // whose corners fit worse (tags seen obliquely) puts the tip worse.
+      weights.push_back(1.0 / std::pow(std::max(e.rms_px, 0.01), 2));
+    }
   }
-  const calib::PivotResult r = calib::SolvePivot(measured);
+  const calib::PivotResult r = calib::SolvePivot(measured, calib::PivotOptions(), o.weighted ? &weights : nullptr);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (!r.ok) {
     std::fprintf(stderr, "pivot-calibration: refused: %s\n", r.reason.c_str());
     return 3;
   }
   for (int i = 0; i < r.poses; ++i) std::printf("  residual %2d: %.4f mm\n", i, 1e3 * r.residual_m[i]);
-  // Scoring only: the TRUE and nominal offsets.
-  const auto& cfg = sim.cell().config();
-  const Eigen::Vector3d nominal(cfg.arm.tcp_offset[0], cfg.arm.tcp_offset[1], cfg.arm.tcp_offset[2]);
-  const auto& d = sim.cell().errors().offset_error[arflex::sim::kNumJoints];
-  const Eigen::Vector3d truth = nominal + Eigen::Vector3d(d[0], d[1], d[2]);
   const double err_mm = 1e3 * (r.tip_in_marker - truth).norm();
   std::printf("TCP in the marker frame (mm):   x          y          z\n");
   std::printf("  calibrated            %10.4f %10.4f %10.4f  (sigma %.4f %.4f %.4f)\n", 1e3 * r.tip_in_marker.x(),

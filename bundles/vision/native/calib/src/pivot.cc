@@ -39,7 +39,8 @@ std::string CheckPose(const Eigen::Isometry3d& p, int i) {
 
 }  // namespace
 
-PivotResult SolvePivot(const std::vector<Eigen::Isometry3d>& poses, const PivotOptions& options) {
+PivotResult SolvePivot(const std::vector<Eigen::Isometry3d>& poses, const PivotOptions& options,
+                       const std::vector<double>* weights) {
   PivotResult out;
   const int n = static_cast<int>(poses.size());
   out.poses = n;
@@ -52,6 +53,17 @@ PivotResult SolvePivot(const std::vector<Eigen::Isometry3d>& poses, const PivotO
     const std::string bad = CheckPose(poses[i], i);
     if (!bad.empty()) {
       out.reason = bad;
+      return out;
+    }
+  }
+  if (weights != nullptr && static_cast<int>(weights->size()) != n) {
+    out.reason = std::to_string(weights->size()) + " weights for " + std::to_string(n) + " poses";
+    return out;
+  }
+  for (int i = 0; weights != nullptr && i < n; ++i) {
+    const double w = (*weights)[i];
+    if (!(std::isfinite(w) && w > 0)) {
+      out.reason = "the weight of pose " + std::to_string(i) + Format(" is %g (must be finite and > 0)", w);
       return out;
     }
   }
@@ -79,34 +91,36 @@ PivotResult SolvePivot(const std::vector<Eigen::Isometry3d>& poses, const PivotO
     return out;
   }
 
-  // Least squares [R_i -I][t; c] = -p_i.
+  // Least squares [R_i -I][t; c] = -p_i, each pose's rows scaled by sqrt(w_i).
   Eigen::MatrixXd a(3 * n, 6);
   Eigen::VectorXd b(3 * n);
   for (int i = 0; i < n; ++i) {
-    a.block<3, 3>(3 * i, 0) = poses[i].linear();
-    a.block<3, 3>(3 * i, 3) = -Eigen::Matrix3d::Identity();
-    b.segment<3>(3 * i) = -poses[i].translation();
+    const double s = weights != nullptr ? std::sqrt((*weights)[i]) : 1.0;
+    a.block<3, 3>(3 * i, 0) = s * poses[i].linear();
+    a.block<3, 3>(3 * i, 3) = -s * Eigen::Matrix3d::Identity();
+    b.segment<3>(3 * i) = -s * poses[i].translation();
   }
   const Eigen::JacobiSVD<Eigen::MatrixXd> svd(a, Eigen::ComputeThinU | Eigen::ComputeThinV);
   const Eigen::VectorXd x = svd.solve(b);
   out.tip_in_marker = x.head<3>();
   out.pivot_in_world = x.tail<3>();
 
-  double sum2 = 0;
+  double sum2 = 0, wsum2 = 0;
   out.residual_m.resize(n);
   for (int i = 0; i < n; ++i) {
     const double r = (poses[i].linear() * out.tip_in_marker + poses[i].translation() -
                       out.pivot_in_world).norm();
     out.residual_m[i] = r;
     sum2 += r * r;
+    wsum2 += (weights != nullptr ? (*weights)[i] : 1.0) * r * r;
     if (r > out.max_residual_m) {
       out.max_residual_m = r;
       out.worst_pose = i;
     }
   }
   out.rms_m = std::sqrt(sum2 / n);
-  // Covariance s^2 (A^T A)^-1 = s^2 V S^-2 V^T, s^2 = sum r^2 / (3N - 6).
-  const double s2 = sum2 / std::max(1, 3 * n - 6);
+  // Covariance s^2 (A^T W A)^-1 = s^2 V S^-2 V^T, s^2 = sum w r^2 / (3N - 6).
+  const double s2 = wsum2 / std::max(1, 3 * n - 6);
   const Eigen::VectorXd inv_s2 = svd.singularValues().cwiseInverse().cwiseAbs2();
   const Eigen::MatrixXd cov = s2 * svd.matrixV() * inv_s2.asDiagonal() * svd.matrixV().transpose();
   for (int k = 0; k < 3; ++k) out.tip_sigma_m(k) = std::sqrt(std::max(0.0, cov(k, k)));

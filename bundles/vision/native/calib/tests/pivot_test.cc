@@ -152,6 +152,50 @@ TEST(PivotTest, ASlippedTipIsRefusedNamingThePose) {
   ASSERT_EQ(r.residual_m.size(), 12u);
 }
 
+TEST(PivotTest, WeightsTakeTheWorsePosesLessIntoAccount) {
+  // A quarter of the poses is measured 5x worse (as a pose whose tags are seen obliquely):
+  // weighted by 1/sigma^2 the tip error over 100 draws is markedly smaller than unweighted.
+  std::mt19937 rng(11);
+  std::normal_distribution<double> unit(0.0, 1.0);
+  double err_plain = 0, err_weighted = 0;
+  for (int d = 0; d < 100; ++d) {
+    std::vector<Eigen::Isometry3d> set = PivotSet(24);
+    std::vector<double> w(set.size());
+    for (size_t i = 0; i < set.size(); ++i) {
+      const double sigma = (i % 4 == 1) ? 100e-6 : 20e-6;
+      set[i].translation() += sigma * Eigen::Vector3d(unit(rng), unit(rng), unit(rng));
+      w[i] = 1.0 / (sigma * sigma);
+    }
+    const PivotResult plain = SolvePivot(set);
+    const PivotResult weighted = SolvePivot(set, PivotOptions(), &w);
+    ASSERT_TRUE(plain.ok) << plain.reason;
+    ASSERT_TRUE(weighted.ok) << weighted.reason;
+    err_plain += (plain.tip_in_marker - kTip).squaredNorm() / 100;
+    err_weighted += (weighted.tip_in_marker - kTip).squaredNorm() / 100;
+  }
+  std::printf("tip error RMS: unweighted %.4f mm, weighted %.4f mm\n", 1e3 * std::sqrt(err_plain),
+              1e3 * std::sqrt(err_weighted));
+  EXPECT_LT(std::sqrt(err_weighted), 0.6 * std::sqrt(err_plain));
+  // Exact poses: any positive weights give the exact tip.
+  std::vector<double> w(12, 1.0);
+  w[3] = 1e-3;
+  const PivotResult exact = SolvePivot(PivotSet(12), PivotOptions(), &w);
+  ASSERT_TRUE(exact.ok) << exact.reason;
+  EXPECT_LT((exact.tip_in_marker - kTip).norm(), 1e-9);
+}
+
+TEST(PivotTest, BadWeightsAreRefusedNamingThePose) {
+  std::vector<double> w(10, 1.0);
+  w[4] = -1.0;
+  PivotResult r = SolvePivot(PivotSet(10), PivotOptions(), &w);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.reason.find("weight of pose 4"), std::string::npos) << r.reason;
+  w.resize(9);
+  r = SolvePivot(PivotSet(10), PivotOptions(), &w);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.reason.find("9 weights for 10 poses"), std::string::npos) << r.reason;
+}
+
 }  // namespace
 }  // namespace calib
 }  // namespace vision

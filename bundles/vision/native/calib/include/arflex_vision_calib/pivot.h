@@ -54,8 +54,13 @@ struct PivotResult {
 // Solves the pivot calibration from `world_from_marker` (the measured marker poses). Never
 // throws; a refused set gives ok = false with the reason (which pose, which axis, which
 // limit). The residuals and spread are filled whenever the solve itself ran.
+// `weights` (may be null: all 1) weighs each pose's three equations: 1 / sigma_i^2 of that
+// pose's tip position, e.g. from the pose estimate's reprojection residual. Each must be
+// finite and > 0; the reported sigma of the tip is then that of the weighted fit (scaled by
+// its weighted residual), the residuals stay in metres.
 PivotResult SolvePivot(const std::vector<Eigen::Isometry3d>& world_from_marker,
-                       const PivotOptions& options = PivotOptions());
+                       const PivotOptions& options = PivotOptions(),
+                       const std::vector<double>* weights = nullptr);
 
 }  // namespace calib
 }  // namespace vision
