@@ -271,6 +271,7 @@ int main(int argc, char** argv) {
     return 3;
   }
   const Eigen::Vector3d pivot = o.pivot;
+  const double calib_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("arflex-pivot-calibration: %d orientations about (%.2f, %.2f, %.2f) m, tilt %.0f deg, "
               "%dx%d, noise %.1f DN, %d frame(s) x 4 cameras per orientation\n",
               o.poses, pivot.x(), pivot.y(), pivot.z(), o.tilt_deg, o.width, o.height, o.noise, o.frames);
@@ -320,9 +321,9 @@ int main(int argc, char** argv) {
   std::printf("  TRUE (scoring only)   %10.4f %10.4f %10.4f\n", 1e3 * truth.x(), 1e3 * truth.y(), 1e3 * truth.z());
   std::printf("  nominal               %10.4f %10.4f %10.4f\n", 1e3 * nominal.x(), 1e3 * nominal.y(), 1e3 * nominal.z());
   std::printf("calibrated - TRUE: %.4f mm; nominal - TRUE: %.4f mm; pivot residual RMS %.4f mm, max %.4f mm "
-              "(pose %d); rotation spread %.1f deg; %d poses; %.1f s\n",
+              "(pose %d); rotation spread %.1f deg; %d poses; %.1f s (cameras calibrated after %.1f s)\n",
               err_mm, 1e3 * (nominal - truth).norm(), 1e3 * r.rms_m, 1e3 * r.max_residual_m, r.worst_pose,
-              r.spread_deg, r.poses, wall);
+              r.spread_deg, r.poses, wall, calib_s);
   if (!o.out.empty()) {
     calib::ToolCalibration tc;
     tc.tool = o.tool;
