@@ -220,6 +220,40 @@ int MakeVision(arflex_host* h, const char* exe, const char* instance = "vision",
   return arflex_host_spawn_ex(h, exe, nullptr, nullptr, spawn_flags);
 }
 
+// The vision half of a case and its tcp_pose reader: closed and destroyed (child reaped, objects
+// unlinked) when the case returns.
+struct HalfUnderTest {
+  arflex_host vis{};
+  arflex_port reader{};
+  bool reader_open = false;
+  HalfUnderTest() = default;
+  HalfUnderTest(const HalfUnderTest&) = delete;
+  HalfUnderTest& operator=(const HalfUnderTest&) = delete;
+  ~HalfUnderTest() {
+    if (reader_open) arflex_port_close(&reader);
+    arflex_host_destroy(&vis);
+  }
+};
+
+// Waits for `vis` READY, binds its inputs to the feeder's outputs, opens `reader` on its
+// tcp_pose (setting *reader_open) and STARTs it. Returns "" or the step that failed.
+std::string ReadyBindStart(Feeder* feeder, arflex_host* vis, arflex_port* reader, bool* reader_open) {
+  static const char* const ports[] = {"cam0", "cam1", "cam2", "cam3", "joint_state"};
+  if (arflex_host_wait_state(vis, ARFLEX_STATE_READY, 20 * kSec) != 0) return "vision READY";
+  for (const char* port : ports) {
+    if (arflex_host_bind(vis, port, arflex_host_output_name(feeder->host(), port), 2 * kSec) != 0) {
+      return std::string("BIND ") + port;
+    }
+  }
+  const arflex_port_type t = {ARFLEX_TYPE_POSE_NAME, 1, 0, ARFLEX_TYPE_POSE_SIZE};
+  if (arflex_port_open(reader, arflex_host_output_name(vis, "tcp_pose"), false, false, ARFLEX_PORT_STATE, &t) != 0) {
+    return "open tcp_pose";
+  }
+  *reader_open = true;
+  if (arflex_host_start(vis, 2 * kSec) != 0) return "START";
+  return "";
+}
+
 // Reads the child's output pipe until it holds `needle`, it ends (EOF) or `timeout_ns` passes.
 // Returns everything read.
 std::string ReadOutputUntil(arflex_host* h, const char* needle, uint64_t timeout_ns) {
@@ -392,14 +426,13 @@ out:
 
 // tool_uncalibrated and tool_calibrated (see the top).
 void ToolCase(const std::string& name, const char* exe, const std::string& data_dir) {
-  Feeder feeder;
-  arflex_host vis;
-  std::memset(&vis, 0, sizeof(vis));
-  arflex_port reader;
-  bool reader_open = false;
   arflex_pose pose;
-  std::string out;
-  static const char* const ports[] = {"cam0", "cam1", "cam2", "cam3", "joint_state"};
+  std::string out;  // what the half wrote on stdout/stderr
+  Feeder feeder;
+  HalfUnderTest half;
+  arflex_host& vis = half.vis;
+  arflex_port& reader = half.reader;
+  bool& reader_open = half.reader_open;
   const std::string file = data_dir + "/tool-1.cal";
   arflex::vision::calib::ToolCalibration cal;
   cal.tool = 1;
@@ -433,18 +466,10 @@ void ToolCase(const std::string& name, const char* exe, const std::string& data_
         "the half does not say it uses the calibrated TCP: '%s'", out.c_str());
   std::printf("uses: %s", out.c_str());
   arflex_host_close_output(&vis);  // nothing more is read: the child's later writes fail, as a closed log would
-  CHECK(arflex_host_wait_state(&vis, ARFLEX_STATE_READY, 20 * kSec) == 0, "vision READY");
-  for (const char* port : ports) {
-    CHECK(arflex_host_bind(&vis, port, arflex_host_output_name(feeder.host(), port), 2 * kSec) == 0,
-          "BIND %s", port);
-  }
   {
-    const arflex_port_type t = {ARFLEX_TYPE_POSE_NAME, 1, 0, ARFLEX_TYPE_POSE_SIZE};
-    CHECK(arflex_port_open(&reader, arflex_host_output_name(&vis, "tcp_pose"), false, false,
-                           ARFLEX_PORT_STATE, &t) == 0, "open tcp_pose");
-    reader_open = true;
+    const std::string failed = ReadyBindStart(&feeder, &vis, &reader, &reader_open);
+    CHECK(failed.empty(), "%s", failed.c_str());
   }
-  CHECK(arflex_host_start(&vis, 2 * kSec) == 0, "START");
   std::memset(&pose, 0, sizeof(pose));
   CHECK(WaitPose(&feeder, &reader, true, true, &pose), "no valid tcp_pose");
   {
@@ -459,35 +484,24 @@ void ToolCase(const std::string& name, const char* exe, const std::string& data_
   CHECK(arflex_host_shutdown(&vis, 5 * kSec) == 0, "SHUTDOWN");
   CHECK(arflex_host_wait_exit(&vis, 10 * kSec) == 0, "exit");
 out:
-  if (reader_open) arflex_port_close(&reader);
-  arflex_host_destroy(&vis);
   unlink(file.c_str());
 }
 
 int RunCase(const std::string& name, const char* exe) {
   Feeder feeder;
-  arflex_host vis;
-  std::memset(&vis, 0, sizeof(vis));
-  arflex_port reader;
-  bool reader_open = false;
+  HalfUnderTest half;
+  arflex_host& vis = half.vis;
+  arflex_port& reader = half.reader;
+  bool& reader_open = half.reader_open;
   arflex_pose pose;
   const Eigen::Isometry3d truth = TrueTcp();
-  static const char* const ports[] = {"cam0", "cam1", "cam2", "cam3", "joint_state"};
   CHECK(feeder.Create() == 0, "feeder create");
   feeder.Draw();
   CHECK(MakeVision(&vis, exe) == 0, "vision create/spawn");
-  CHECK(arflex_host_wait_state(&vis, ARFLEX_STATE_READY, 20 * kSec) == 0, "vision READY");
-  for (const char* port : ports) {
-    CHECK(arflex_host_bind(&vis, port, arflex_host_output_name(feeder.host(), port), 2 * kSec) == 0,
-          "BIND %s", port);
-  }
   {
-    const arflex_port_type t = {ARFLEX_TYPE_POSE_NAME, 1, 0, ARFLEX_TYPE_POSE_SIZE};
-    CHECK(arflex_port_open(&reader, arflex_host_output_name(&vis, "tcp_pose"), false, false,
-                           ARFLEX_PORT_STATE, &t) == 0, "open tcp_pose");
-    reader_open = true;
+    const std::string failed = ReadyBindStart(&feeder, &vis, &reader, &reader_open);
+    CHECK(failed.empty(), "%s", failed.c_str());
   }
-  CHECK(arflex_host_start(&vis, 2 * kSec) == 0, "START");
   // Calibration from the board, then the tool pose from all four views.
   std::memset(&pose, 0, sizeof(pose));
   CHECK(WaitPose(&feeder, &reader, true, true, &pose), "no valid tcp_pose (last: seq %llu valid %u views %u)",
@@ -549,8 +563,6 @@ int RunCase(const std::string& name, const char* exe) {
   CHECK(WIFEXITED(arflex_host_exit_status(&vis)) && WEXITSTATUS(arflex_host_exit_status(&vis)) == 0,
         "exit status %d", arflex_host_exit_status(&vis));
 out:
-  if (reader_open) arflex_port_close(&reader);
-  arflex_host_destroy(&vis);
   return 0;
 }
 

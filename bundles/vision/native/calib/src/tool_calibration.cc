@@ -1,7 +1,5 @@
 #include "arflex_vision_calib/tool_calibration.h"
 
-#include <fcntl.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cctype>
@@ -210,35 +208,29 @@ bool WriteToolCalibration(const std::string& path, const ToolCalibration& c, std
     *error = path + ": tcp_in_marker_m does not survive formatting";
     return false;
   }
+  // Atomic: the whole text into path.tmp, flushed to the disk, then renamed over the file.
   const std::string tmp = path + ".tmp";
-  const int fd = open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) {
+  FILE* f = std::fopen(tmp.c_str(), "we");
+  if (f == nullptr) {
     *error = tmp + ": cannot create: " + std::strerror(errno);
     return false;
   }
-  size_t off = 0;
-  while (off < text.size()) {
-    const ssize_t w = write(fd, text.data() + off, text.size() - off);
-    if (w < 0 && errno == EINTR) continue;
-    if (w <= 0) {
-      *error = tmp + ": write failed: " + std::strerror(errno);
-      close(fd);
-      unlink(tmp.c_str());
-      return false;
-    }
-    off += static_cast<size_t>(w);
+  bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size() && std::fflush(f) == 0 &&
+            fsync(fileno(f)) == 0;
+  int e = errno;
+  if (std::fclose(f) != 0 && ok) {
+    ok = false;
+    e = errno;
   }
-  if (fsync(fd) != 0 || close(fd) != 0) {
-    *error = tmp + ": fsync/close failed: " + std::strerror(errno);
+  if (ok && rename(tmp.c_str(), path.c_str()) != 0) {
+    ok = false;
+    e = errno;
+  }
+  if (!ok) {
+    *error = path + ": cannot write: " + std::strerror(e);
     unlink(tmp.c_str());
-    return false;
   }
-  if (rename(tmp.c_str(), path.c_str()) != 0) {
-    *error = path + ": rename failed: " + std::strerror(errno);
-    unlink(tmp.c_str());
-    return false;
-  }
-  return true;
+  return ok;
 }
 
 bool ReadToolCalibration(const std::string& path, ToolCalibration* out, bool* missing, std::string* error) {
