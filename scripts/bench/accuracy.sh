@@ -7,16 +7,14 @@
 #                             [--period-ms P] [--width W --height H] [--no-refine]
 #                             [--with-orientation] [--outlier-px PX] [--only INDEX] [--trace]
 #                             [--calib-frames N] [--calib-at-home] [--average K] [--diag] [--no-loop] [--cameras LIST]
+#                             [--tool-calibration FILE]   (a run with the pivot-calibrated TCP: ./arflex bench pivot)
 # Uses the Maven-built native tree (target/native) or ARFLEX_NATIVE_DIR; builds the benchmark
 # there if it is missing. JSON goes to target/bench/accuracy.json. Takes 10-30 minutes on a
 # loaded 2-core machine (software rendering dominates); --quick runs only payload 0.
 set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
-BUILD=${ARFLEX_NATIVE_DIR:-$ROOT/target/native}
 OUT=$ROOT/target/bench
-if [ ! -x "$BUILD/bin/arflex-accuracy-bench" ]; then
-  [ -f "$BUILD/build.ninja" ] || cmake -S "$ROOT" -B "$BUILD" -G Ninja >/dev/null
-  cmake --build "$BUILD" -j2 --target arflex-accuracy-bench
-fi
+. "$ROOT/scripts/native-target.sh"
+BIN=$(native_target arflex-accuracy-bench)
 mkdir -p "$OUT"
-exec "$BUILD/bin/arflex-accuracy-bench" --json "$OUT/accuracy.json" "$@"
+exec "$BIN" --json "$OUT/accuracy.json" "$@"

@@ -16,12 +16,16 @@
 //                              [--no-refine] [--only INDEX] [--trace] [--outlier-px PX]
 //                              [--with-orientation] [--calib-frames N] [--calib-at-home]
 //                              [--average K] [--diag] [--no-loop] [--cameras LIST]
+//                              [--tool-calibration FILE]
 // --quick: only the payload-0 run; --no-refine: AprilTag's corners without the edge re-fit;
 // --calib-frames: frames pooled per camera for the board calibration (8); --calib-at-home:
 // calibrate with the arm in front of the board (default: parked facing away); --average: frames
 // averaged per final update once the loop has converged (4; 1 = off); --diag: per camera / tag
 // corner errors against the simulator's projections, calibration errors, static check;
-// --no-loop: diagnostics only (no correction); --cameras 2,3: the cameras of the --quick run.
+// --no-loop: diagnostics only (no correction); --cameras 2,3: the cameras of the --quick run;
+// --tool-calibration FILE: one more run (pivot-tool) with the TCP offset of that tool
+// calibration file (arflex-pivot-calibration --out FILE) instead of the TRUE model's; with
+// --quick: payload-0 (TRUE offset), pivot-tool and nominal-tool.
 // --programs DIR [--first N] [--speed F]: writes the joint targets (the nominal IK of the same
 // target set, solved as the runs solve it) as trajectory programs DIR/program-<N+i>.arp (one
 // ptp each, at speed fraction F, default 0.1) and exits: the cell benchmark (tests/,
@@ -44,6 +48,7 @@
 #include "arflex_vision/detector.h"
 #include "arflex_vision/estimator.h"
 #include "arflex_vision/geometry.h"
+#include "arflex_vision_calib/tool_calibration.h"
 
 namespace {
 
@@ -84,6 +89,7 @@ struct Args {
   int average = 4;       // frames averaged per final update once the loop has converged (1: off)
   bool diag = false;   // print per camera / per tag corner errors (board and tool)
   bool no_loop = false;  // diagnostics only: no correction loop (error "on" not measured)
+  std::string tool_calibration;  // a run with the TCP from this calibration file (pivot-tool)
   std::string programs;  // write the targets as trajectory programs into this directory
   int first_program = 11;
   double program_speed = 0.1;
@@ -230,11 +236,20 @@ struct PoseRow {
   bool converged;
 };
 
+// Where a run's TCP offset in the marker frame comes from: the simulator's TRUE model (the
+// ideal calibration), the pivot calibration file (--tool-calibration, camera data alone), or
+// the nominal model (uncalibrated).
+enum class ToolOffset { kTrue, kFile, kNominal };
+
+const char* ToolOffsetName(ToolOffset t) {
+  return t == ToolOffset::kTrue ? "TRUE" : (t == ToolOffset::kFile ? "pivot-calibrated" : "nominal");
+}
+
 struct RunResult {
   std::string name;
   double payload;
   std::vector<int> cameras;
-  bool tool_calibrated;
+  ToolOffset tool;
   std::vector<PoseRow> rows;
   Stats off, on, settle, vision_err;
   // Diagnostics at the uncorrected pose: the same detections with the TRUE camera poses
@@ -251,7 +266,7 @@ class Bench {
   Bench(const Args& args) : args_(args) {}
 
   bool Run(const std::string& name, double payload, const std::vector<int>& cams,
-           bool tool_calibrated, RunResult* out);
+           ToolOffset tool, RunResult* out);
 
  private:
   // Renders the active cameras at the current state, detects (ROI around the prediction if
@@ -366,11 +381,11 @@ vision::PoseEstimate Bench::Measure(bool use_roi, RunResult* r, bool diagnose) {
 }
 
 bool Bench::Run(const std::string& name, double payload, const std::vector<int>& cams,
-                bool tool_calibrated, RunResult* r) {
+                ToolOffset tool, RunResult* r) {
   r->name = name;
   r->payload = payload;
   r->cameras = cams;
-  r->tool_calibrated = tool_calibrated;
+  r->tool = tool;
   CellConfig config = arflex::sim::DefaultCellConfig();
   config.payload_mass = payload;
   config.nominal_payload_mass = payload;  // the controller is told the payload
@@ -410,10 +425,22 @@ bool Bench::Run(const std::string& name, double payload, const std::vector<int>&
     vision::TagModel m{t.id, t.size, TagPose(t)};
     (t.body == "world" ? board_ : tool_).push_back(m);
   }
-  // TCP in the marker (flange) frame: nominal, or as a one-time tool calibration measures it.
-  // The pivot calibration is not simulated: the calibrated offset is the TRUE model's.
+  // TCP in the marker (flange) frame: nominal, the TRUE model's (an ideal tool calibration),
+  // or the one the pivot calibration measured from the cameras (arflex-pivot-calibration).
   Eigen::Vector3d tcp = V(config.arm.tcp_offset);
-  if (tool_calibrated) tcp += V(cell_->errors().offset_error[arflex::sim::kNumJoints]);
+  if (tool == ToolOffset::kTrue) tcp += V(cell_->errors().offset_error[arflex::sim::kNumJoints]);
+  if (tool == ToolOffset::kFile) {
+    arflex::vision::calib::ToolCalibration cal;
+    if (!arflex::vision::calib::ReadToolCalibration(args_.tool_calibration, &cal, nullptr, &error)) {
+      std::fprintf(stderr, "accuracy-bench: %s\n", error.c_str());
+      return false;
+    }
+    tcp = cal.tcp_in_marker;
+    std::printf("%s: TCP from %s (%s, %d poses, residual RMS %.4f mm, %s): %.4f mm from the TRUE one\n",
+                name.c_str(), args_.tool_calibration.c_str(), cal.method.c_str(), cal.poses, 1e3 * cal.rms_m,
+                cal.date.c_str(),
+                1e3 * (tcp - V(config.arm.tcp_offset) - V(cell_->errors().offset_error[arflex::sim::kNumJoints])).norm());
+  }
   tcp_in_marker_ = Eigen::Isometry3d::Identity();
   tcp_in_marker_.translation() = tcp;
 
@@ -676,7 +703,7 @@ bool Bench::Run(const std::string& name, double payload, const std::vector<int>&
 void PrintRun(const RunResult& r, bool per_pose) {
   std::printf("\n== %s: payload %.0f kg, cameras", r.name.c_str(), r.payload);
   for (int c : r.cameras) std::printf(" %d", c);
-  std::printf(", tool offset %s ==\n", r.tool_calibrated ? "calibrated" : "nominal");
+  std::printf(", tool offset %s ==\n", ToolOffsetName(r.tool));
   std::printf("camera calibration (board): max translation error %.2f mm, max rotation error "
               "%.1f mdeg, max rms %.3f px\n",
               r.calib_trans_mm_max, r.calib_rot_mdeg_max, r.calib_rms_px_max);
@@ -729,7 +756,7 @@ void WriteJson(FILE* f, const Args& a, const std::vector<RunResult>& runs) {
   for (size_t i = 0; i < runs.size(); ++i) {
     const RunResult& r = runs[i];
     std::fprintf(f, "    {\"name\": \"%s\", \"payload_kg\": %g, \"tool_offset\": \"%s\", \"cameras\": [",
-                 r.name.c_str(), r.payload, r.tool_calibrated ? "calibrated" : "nominal");
+                 r.name.c_str(), r.payload, ToolOffsetName(r.tool));
     for (size_t c = 0; c < r.cameras.size(); ++c) std::fprintf(f, "%s%d", c ? ", " : "", r.cameras[c]);
     std::fprintf(f, "],\n     \"error_off_mm\": {\"mean\": %.6f, \"max\": %.6f}, \"error_on_mm\": "
                     "{\"mean\": %.6f, \"max\": %.6f}, \"reduction\": %.3f,\n",
@@ -839,7 +866,7 @@ bool ParseArgs(int argc, char** argv, Args* a) {
     }
     if (k == "--json" || k == "--width" || k == "--height" || k == "--poses" || k == "--noise" ||
         k == "--blur" || k == "--period-ms" || k == "--only" || k == "--outlier-px" ||
-        k == "--calib-frames" || k == "--average" || k == "--cameras") {
+        k == "--calib-frames" || k == "--average" || k == "--cameras" || k == "--tool-calibration") {
       if (!(v = value(k.c_str()))) return false;
     } else {
       std::fprintf(stderr, "accuracy-bench: unknown argument '%s'\n", k.c_str());
@@ -848,6 +875,10 @@ bool ParseArgs(int argc, char** argv, Args* a) {
     char* end = nullptr;
     if (k == "--json") {
       a->json = v;
+      continue;
+    }
+    if (k == "--tool-calibration") {
+      a->tool_calibration = v;
       continue;
     }
     if (k == "--cameras") {
@@ -915,20 +946,26 @@ int main(int argc, char** argv) {
     const char* name;
     double payload;
     std::vector<int> cams;
-    bool tool_calibrated;
+    ToolOffset tool;
     bool per_pose;
   };
   std::vector<Spec> specs = {
-      {"payload-0", 0, {0, 1, 2, 3}, true, true},
-      {"payload-100", 100, {0, 1, 2, 3}, true, false},
-      {"payload-210", 210, {0, 1, 2, 3}, true, false},
-      {"blocked-1", 0, {1, 2, 3}, true, false},
-      {"blocked-2", 0, {2, 3}, true, false},
-      {"nominal-tool", 0, {0, 1, 2, 3}, false, false},
+      {"payload-0", 0, {0, 1, 2, 3}, ToolOffset::kTrue, true},
+      {"payload-100", 100, {0, 1, 2, 3}, ToolOffset::kTrue, false},
+      {"payload-210", 210, {0, 1, 2, 3}, ToolOffset::kTrue, false},
+      {"blocked-1", 0, {1, 2, 3}, ToolOffset::kTrue, false},
+      {"blocked-2", 0, {2, 3}, ToolOffset::kTrue, false},
+      {"nominal-tool", 0, {0, 1, 2, 3}, ToolOffset::kNominal, false},
   };
   if (args.quick) {
     specs.resize(1);
     specs[0].cams = args.quick_cameras;
+  }
+  if (!args.tool_calibration.empty()) {
+    // --tool-calibration: the pivot-calibrated TCP next to the TRUE (payload-0) and the
+    // nominal one; with --quick these three runs only.
+    specs.push_back({"pivot-tool", 0, {0, 1, 2, 3}, ToolOffset::kFile, false});
+    if (args.quick) specs.push_back({"nominal-tool", 0, {0, 1, 2, 3}, ToolOffset::kNominal, false});
   }
   std::printf("arflex-accuracy-bench: %d poses, %dx%d, noise %.1f DN, blur %.1f px, vision "
               "period %d ms (simulated time), corner re-fit %s, outlier threshold %.2f px, "
@@ -941,7 +978,7 @@ int main(int argc, char** argv) {
   Bench bench(args);
   for (const Spec& s : specs) {
     RunResult r;
-    if (!bench.Run(s.name, s.payload, s.cams, s.tool_calibrated, &r)) return 1;
+    if (!bench.Run(s.name, s.payload, s.cams, s.tool, &r)) return 1;
     PrintRun(r, s.per_pose);
     std::fflush(stdout);
     runs.push_back(std::move(r));

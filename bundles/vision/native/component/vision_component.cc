@@ -5,7 +5,12 @@
 // Parameters (all optional in the contract; defaults below when absent): fovy_deg (pinhole
 // intrinsics of the cell cameras: fy = fx = (H/2)/tan(fovy/2), principal point at the image
 // centre), tcp_x/tcp_y/tcp_z (TCP in the flange/marker frame, m), roi_margin_px, calibrate
-// (int64: each change re-runs the extrinsic calibration of every camera from the board).
+// (int64: each change re-runs the extrinsic calibration of every camera from the board),
+// tool_id and require_tool_calibration (read at configure): the tool's calibrated TCP from
+// $ARFLEX_DATA_DIR/tool-<id>.cal (vision/native/calib, tool_calibration.h) replaces
+// tcp_x/y/z; configure says on stderr which TCP it uses (calibrated: method, poses, residual,
+// date; or nominal) and refuses (-EINVAL, the reason on stderr) a file that is unreadable,
+// malformed or another tool's, and an uncalibrated tool when a calibration is required.
 //
 // Threads: detection allocates (libapriltag), so it runs on a worker thread created in
 // configure. update() (RT thread) never allocates, blocks or prints: when the worker is idle
@@ -58,6 +63,7 @@ extern "C" {
 #include "arflex_vision/cell_layout.h"
 #include "arflex_vision/detector.h"
 #include "arflex_vision/estimator.h"
+#include "arflex_vision_calib/tool_calibration.h"
 
 namespace {
 
@@ -87,6 +93,8 @@ struct Vision {
   bool joints_invalid = false;  // the newest joint state read was rejected (RT thread only)
   double fovy_deg = 50.0, margin = 30.0;
   Eigen::Vector3d tcp{0.30, 0.0, 0.0};
+  bool tcp_calibrated = false;  // the tool's calibration file gave the TCP (configure)
+  Eigen::Vector3d tcp_calibration{0.30, 0.0, 0.0};
   bool recalibrate = false;
   int64_t calibrate_seen = 0;
 
@@ -258,6 +266,24 @@ void WorkerLoop() {
   }
 }
 
+// Which TCP the half measures (configure): the tool's calibration file, or the nominal
+// tcp_x/y/z unless a calibration is required. Says which on stderr; -EINVAL when refused.
+int ChooseTcp(arflex_component* c) {
+  const int p_tool = arflex_component_param(c, "tool_id");
+  const int p_require = arflex_component_param(c, "require_tool_calibration");
+  const int tool = p_tool >= 0 ? static_cast<int>(arflex_param_i64(c, p_tool)) : 1;
+  const bool require = p_require >= 0 && arflex_param_i64(c, p_require) != 0;
+  const Eigen::Vector3d nominal(ParamF64(c, g.p_tcp[0], 0.30), ParamF64(c, g.p_tcp[1], 0.0),
+                                ParamF64(c, g.p_tcp[2], 0.0));
+  const arflex::vision::calib::TcpChoice choice =
+      arflex::vision::calib::ChooseTcp(tool, nominal, arflex::vision::calib::ToolCalibrationPath(tool), require);
+  std::fprintf(stderr, "vision: %s\n", choice.description.c_str());
+  if (!choice.ok) return -EINVAL;
+  g.tcp_calibrated = choice.calibrated;
+  g.tcp_calibration = choice.tcp_in_marker;
+  return 0;
+}
+
 int Configure(arflex_component* c, void*) {
   static const char* const names[kCameras] = {"cam0", "cam1", "cam2", "cam3"};
   for (int i = 0; i < kCameras; ++i) {
@@ -279,6 +305,7 @@ int Configure(arflex_component* c, void*) {
   g.p_tcp[2] = arflex_component_param(c, "tcp_z");
   g.p_margin = arflex_component_param(c, "roi_margin_px");
   g.p_calibrate = arflex_component_param(c, "calibrate");
+  if ((r = ChooseTcp(c)) < 0) return r;
   vision::DetectorOptions o;
   o.max_width = kMaxWidth;
   o.max_height = kMaxHeight;
@@ -415,8 +442,9 @@ int Update(arflex_component* c, void*, uint64_t release_ns) {
   g.have_joints = got >= 0 && !g.joints_invalid && g.joint_state.seq != 0;
   g.fovy_deg = ParamF64(c, g.p_fovy, 50.0);
   g.margin = ParamF64(c, g.p_margin, 30.0);
-  g.tcp = Eigen::Vector3d(ParamF64(c, g.p_tcp[0], 0.30), ParamF64(c, g.p_tcp[1], 0.0),
-                          ParamF64(c, g.p_tcp[2], 0.0));
+  g.tcp = g.tcp_calibrated ? g.tcp_calibration
+                           : Eigen::Vector3d(ParamF64(c, g.p_tcp[0], 0.30), ParamF64(c, g.p_tcp[1], 0.0),
+                                             ParamF64(c, g.p_tcp[2], 0.0));
   if (g.p_calibrate >= 0) {
     const int64_t want = arflex_param_i64(c, g.p_calibrate);
     if (want != g.calibrate_seen) {

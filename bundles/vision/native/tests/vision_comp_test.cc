@@ -3,7 +3,14 @@
 // state) it writes itself, with synthetic frames of the board and the tool tags drawn through
 // the cell's camera model, spawns the vision component, binds it and reads tcp_pose.
 //
-//   vision_comp_test <case> <vision exe> <contract>      cases: pose, loss, invalid, adopt
+//   vision_comp_test <case> <vision exe> <contract>
+//   cases: pose, loss, invalid, adopt, tool_uncalibrated, tool_calibrated
+//
+// tool_uncalibrated / tool_calibrated (the tool calibration, vision/native/calib): with
+// require_tool_calibration = 1 and no tool-1.cal in the data directory the half refuses to
+// configure, naming the tool and the file; with a tool-1.cal whose TCP is 10 mm off the
+// nominal one it says it uses that TCP and its poses are the marker pose times it. Every case
+// runs with ARFLEX_DATA_DIR set to a fresh directory of its own (removed at the end).
 //
 // adopt (docs/DECISIONS.md D58): a second vision half given the first one's state block
 // (arflex.VisionState) by ADOPT continues its estimate: its first pose carries the next seq,
@@ -20,6 +27,7 @@
 // Every case ends by checking that no /dev/shm or /dev/mqueue object of its runtime id and no
 // child process is left. Waits are on conditions with deadlines; nothing asserts on timing.
 #include <dirent.h>
+#include <poll.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -41,6 +49,7 @@ extern "C" {
 #include "arflex_types/pose.h"
 #include "arflex_types/vision_state.h"
 #include "arflex_vision/cell_layout.h"
+#include "arflex_vision_calib/tool_calibration.h"
 #include "synthetic_scene.h"
 
 namespace {
@@ -184,7 +193,9 @@ class Feeder {
 
 // The vision instance as its contract declares it, with the harness's period and flags.
 // `instance` names its objects ("vision"; the half that replaces it in the adopt case: "2-vision").
-int MakeVision(arflex_host* h, const char* exe, const char* instance = "vision") {
+// `param` (may be null) gets the initial value `bits`; `spawn_flags` go to arflex_host_spawn_ex.
+int MakeVision(arflex_host* h, const char* exe, const char* instance = "vision", const char* param = nullptr,
+               uint64_t bits = 0, unsigned spawn_flags = 0) {
   static const arflex_host_type types[] = {ARFLEX_HOST_FRAME_TYPE(IMAGE_FRAME), ARFLEX_HOST_TYPE(JOINT_STATE),
                                            ARFLEX_HOST_TYPE(POSE), ARFLEX_HOST_TYPE(VISION_STATE)};
   static arflex_host_contract c;
@@ -193,6 +204,9 @@ int MakeVision(arflex_host* h, const char* exe, const char* instance = "vision")
   if (r < 0) {
     std::fprintf(stderr, "%s\n", err);
     return r;
+  }
+  for (unsigned i = 0; param != nullptr && i < c.nparams; ++i) {
+    if (std::strcmp(c.params[i].name, param) == 0) c.params[i].default_bits = bits;
   }
   arflex_host_opts o;
   arflex_host_contract_opts(&c, rid, instance, &o);
@@ -203,7 +217,58 @@ int MakeVision(arflex_host* h, const char* exe, const char* instance = "vision")
   o.config.cfg_flags |= ARFLEX_CFG_NO_MLOCK | ARFLEX_CFG_NO_DMA_LATENCY;
   r = arflex_host_create(h, &o);
   if (r < 0) return r;
-  return arflex_host_spawn(h, exe, nullptr, nullptr);
+  return arflex_host_spawn_ex(h, exe, nullptr, nullptr, spawn_flags);
+}
+
+// The vision half of a case and its tcp_pose reader: closed and destroyed (child reaped, objects
+// unlinked) when the case returns.
+struct HalfUnderTest {
+  arflex_host vis{};
+  arflex_port reader{};
+  bool reader_open = false;
+  HalfUnderTest() = default;
+  HalfUnderTest(const HalfUnderTest&) = delete;
+  HalfUnderTest& operator=(const HalfUnderTest&) = delete;
+  ~HalfUnderTest() {
+    if (reader_open) arflex_port_close(&reader);
+    arflex_host_destroy(&vis);
+  }
+};
+
+// Waits for `vis` READY, binds its inputs to the feeder's outputs, opens `reader` on its
+// tcp_pose (setting *reader_open) and STARTs it. Returns "" or the step that failed.
+std::string ReadyBindStart(Feeder* feeder, arflex_host* vis, arflex_port* reader, bool* reader_open) {
+  static const char* const ports[] = {"cam0", "cam1", "cam2", "cam3", "joint_state"};
+  if (arflex_host_wait_state(vis, ARFLEX_STATE_READY, 20 * kSec) != 0) return "vision READY";
+  for (const char* port : ports) {
+    if (arflex_host_bind(vis, port, arflex_host_output_name(feeder->host(), port), 2 * kSec) != 0) {
+      return std::string("BIND ") + port;
+    }
+  }
+  const arflex_port_type t = {ARFLEX_TYPE_POSE_NAME, 1, 0, ARFLEX_TYPE_POSE_SIZE};
+  if (arflex_port_open(reader, arflex_host_output_name(vis, "tcp_pose"), false, false, ARFLEX_PORT_STATE, &t) != 0) {
+    return "open tcp_pose";
+  }
+  *reader_open = true;
+  if (arflex_host_start(vis, 2 * kSec) != 0) return "START";
+  return "";
+}
+
+// Reads the child's output pipe until it holds `needle`, it ends (EOF) or `timeout_ns` passes.
+// Returns everything read.
+std::string ReadOutputUntil(arflex_host* h, const char* needle, uint64_t timeout_ns) {
+  std::string text;
+  const int fd = arflex_host_output_fd(h);
+  const uint64_t deadline = arflex_sys_now_ns() + timeout_ns;
+  while (fd >= 0 && text.find(needle) == std::string::npos && arflex_sys_now_ns() < deadline) {
+    pollfd p{fd, POLLIN, 0};
+    if (poll(&p, 1, 100) <= 0) continue;
+    char buf[512];
+    const ssize_t n = read(fd, buf, sizeof buf);
+    if (n == 0) break;
+    if (n > 0) text.append(buf, static_cast<size_t>(n));
+  }
+  return text;
 }
 
 // Publishes frames (with or without tags) until a tcp_pose with `want_valid` arrives or the
@@ -359,30 +424,84 @@ out:
   if (bad_created) arflex_host_destroy(&bad);
 }
 
+// tool_uncalibrated and tool_calibrated (see the top).
+void ToolCase(const std::string& name, const char* exe, const std::string& data_dir) {
+  arflex_pose pose;
+  std::string out;  // what the half wrote on stdout/stderr
+  Feeder feeder;
+  HalfUnderTest half;
+  arflex_host& vis = half.vis;
+  arflex_port& reader = half.reader;
+  bool& reader_open = half.reader_open;
+  const std::string file = data_dir + "/tool-1.cal";
+  arflex::vision::calib::ToolCalibration cal;
+  cal.tool = 1;
+  cal.name = "tool-gripper";
+  cal.tcp_in_marker = Eigen::Vector3d(0.31, 0.004, -0.002);
+  cal.rms_m = 20e-6;
+  cal.poses = 16;
+  cal.spread_deg = 20;
+  cal.date = "2026-12-07T21:00:00Z";
+  CHECK(feeder.Create() == 0, "feeder create");
+  feeder.Draw();
+  if (name == "tool_uncalibrated") {
+    CHECK(MakeVision(&vis, exe, "vision", "require_tool_calibration", 1, ARFLEX_HOST_OUTPUT_PIPE) == 0,
+          "vision create/spawn");
+    CHECK(arflex_host_wait_state(&vis, ARFLEX_STATE_READY, 20 * kSec) != 0, "an uncalibrated tool got READY");
+    out = ReadOutputUntil(&vis, "\n", 10 * kSec);
+    CHECK(out.find("tool 1 is not calibrated") != std::string::npos && out.find(file) != std::string::npos,
+          "the refusal does not name the tool and %s: '%s'", file.c_str(), out.c_str());
+    std::printf("refused: %s", out.c_str());
+    goto out;
+  }
+  {
+    std::string error;
+    CHECK(arflex::vision::calib::WriteToolCalibration(file, cal, &error), "%s", error.c_str());
+  }
+  CHECK(MakeVision(&vis, exe, "vision", "require_tool_calibration", 1, ARFLEX_HOST_OUTPUT_PIPE) == 0,
+        "vision create/spawn");
+  out = ReadOutputUntil(&vis, "\n", 20 * kSec);
+  CHECK(out.find("calibrated TCP (0.310000, 0.004000, -0.002000)") != std::string::npos &&
+            out.find(file) != std::string::npos && out.find("2026-12-07T21:00:00Z") != std::string::npos,
+        "the half does not say it uses the calibrated TCP: '%s'", out.c_str());
+  std::printf("uses: %s", out.c_str());
+  arflex_host_close_output(&vis);  // nothing more is read: the child's later writes fail, as a closed log would
+  {
+    const std::string failed = ReadyBindStart(&feeder, &vis, &reader, &reader_open);
+    CHECK(failed.empty(), "%s", failed.c_str());
+  }
+  std::memset(&pose, 0, sizeof(pose));
+  CHECK(WaitPose(&feeder, &reader, true, true, &pose), "no valid tcp_pose");
+  {
+    arflex::cellmodel::NominalKinematics kin(arflex::cellmodel::DefaultArm());
+    const Eigen::Vector3d want = kin.Flange(kQ) * cal.tcp_in_marker;
+    const Eigen::Vector3d p(pose.p[0], pose.p[1], pose.p[2]);
+    CHECK((p - want).norm() < 1e-3, "tcp_pose is %.3f mm from the marker pose times the calibrated TCP",
+          1e3 * (p - want).norm());
+    CHECK((p - TrueTcp().translation()).norm() > 5e-3, "tcp_pose is at the nominal TCP (%.3f mm)",
+          1e3 * (p - TrueTcp().translation()).norm());
+  }
+  CHECK(arflex_host_shutdown(&vis, 5 * kSec) == 0, "SHUTDOWN");
+  CHECK(arflex_host_wait_exit(&vis, 10 * kSec) == 0, "exit");
+out:
+  unlink(file.c_str());
+}
+
 int RunCase(const std::string& name, const char* exe) {
   Feeder feeder;
-  arflex_host vis;
-  std::memset(&vis, 0, sizeof(vis));
-  arflex_port reader;
-  bool reader_open = false;
+  HalfUnderTest half;
+  arflex_host& vis = half.vis;
+  arflex_port& reader = half.reader;
+  bool& reader_open = half.reader_open;
   arflex_pose pose;
   const Eigen::Isometry3d truth = TrueTcp();
-  static const char* const ports[] = {"cam0", "cam1", "cam2", "cam3", "joint_state"};
   CHECK(feeder.Create() == 0, "feeder create");
   feeder.Draw();
   CHECK(MakeVision(&vis, exe) == 0, "vision create/spawn");
-  CHECK(arflex_host_wait_state(&vis, ARFLEX_STATE_READY, 20 * kSec) == 0, "vision READY");
-  for (const char* port : ports) {
-    CHECK(arflex_host_bind(&vis, port, arflex_host_output_name(feeder.host(), port), 2 * kSec) == 0,
-          "BIND %s", port);
-  }
   {
-    const arflex_port_type t = {ARFLEX_TYPE_POSE_NAME, 1, 0, ARFLEX_TYPE_POSE_SIZE};
-    CHECK(arflex_port_open(&reader, arflex_host_output_name(&vis, "tcp_pose"), false, false,
-                           ARFLEX_PORT_STATE, &t) == 0, "open tcp_pose");
-    reader_open = true;
+    const std::string failed = ReadyBindStart(&feeder, &vis, &reader, &reader_open);
+    CHECK(failed.empty(), "%s", failed.c_str());
   }
-  CHECK(arflex_host_start(&vis, 2 * kSec) == 0, "START");
   // Calibration from the board, then the tool pose from all four views.
   std::memset(&pose, 0, sizeof(pose));
   CHECK(WaitPose(&feeder, &reader, true, true, &pose), "no valid tcp_pose (last: seq %llu valid %u views %u)",
@@ -444,8 +563,6 @@ int RunCase(const std::string& name, const char* exe) {
   CHECK(WIFEXITED(arflex_host_exit_status(&vis)) && WEXITSTATUS(arflex_host_exit_status(&vis)) == 0,
         "exit status %d", arflex_host_exit_status(&vis));
 out:
-  if (reader_open) arflex_port_close(&reader);
-  arflex_host_destroy(&vis);
   return 0;
 }
 
@@ -453,17 +570,33 @@ out:
 
 int main(int argc, char** argv) {
   if (argc != 4) {
-    std::fprintf(stderr, "usage: vision_comp_test <pose|loss|invalid|adopt> <vision exe> <contract>\n");
+    std::fprintf(stderr, "usage: vision_comp_test <pose|loss|invalid|adopt|tool_uncalibrated|tool_calibrated> "
+                         "<vision exe> <contract>\n");
     return 2;
   }
   contract_xml = argv[3];
   std::snprintf(rid, sizeof(rid), "vct%d", static_cast<int>(getpid()));
   const std::string name = argv[1];
-  if (name != "pose" && name != "loss" && name != "invalid" && name != "adopt") {
+  const bool tool_case = name == "tool_uncalibrated" || name == "tool_calibrated";
+  if (name != "pose" && name != "loss" && name != "invalid" && name != "adopt" && !tool_case) {
     std::fprintf(stderr, "vision_comp_test: unknown case '%s'\n", argv[1]);
     return 2;
   }
-  RunCase(name, argv[2]);
+  // A data directory of the case's own: no tool calibration file unless the case writes one.
+  char data_dir[] = "/tmp/vct-data-XXXXXX";
+  if (mkdtemp(data_dir) == nullptr || setenv("ARFLEX_DATA_DIR", data_dir, 1) != 0) {
+    std::fprintf(stderr, "vision_comp_test: cannot make a data directory: %s\n", std::strerror(errno));
+    return 1;
+  }
+  if (tool_case) {
+    ToolCase(name, argv[2], data_dir);
+  } else {
+    RunCase(name, argv[2]);
+  }
+  if (rmdir(data_dir) != 0) {
+    std::fprintf(stderr, "leak: %s is left (%s)\n", data_dir, std::strerror(errno));
+    ++failures;
+  }
   if (Leaked()) ++failures;
   std::printf("vision.comp.%s: %s\n", name.c_str(), failures ? "FAIL" : "ok");
   return failures ? 1 : 0;
