@@ -4,7 +4,6 @@ import java.io.IOException;
 import java.nio.file.Files;
 import java.nio.file.LinkOption;
 import java.nio.file.Path;
-import org.arflex.drcr.impl.abi.Posix;
 
 /**
  * Whether a file or folder is a door into what the runtime trusts: one that group or others may
@@ -21,8 +20,8 @@ final class FileDoors {
     }
 
     /** The runtime's effective user id (the owner, besides root, whose files are trusted). */
-    static int runtimeUid() {
-        return Posix.LIBC.geteuid();
+    static int runtimeUid() throws IOException {
+        return (Integer) Files.getAttribute(Path.of("/proc/self"), "unix:uid"); // /proc/<pid>: this process's euid
     }
 
     /**

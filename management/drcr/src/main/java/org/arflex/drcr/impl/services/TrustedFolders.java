@@ -22,8 +22,8 @@ final class TrustedFolders {
      * be trusted as it is, else why not, naming the path and its mode or owner.
      */
     static String refusal(Path dir, Path file) {
-        int uid = FileDoors.runtimeUid();
         try {
+            int uid = FileDoors.runtimeUid();
             Path above = FileDoors.writableAbove(dir);
             if (above != null) {
                 return "the folder " + above + " above it is writable by group or others (" + FileDoors.octal(FileDoors.mode(above))
