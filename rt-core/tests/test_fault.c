@@ -95,13 +95,26 @@ static void host_create_every_call_fails(void **state)
 static char *envp[256];
 static char env_nth[64];
 
-static void make_env(long n)
+static char env_hooks[] = "ARFLEX_TEST_HOOKS=1";
+
+/* envp: this process's environment without ARFLEX_*, with the test-hook marker (D80: without
+ * it rt-core ignores every ARFLEX_FAULT_*) when @hooks; returns the next free slot. */
+static int base_env(int hooks)
 {
 	int k = 0;
 
 	for (char **e = environ; *e && k < 250; e++)
 		if (strncmp(*e, "ARFLEX_", 7))
 			envp[k++] = *e;
+	if (hooks)
+		envp[k++] = env_hooks;
+	return k;
+}
+
+static void make_env(long n)
+{
+	int k = base_env(1);
+
 	snprintf(env_nth, sizeof(env_nth), "ARFLEX_FAULT_NTH=%ld", n);
 	envp[k++] = env_nth;
 	envp[k] = NULL;
@@ -182,11 +195,8 @@ static void env_var_refuses_start(void **state)
 	out.spec.type.elem_size = PROBE_OUT_BYTES;
 	for (int refuse = 0; refuse < 2; refuse++) {
 		struct arflex_host h;
-		int k = 0;
+		int k = base_env(1);
 
-		for (char **e = environ; *e && k < 250; e++)
-			if (strncmp(*e, "ARFLEX_", 7))
-				envp[k++] = *e;
 		if (refuse) {
 			snprintf(env_start, sizeof(env_start), "ARFLEX_FAULT_START_ERRNO=%d", ECANCELED);
 			envp[k++] = env_start;
@@ -242,9 +252,7 @@ static void env_var_crashes_after_cycles(void **state)
 	th_rid(rid, sizeof(rid), "fcrash");
 	fill_opts(&o, &p, &out, "probe");
 	out.spec.type.elem_size = PROBE_OUT_BYTES;
-	for (char **e = environ; *e && k < 250; e++)
-		if (strncmp(*e, "ARFLEX_", 7))
-			envp[k++] = *e;
+	k = base_env(1);
 	snprintf(env_crash, sizeof(env_crash), "ARFLEX_FAULT_CRASH_AFTER_CYCLES=%d", 20);
 	envp[k++] = env_crash;
 	envp[k] = NULL;
@@ -287,9 +295,7 @@ static void env_var_makes_every_nth_cycle_late(void **state)
 	th_rid(rid, sizeof(rid), "flate");
 	fill_opts(&o, &p, &out, "probe");
 	out.spec.type.elem_size = PROBE_OUT_BYTES;
-	for (char **e = environ; *e && k < 250; e++)
-		if (strncmp(*e, "ARFLEX_", 7))
-			envp[k++] = *e;
+	k = base_env(1);
 	snprintf(env_late, sizeof(env_late), "ARFLEX_FAULT_LATE_EVERY_CYCLES=%d", 5);
 	envp[k++] = env_late;
 	envp[k] = NULL;
@@ -327,6 +333,69 @@ static void env_var_makes_every_nth_cycle_late(void **state)
 	assert_true(overruns + 1 >= cycles / 5 && overruns <= cycles / 5 + 10);
 }
 
+static char env_f1[32], env_f2[48], env_f3[48], env_f4[48];
+
+/* Issue 32 (D80): a shipped half, started without the test-hook marker, ignores every
+ * ARFLEX_FAULT_* variable: with all of them set to fault at once (the first set-up call, every
+ * START, a crash and a late cycle in the first update) it comes up, starts, runs 100 cycles on
+ * time and shuts down cleanly, as without them. */
+static void fault_vars_without_the_marker_are_ignored(void **state)
+{
+	struct arflex_host_output out;
+	struct arflex_param_slot p;
+	struct arflex_host_opts o;
+	struct arflex_host h;
+	int k, ready, start, down, status;
+	uint64_t cycles = 0, misses, deadline;
+
+	(void)state;
+	th_rid(rid, sizeof(rid), "fnohooks");
+	fill_opts(&o, &p, &out, "probe");
+	out.spec.type.elem_size = PROBE_OUT_BYTES;
+	k = base_env(0);
+	snprintf(env_f1, sizeof(env_f1), "ARFLEX_FAULT_NTH=%d", 1);
+	snprintf(env_f2, sizeof(env_f2), "ARFLEX_FAULT_START_ERRNO=%d", ECANCELED);
+	snprintf(env_f3, sizeof(env_f3), "ARFLEX_FAULT_CRASH_AFTER_CYCLES=%d", 1);
+	snprintf(env_f4, sizeof(env_f4), "ARFLEX_FAULT_LATE_EVERY_CYCLES=%d", 1);
+	envp[k++] = env_f1;
+	envp[k++] = env_f2;
+	envp[k++] = env_f3;
+	envp[k++] = env_f4;
+	envp[k] = NULL;
+	assert_int_equal(arflex_host_create(&h, &o), 0);
+	assert_int_equal(arflex_host_spawn(&h, ARFLEX_PROBE_EXE, NULL, envp), 0);
+	ready = arflex_host_wait_state(&h, ARFLEX_STATE_READY, 10 * SEC);
+	start = ready == 0 ? arflex_host_start(&h, 2 * SEC) : ready;
+	deadline = arflex_sys_now_ns() + 10 * SEC;
+	while (start == 0 && arflex_sys_now_ns() < deadline &&
+	       (cycles = __atomic_load_n(&h.ctl->stats.cycles, __ATOMIC_ACQUIRE)) < 100)
+		arflex_sys_sleep_until(arflex_sys_now_ns() + 1000000u);
+	if (start == 0)
+		arflex_host_stop(&h, 2 * SEC);
+	cycles = h.ctl->stats.cycles;
+	misses = h.ctl->stats.deadline_misses;
+	/* the half is shut down before anything is asserted: a failure leaves no process */
+	down = arflex_host_shutdown(&h, 2 * SEC);
+	if (down == 0)
+		down = arflex_host_wait_exit(&h, 10 * SEC);
+	else
+		arflex_host_kill(&h, SIGKILL), arflex_host_wait_exit(&h, 10 * SEC);
+	status = arflex_host_exit_status(&h);
+	arflex_host_destroy(&h);
+	th_assert_clean(rid);
+	print_message("without the marker: ready %d, start %d, %llu cycles, %llu deadline misses\n", ready, start,
+		      (unsigned long long)cycles, (unsigned long long)misses);
+	assert_int_equal(ready, 0);
+	assert_int_equal(start, 0);
+	assert_true(cycles >= 100);
+	/* the late fault honoured would make every cycle late (>= 100 misses); a loaded machine
+	 * adds a few (1 to 3 at a load of 16 on 2 CPUs) */
+	assert_true(misses < cycles / 2);
+	assert_int_equal(down, 0);
+	assert_true(WIFEXITED(status));
+	assert_int_equal(WEXITSTATUS(status), 0);
+}
+
 static void env_var_enables_injection(void **state)
 {
 	(void)state;
@@ -361,6 +430,7 @@ int main(void)
 		cmocka_unit_test(env_var_refuses_start),
 		cmocka_unit_test(env_var_crashes_after_cycles),
 		cmocka_unit_test(env_var_makes_every_nth_cycle_late),
+		cmocka_unit_test(fault_vars_without_the_marker_are_ignored),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);

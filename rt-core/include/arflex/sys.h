@@ -15,7 +15,9 @@
  * acquiring call after enabling fails with the given errno (or a realistic default for that
  * call) and no side effect; all other calls behave normally. It is enabled either by
  * arflex_sys_fault_set() or, at the first wrapped call of a process, by the environment
- * variable ARFLEX_FAULT_NTH=<N> (optionally ARFLEX_FAULT_ERRNO=<errno number>).
+ * variable ARFLEX_FAULT_NTH=<N> (optionally ARFLEX_FAULT_ERRNO=<errno number>), which is read
+ * only when the environment also holds the test-hook marker ARFLEX_TEST_HOOKS=1 (D80: only a
+ * test runtime's DRCR and the tests set it; a production half ignores every ARFLEX_FAULT_*).
  * The counter is per process and thread safe.
  *
  * Thread safety: all functions are thread safe. arflex_sys_now_ns() and
@@ -63,6 +65,16 @@ ARFLEX_API long arflex_sys_fault_calls(void);
 
 /** True when an injected fault has fired since the last arflex_sys_fault_set(). */
 ARFLEX_API bool arflex_sys_fault_fired(void);
+
+/** True when this process's environment holds the test-hook marker ARFLEX_TEST_HOOKS=1 (D80). */
+ARFLEX_API bool arflex_sys_test_hooks(void);
+
+/**
+ * The value of the test fault variable @name (an ARFLEX_FAULT_*), or NULL when it is unset or
+ * the test-hook marker is not (arflex_sys_test_hooks()): a production half has no fault mode.
+ * Not for the RT thread (getenv).
+ */
+ARFLEX_API const char *arflex_sys_fault_env(const char *name);
 
 /* ---- time (never faulted, RT safe) -------------------------------------------------- */
 

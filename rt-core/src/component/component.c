@@ -13,6 +13,8 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+extern char **environ;
+
 #include "internal.h"
 
 static volatile sig_atomic_t got_signal;
@@ -155,7 +157,7 @@ static void init_params(struct arflex_ctl *ctl)
  * faulty versions set it (a script that execs the real executable); nothing shipped does. */
 static void fault_start_env(struct arflex_component *c)
 {
-	const char *s = getenv("ARFLEX_FAULT_START_ERRNO");
+	const char *s = arflex_sys_fault_env("ARFLEX_FAULT_START_ERRNO");
 	char *end;
 	long n;
 
@@ -175,7 +177,7 @@ static void fault_start_env(struct arflex_component *c)
  * ignored on stderr). */
 static uint64_t fault_count_env(const struct arflex_component *c, const char *var)
 {
-	const char *s = getenv(var);
+	const char *s = arflex_sys_fault_env(var);
 	char *end;
 	long long n;
 
@@ -214,6 +216,21 @@ static void fault_late_env(struct arflex_component *c)
 			c->name, (unsigned long long)c->fault_late_every);
 }
 
+/* Says once, at start, that ARFLEX_FAULT_* variables were found and ignored: without the
+ * test-hook marker (ARFLEX_TEST_HOOKS=1, set only by a test runtime's DRCR and the tests: D80)
+ * a half has no fault mode, whatever its environment holds. */
+static void fault_ignored_note(const struct arflex_component *c)
+{
+	if (arflex_sys_test_hooks())
+		return;
+	for (char **e = environ; *e; e++)
+		if (!strncmp(*e, "ARFLEX_FAULT_", 13)) {
+			fprintf(stderr, "arflex: %s: ARFLEX_FAULT_* ignored: rt-core's test faults need "
+				"ARFLEX_TEST_HOOKS=1, which only a test runtime sets\n", c->name);
+			return;
+		}
+}
+
 int arflex_component_main(int argc, char **argv, const struct arflex_component_ops *ops)
 {
 	static struct arflex_component comp;
@@ -237,6 +254,7 @@ int arflex_component_main(int argc, char **argv, const struct arflex_component_o
 	fault_start_env(c);
 	fault_crash_env(c);
 	fault_late_env(c);
+	fault_ignored_note(c);
 
 	memset(&sa, 0, sizeof(sa));
 	sa.sa_handler = on_signal;

@@ -81,7 +81,7 @@ void arflex_comp_readopt_take(struct arflex_component *c)
  * real executable); nothing shipped does. 0: not set (mailbox thread). */
 static int fault_readopt_env(void)
 {
-	const char *s = getenv("ARFLEX_FAULT_READOPT_ERRNO");
+	const char *s = arflex_sys_fault_env("ARFLEX_FAULT_READOPT_ERRNO");
 	char *end;
 	long n;
 

@@ -6,6 +6,7 @@
 #include <sched.h>
 #include <spawn.h>
 #include <stdlib.h>
+#include <string.h>
 #include <sys/mman.h>
 #include <sys/random.h>
 #include <sys/wait.h>
@@ -38,6 +39,18 @@ bool arflex_sys_fault_fired(void)
 	return __atomic_load_n(&fault_fired, __ATOMIC_RELAXED) != 0;
 }
 
+bool arflex_sys_test_hooks(void)
+{
+	const char *m = getenv("ARFLEX_TEST_HOOKS");
+
+	return m && !strcmp(m, "1");
+}
+
+const char *arflex_sys_fault_env(const char *name)
+{
+	return arflex_sys_test_hooks() ? getenv(name) : NULL;
+}
+
 static void fault_env(void)
 {
 	const char *s, *e;
@@ -46,13 +59,13 @@ static void fault_env(void)
 
 	if (__atomic_exchange_n(&fault_env_done, 1, __ATOMIC_ACQ_REL))
 		return;
-	s = getenv("ARFLEX_FAULT_NTH");
+	s = arflex_sys_fault_env("ARFLEX_FAULT_NTH");
 	if (!s || !*s)
 		return;
 	n = strtol(s, &end, 10);
 	if (*end || n < 0)
 		return;
-	e = getenv("ARFLEX_FAULT_ERRNO");
+	e = arflex_sys_fault_env("ARFLEX_FAULT_ERRNO");
 	__atomic_store_n(&fault_err, e ? atoi(e) : 0, __ATOMIC_RELAXED);
 	__atomic_store_n(&fault_nth, n, __ATOMIC_RELEASE);
 }

@@ -53,6 +53,7 @@ class AttackBench {
             print(mb.attempts);
         }
         print(List.of(CodeDoors.umask000(work)));
+        print(EnvDoors.tryAll(work)); // trusted folders' owners and modes, the halves' environment (D80)
 
         long ok = all.stream().filter(CodeDoors.Attempt::succeeded).count();
         StringBuilder json = new StringBuilder("{\"part\":\"runtime\",\"attempts\":[");

@@ -5,6 +5,7 @@ import java.time.LocalTime;
 import java.util.ArrayList;
 import java.util.Hashtable;
 import java.util.List;
+import java.util.Map;
 import java.util.concurrent.Executors;
 import java.util.concurrent.ScheduledExecutorService;
 import java.util.concurrent.ScheduledThreadPoolExecutor;
@@ -55,7 +56,8 @@ import org.osgi.util.tracker.BundleTracker;
  * {@code bundle,cell,tools,console} of the working directory: docs/DECISIONS.md D12),
  * {@code arflex.code.truststore} (the folder of certificates whose keys may sign component
  * bundles; default {@code trust} of the working directory, {@code none}: no signature is
- * trusted; D14).
+ * trusted; D14), {@code arflex.test.hooks} (true: RT halves get {@code ARFLEX_TEST_HOOKS=1}, so
+ * rt-core honours its test fault variables; the tests' runtimes only; D80).
  */
 @Header(name = Constants.BUNDLE_ACTIVATOR, value = "${@class}")
 public final class Activator implements BundleActivator {
@@ -156,6 +158,14 @@ public final class Activator implements BundleActivator {
             return t;
         });
         VerifiedExecutables executables = new VerifiedExecutables(storage, log);
+        // halves get an explicit environment; rt-core's test faults only under a test runtime (D80)
+        boolean testHooks = Boolean.parseBoolean(prop(ctx, "arflex.test.hooks", "false"));
+        if (testHooks) {
+            log.accept("arflex: TEST HOOKS ON (arflex.test.hooks=true): RT halves honour rt-core's ARFLEX_FAULT_* "
+                    + "variables; never on a cell");
+        }
+        Map<String, String> halfEnv = org.arflex.drcr.impl.supervisor.HalfEnvironment.of(System.getenv(), testHooks);
+        log.accept("arflex: RT halves get only the environment variables " + new java.util.TreeSet<>(halfEnv.keySet()));
         Cell.Config cfg = new Cell.Config(rid, Long.parseLong(prop(ctx, "arflex.ready.timeout.ms", "5000")), 3_000,
                 Boolean.parseBoolean(prop(ctx, "arflex.nomlock", "false")), types, Posix::monotonicNs,
                 Boolean.parseBoolean(prop(ctx, "arflex.evaluation", "false")));
@@ -164,7 +174,7 @@ public final class Activator implements BundleActivator {
         cell = actor.call(() -> {
             ResourceManagerImpl tmp = new ResourceManagerImpl(null, cap, reserved);
             Planner planner = new Planner(tmp.capacities(cpus, memory, network));
-            Cell c = new Cell(cfg, actor, new ProcessLauncher(log, executables), planner, log, stopper, launches);
+            Cell c = new Cell(cfg, actor, new ProcessLauncher(log, executables, halfEnv), planner, log, stopper, launches);
             rm[0] = new ResourceManagerImpl(c, cap, reserved);
             return c;
         }, 10_000);

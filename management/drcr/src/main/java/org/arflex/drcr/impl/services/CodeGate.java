@@ -159,6 +159,10 @@ public final class CodeGate {
         if (dir == null) {
             return new Decision(false, "not verified: " + file + " is outside the trusted folders");
         }
+        String door = TrustedFolders.refusal(dir, file); // issue 30 finding 5 (D80)
+        if (door != null) {
+            return new Decision(false, "not trusted: " + door + "; chmod go-w and chown it to the runtime's user or root");
+        }
         String onDisk;
         try {
             onDisk = ContentDigest.ofJar(file);

@@ -35,8 +35,6 @@ final class TrustStore {
 
     private static final Set<PosixFilePermission> OTHERS_WRITE = Set.of(PosixFilePermission.GROUP_WRITE,
             PosixFilePermission.OTHERS_WRITE);
-    private static final int STICKY = 01000;
-    private static final int GROUP_OR_OTHERS_WRITE = 0022;
 
     private final Path folder;
 
@@ -64,13 +62,11 @@ final class TrustStore {
         }
         Path real = folder.toRealPath();
         checkNotADoor(real, "the trust store folder");
-        for (Path up = real.getParent(); up != null; up = up.getParent()) {
-            int mode = mode(up);
-            if ((mode & GROUP_OR_OTHERS_WRITE) != 0 && (mode & STICKY) == 0) {
-                throw new IOException("the trust store " + real + " is refused: the folder " + up
-                        + " above it is writable by group or others (" + String.format("%04o", mode & 07777)
-                        + "), so its trust store could be replaced");
-            }
+        Path up = FileDoors.writableAbove(real);
+        if (up != null) {
+            throw new IOException("the trust store " + real + " is refused: the folder " + up
+                    + " above it is writable by group or others (" + FileDoors.octal(FileDoors.mode(up))
+                    + "), so its trust store could be replaced");
         }
         KeyStore ks;
         try {
@@ -133,18 +129,6 @@ final class TrustStore {
         if (!owner.equals(me) && !owner.equals("root")) {
             throw new IOException(what + " " + p + " is owned by " + owner + ", not by " + me
                     + " or root: the trust store is refused, no signature is trusted");
-        }
-    }
-
-    private static int mode(Path p) throws IOException {
-        try {
-            return (Integer) Files.getAttribute(p, "unix:mode");
-        } catch (UnsupportedOperationException | IllegalArgumentException e) {
-            int m = 0;
-            for (PosixFilePermission x : Files.getPosixFilePermissions(p)) {
-                m |= 1 << (8 - x.ordinal());
-            }
-            return m;
         }
     }
 }

@@ -11,6 +11,7 @@ import java.security.SecureRandom;
 import java.util.ArrayDeque;
 import java.util.Deque;
 import java.util.List;
+import java.util.Map;
 import java.util.concurrent.CompletableFuture;
 import java.util.concurrent.TimeUnit;
 import java.util.concurrent.locks.LockSupport;
@@ -46,11 +47,26 @@ public final class ProcessLauncher implements RtLauncher {
     private final Consumer<String> log;
     private final VerifiedExecutables executables;
     private final RebindConfirmer confirmer = new RebindConfirmer();
+    private final Map<String, String> environment;
 
-    /** @param executables every executable is checked against it before it is spawned */
+    /**
+     * A launcher whose halves get {@link HalfEnvironment} of this process's environment, without
+     * the test-hook marker.
+     *
+     * @param executables every executable is checked against it before it is spawned
+     */
     public ProcessLauncher(Consumer<String> log, VerifiedExecutables executables) {
+        this(log, executables, HalfEnvironment.of(System.getenv(), false));
+    }
+
+    /**
+     * @param executables every executable is checked against it before it is spawned
+     * @param environment the whole environment of every half ({@link HalfEnvironment}), nothing of this process's own
+     */
+    public ProcessLauncher(Consumer<String> log, VerifiedExecutables executables, Map<String, String> environment) {
         this.log = log;
         this.executables = executables;
+        this.environment = Map.copyOf(environment);
     }
 
     /** The name of a shared object of an instance. */
@@ -134,6 +150,8 @@ public final class ProcessLauncher implements RtLauncher {
             ProcessBuilder pb = new ProcessBuilder(exe, "--runtime", rid, "--instance", inst)
                     .redirectErrorStream(true)
                     .redirectInput(ProcessBuilder.Redirect.PIPE);
+            pb.environment().clear(); // not the runtime's: no console password, no stray fault (D80)
+            pb.environment().putAll(environment);
             p = pb.start();
         } catch (IOException e) {
             mb.close();
