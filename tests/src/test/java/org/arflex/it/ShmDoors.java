@@ -153,7 +153,8 @@ final class ShmDoors implements AutoCloseable {
         String comp = CodeDoors.COMPONENT;
         Path ctl = shm("arflex." + rt.rid + "." + comp + ".ctl");
         rt.cmd("stop " + bundle);
-        rt.waitUntil(comp + " gone", CellIT.T, () -> rt.instance(comp) == null);
+        // Felix stop removes the process and its objects; the component shows INSTALLED
+        rt.waitUntil(comp + " stopped", CellIT.T, () -> "INSTALLED".equals(rt.state(comp)) && rt.pid(comp) == 0);
         runAs("mkdir", ctl.toString());
         runAs("touch", ctl.resolve("mine").toString());
         rt.cmd("start " + bundle);
@@ -230,6 +231,11 @@ final class ShmDoors implements AutoCloseable {
     @Override
     public void close() throws Exception {
         processes.forEach(ShmDoors::end);
+        // what the attacker's processes left when something killed their parent (the old sweep did)
+        List<ProcessHandle> left = ProcessHandle.allProcesses()
+                .filter(h -> h.info().user().map(user::equals).orElse(false)).toList();
+        left.forEach(ProcessHandle::destroyForcibly);
+        left.forEach(h -> h.onExit().orTimeout(10, TimeUnit.SECONDS).exceptionally(e -> h).join());
         List<Path> all = new ArrayList<>(planted);
         try (DirectoryStream<Path> ds = Files.newDirectoryStream(Path.of("/dev/shm"), "squatted.arflex.*")) {
             ds.forEach(all::add);
