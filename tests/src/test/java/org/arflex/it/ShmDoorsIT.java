@@ -61,11 +61,11 @@ class ShmDoorsIT {
             long id = rt.installAndStart(jar);
             rt.awaitState("ACTIVE", CellIT.T, CodeDoors.COMPONENT);
             doors.trySquattedDirectory(rt, id);
+            assertAllShut();
             rt.dto(); // record the instance for the queue leak check
             rt.cmd("uninstall " + id);
             rt.waitUntil(CodeDoors.COMPONENT + " gone", CellIT.T, () -> rt.instance(CodeDoors.COMPONENT) == null);
         }
-        assertAllShut();
         assertEquals(2, doors.attempts.size(), doors.attempts.toString());
     }
 }
