@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -659,9 +660,30 @@ static void port_abi_2_layout_and_1x_refused(void **state)
 	th_assert_clean(rid);
 }
 
+/* Issue 30 (D79): a FIFO or a directory someone put at a port's name is refused, never waited on. */
+static void port_open_refuses_a_fifo_or_directory_at_the_name(void **state)
+{
+	struct arflex_port q;
+	char name[ARFLEX_OBJ_NAME_SIZE], path[ARFLEX_OBJ_NAME_SIZE + 16];
+
+	(void)state;
+	th_rid(rid, sizeof(rid), "squat");
+	name_of(name, "fifo");
+	snprintf(path, sizeof(path), "/dev/shm%s", name);
+	assert_int_equal(mkfifo(path, 0666), 0);
+	/* a reader's open of a FIFO without O_NONBLOCK waits for a writer: this returns at once */
+	assert_int_equal(arflex_port_open(&q, name, false, false, ARFLEX_PORT_STATE, NULL), -EPERM);
+	assert_int_equal(unlink(path), 0);
+	assert_int_equal(mkdir(path, 0777), 0);
+	assert_int_equal(arflex_port_open(&q, name, false, false, ARFLEX_PORT_STATE, NULL), -EPERM);
+	assert_int_equal(rmdir(path), 0);
+	th_assert_clean(rid);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(port_open_refuses_a_fifo_or_directory_at_the_name),
 		cmocka_unit_test(state_port_no_torn_no_lost),
 		cmocka_unit_test(port_open_checks_type),
 		cmocka_unit_test(port_age_and_header_recheck),

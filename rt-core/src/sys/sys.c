@@ -9,6 +9,7 @@
 #include <string.h>
 #include <sys/mman.h>
 #include <sys/random.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -127,16 +128,28 @@ struct timespec arflex_sys_realtime_in(uint64_t rel_ns)
 	return arflex_sys_ts(ns);
 }
 
+/*
+ * /dev/shm is writable by every user (issue 30, D79): an object is only used when it is a
+ * regular file of this process's user. glibc's shm_open adds O_NOFOLLOW; O_NONBLOCK keeps a
+ * FIFO someone put at the name from blocking the open (it changes nothing for a regular file).
+ */
 int arflex_sys_shm_open(const char *name, int oflag, mode_t mode)
 {
+	struct stat st;
 	int r = fault(EMFILE);
 
 	if (r)
 		return r;
 	do {
-		r = shm_open(name, oflag, mode);
+		r = shm_open(name, oflag | O_NONBLOCK, mode);
 	} while (r < 0 && errno == EINTR);
-	return r < 0 ? -errno : r;
+	if (r < 0)
+		return -errno;
+	if (fstat(r, &st) || !S_ISREG(st.st_mode) || st.st_uid != geteuid()) {
+		close(r);
+		return -EPERM;
+	}
+	return r;
 }
 
 int arflex_sys_shm_unlink(const char *name)

@@ -51,6 +51,10 @@ class AttackBench {
             rt.waitUntil(CodeDoors.COMPONENT + " gone", CellIT.T, () -> rt.instance(CodeDoors.COMPONENT) == null);
             mb.trySquat(counter);
             print(mb.attempts);
+            try (ShmDoors shm = new ShmDoors()) {
+                shm.tryAll(rt, counter);
+                print(shm.attempts);
+            }
         }
         print(List.of(CodeDoors.umask000(work)));
         print(EnvDoors.tryAll(work)); // trusted folders' owners and modes, the halves' environment (D80)

@@ -30,7 +30,9 @@ import org.arflex.drcr.impl.services.VerifiedInstaller;
 import org.arflex.drcr.impl.shell.CellWatch;
 import org.arflex.drcr.impl.shell.Commands;
 import org.arflex.drcr.impl.supervisor.HeartbeatBridge;
+import org.arflex.drcr.impl.supervisor.HalfRecords;
 import org.arflex.drcr.impl.supervisor.ProcessLauncher;
+import org.arflex.drcr.impl.supervisor.RecordingLauncher;
 import org.arflex.drcr.impl.supervisor.VerifiedExecutables;
 import org.arflex.planner.Planner;
 import org.osgi.annotation.bundle.Header;
@@ -174,7 +176,8 @@ public final class Activator implements BundleActivator {
         cell = actor.call(() -> {
             ResourceManagerImpl tmp = new ResourceManagerImpl(null, cap, reserved);
             Planner planner = new Planner(tmp.capacities(cpus, memory, network));
-            Cell c = new Cell(cfg, actor, new ProcessLauncher(log, executables, halfEnv), planner, log, stopper, launches);
+            Cell c = new Cell(cfg, actor, new RecordingLauncher(new ProcessLauncher(log, executables, halfEnv),
+                    HalfRecords.system(log)), planner, log, stopper, launches);
             rm[0] = new ResourceManagerImpl(c, cap, reserved);
             return c;
         }, 10_000);

@@ -53,6 +53,17 @@ public interface Posix extends Library {
 
     int close(int fd) throws LastErrorException;
 
+    int O_NOCTTY = 0400;
+    int O_NOFOLLOW = 0400000;
+    int O_CLOEXEC = 02000000;
+
+    int open(String path, int oflag) throws LastErrorException;
+
+    long read(int fd, byte[] buf, long count) throws LastErrorException;
+
+    /** struct stat on x86-64 is 144 bytes: st_mode at 24, st_uid at 28, st_size at 48 (glibc 2.33+ exports fstat). */
+    int fstat(int fd, byte[] statbuf) throws LastErrorException;
+
     int SEEK_END = 2;
 
     /** With SEEK_END and offset 0: the size of a shared-memory object. */

@@ -5,8 +5,10 @@ import java.io.IOException;
 import java.nio.file.Files;
 import java.nio.file.LinkOption;
 import java.nio.file.Path;
+import java.nio.file.StandardCopyOption;
 import java.nio.file.attribute.PosixFileAttributes;
 import java.nio.file.attribute.PosixFilePermissions;
+import java.security.SecureRandom;
 import java.util.List;
 import java.util.function.Consumer;
 import org.arflex.drcr.impl.abi.MessageQueue;
@@ -28,6 +30,8 @@ final class Squatters {
         T create() throws IOException;
     }
 
+    private static final SecureRandom RANDOM = new SecureRandom();
+
     private Squatters() {
     }
 
@@ -46,9 +50,16 @@ final class Squatters {
         }
         List<String> kept = new java.util.ArrayList<>();
         for (String n : shm) {
-            String who = owner(Path.of("/dev/shm", n.substring(1)));
+            Path path = Path.of("/dev/shm", n.substring(1));
+            String who = owner(path);
             if (who != null && !ShmSegment.unlinkQuietly(n)) {
-                kept.add(n + " (" + who + ")");
+                String aside = moveAside(path);
+                if (aside == null) {
+                    kept.add(n + " (" + who + ")");
+                } else {
+                    log.accept("arflex: " + inst + ": " + path + " existed before this runtime created it (" + who
+                            + "), a directory shm_unlink cannot remove: " + aside + ", never adopted");
+                }
             } else if (who != null) {
                 log.accept("arflex: " + inst + ": shared memory " + n + " existed before this runtime created it ("
                         + who + "): removed, never adopted");
@@ -73,6 +84,27 @@ final class Squatters {
                         + "removed (someone on this machine squats " + shm + " " + mq + "): " + e.getMessage(), e);
             }
             throw e;
+        }
+    }
+
+    /**
+     * Frees a name shm_unlink cannot remove (a directory, issue 30 finding 4): an empty one is
+     * removed (rmdir), any other is renamed aside within the folder (rename neither follows nor
+     * opens anything; what it holds stays its owner's). Null when neither worked (not root).
+     */
+    static String moveAside(Path p) {
+        try {
+            Files.delete(p);
+            return "removed";
+        } catch (IOException e) {
+            // not empty, or not ours to remove
+        }
+        Path to = p.resolveSibling("squatted." + p.getFileName() + "." + Long.toHexString(RANDOM.nextLong()));
+        try {
+            Files.move(p, to, StandardCopyOption.ATOMIC_MOVE);
+            return "moved aside to " + to;
+        } catch (IOException e) {
+            return null;
         }
     }
 

@@ -47,6 +47,35 @@ class SquattersTest {
                 && log.get(0).contains("never adopted"), log.get(0));
     }
 
+    /** Issue 30 finding 4: a directory at the name (shm_unlink cannot remove one) made every restart fail. */
+    @Test
+    void aSquattedDirectoryIsMovedAsideAndTheSegmentCreated() throws IOException {
+        String name = base + ".ctl";
+        Path dir = Path.of("/dev/shm", name.substring(1));
+        Files.createDirectory(dir);
+        Files.write(dir.resolve("keep"), new byte[] {1});
+        List<Path> aside = new ArrayList<>();
+        try (ShmSegment s = Squatters.createExclusive("probe", List.of(name), List.of(),
+                () -> ShmSegment.create(name, 4096), log::add)) {
+            assertTrue(Files.isRegularFile(dir), "the segment was created at the name");
+        } finally {
+            ShmSegment.unlinkQuietly(name);
+            try (var ds = Files.newDirectoryStream(dir.getParent(), "squatted." + dir.getFileName() + ".*")) {
+                ds.forEach(aside::add);
+            }
+            for (Path p : aside) {
+                Files.deleteIfExists(p.resolve("keep"));
+                Files.deleteIfExists(p);
+            }
+            Files.deleteIfExists(dir.resolve("keep"));
+            Files.deleteIfExists(dir);
+        }
+        assertEquals(1, aside.size(), "the squatter's directory, with what it holds, kept aside: " + aside);
+        assertEquals(1, log.size(), log.toString());
+        assertTrue(log.get(0).contains("a directory") && log.get(0).contains("moved aside to ")
+                && log.get(0).contains("never adopted"), log.get(0));
+    }
+
     @Test
     void squattedQueuesAreRemovedAndTheMailboxCreated() throws IOException {
         String cmd = base + ".cmd";
