@@ -51,6 +51,9 @@ class AttackBench {
             rt.waitUntil(CodeDoors.COMPONENT + " gone", CellIT.T, () -> rt.instance(CodeDoors.COMPONENT) == null);
             mb.trySquat(counter);
             print(mb.attempts);
+            GateDoors gate = new GateDoors(rt, work.resolve("attack-gate"));
+            gate.tryAll();
+            print(gate.attempts);
         }
         print(List.of(CodeDoors.umask000(work)));
 

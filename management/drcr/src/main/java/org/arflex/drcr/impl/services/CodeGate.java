@@ -84,6 +84,8 @@ public final class CodeGate {
     JarSignatures.Verdict signature(String name, byte[] jar) {
         try {
             return signature(ContentDigest.entries(name, jar));
+        } catch (BoundedJar.Refused e) {
+            return JarSignatures.Verdict.refused("refused: " + e.getMessage());
         } catch (IOException e) {
             return JarSignatures.Verdict.refused("unreadable jar: " + e.getMessage());
         }
@@ -118,7 +120,7 @@ public final class CodeGate {
             entries = ContentDigest.entries(b);
             digest = ContentDigest.of(entries);
         } catch (BoundedJar.Refused e) {
-            return new Decision(false, "refused: " + e.getMessage()); // a verdict: the same each time it is read
+            return new Decision(false, e.getMessage()); // a verdict: the same each time it is read
         } catch (IOException | RuntimeException e) {
             digest = "(unreadable: " + e.getMessage() + ")";
         }

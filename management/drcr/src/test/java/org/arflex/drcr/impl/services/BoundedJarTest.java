@@ -103,4 +103,21 @@ class BoundedJarTest {
                 e.getMessage());
         assertEquals(0, new BoundedJar("x.jar").entries(jar, n -> !n.equals("e-1")).get("e-1").length, "not kept");
     }
+
+    @Test
+    void aJarWithinTheLimitsIsKeptOnceItsInflatedSizeNoMore(@org.junit.jupiter.api.io.TempDir java.nio.file.Path dir)
+            throws IOException {
+        // an RT executable of 24 MiB (the largest today) and a contract: what a reading keeps is measured
+        int exe = 24 << 20;
+        java.nio.file.Path jar = java.nio.file.Files.write(dir.resolve("x.jar"), random(exe, 3000));
+        long size = java.nio.file.Files.size(jar);
+        Bombs.Measured<Map<String, byte[]>> m = Bombs.allocation(() -> {
+            BoundedJar r = new BoundedJar(jar.toString());
+            return r.entries(r.file(jar));
+        });
+        assertEquals(exe, m.value().get("e-0").length);
+        System.out.println("a jar of " + (size >> 10) + " KiB inflating to " + ((exe + 3000) >> 10) + " KiB read having"
+                + " allocated " + (m.allocated() >> 10) + " KiB");
+        assertTrue(m.allocated() < size + exe + (4 << 20), "allocated " + (m.allocated() >> 10) + " KiB");
+    }
 }
