@@ -55,6 +55,9 @@ class AttackBench {
                 shm.tryAll(rt, counter);
                 print(shm.attempts);
             }
+            GateDoors gate = new GateDoors(rt, work.resolve("attack-gate"));
+            gate.tryAll();
+            print(gate.attempts);
         }
         print(List.of(CodeDoors.umask000(work)));
         print(EnvDoors.tryAll(work)); // trusted folders' owners and modes, the halves' environment (D80)

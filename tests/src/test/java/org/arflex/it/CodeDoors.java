@@ -172,7 +172,7 @@ final class CodeDoors implements AutoCloseable {
     }
 
     /** Runs a JDK tool (keytool, jarsigner) of this JVM, failing with its output. */
-    private static void jdk(String tool, String... args) throws Exception {
+    static void jdk(String tool, String... args) throws Exception {
         List<String> cmd = new ArrayList<>();
         cmd.add(Path.of(System.getProperty("java.home"), "bin", tool).toString());
         cmd.addAll(List.of(args));

@@ -137,6 +137,8 @@ class ConsoleAttackBench {
             }
             everyOtherEndpoint();
             corpus();
+            ChangeSetFileDoor.Result f = ChangeSetFileDoor.tryOn(rt, counter.toUri().toString());
+            record(ChangeSetFileDoor.DOOR + (f.controlSeen() ? "" : " (CONTROL NOT SEEN)"), f.tries(), f.succeeded(), f.detail());
             assertTrue(rt.get("/system/console/arflex-cell/api/cell", true).statusCode() == 200, "the runtime still runs");
         }
         StringBuilder json = new StringBuilder("{\"part\":\"console\",\"attempts\":[");

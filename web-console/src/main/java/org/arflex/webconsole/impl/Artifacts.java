@@ -1,5 +1,6 @@
 package org.arflex.webconsole.impl;
 
+import java.io.ByteArrayInputStream;
 import java.io.IOException;
 import java.io.InputStream;
 import java.io.OutputStream;
@@ -18,6 +19,9 @@ import java.time.Duration;
 import java.util.HexFormat;
 import java.util.Locale;
 import java.util.jar.JarFile;
+import java.util.jar.Manifest;
+import java.util.zip.ZipEntry;
+import java.util.zip.ZipFile;
 import java.util.regex.Pattern;
 
 /**
@@ -186,8 +190,8 @@ final class Artifacts {
     }
 
     private static Staged inspect(Path jar, String sha, String origin) throws HttpError {
-        try (JarFile jf = new JarFile(jar.toFile())) {
-            var mf = jf.getManifest();
+        try (ZipFile zf = new ZipFile(jar.toFile())) {
+            var mf = manifest(zf, origin);
             String bsn = mf == null ? null : mf.getMainAttributes().getValue("Bundle-SymbolicName");
             if (bsn == null) {
                 throw new HttpError(400, origin + ": not an OSGi bundle (no Bundle-SymbolicName in the manifest)");
@@ -196,6 +200,28 @@ final class Artifacts {
             return new Staged(jar, sha, bsn.split(";")[0].trim(), version == null ? "0.0.0" : version, origin);
         } catch (IOException e) {
             throw new HttpError(400, origin + ": not a jar (" + e.getMessage() + ")");
+        }
+    }
+
+    /** Largest manifest read (the runtime's largest bundle has one of about 30 KiB). */
+    static final int MAX_MANIFEST = 1 << 20;
+
+    /**
+     * The manifest, read within {@link #MAX_MANIFEST} bytes whatever the jar declares (issue 30,
+     * finding 1: a zip bomb in place of a manifest fills the heap); null when there is none.
+     */
+    private static Manifest manifest(ZipFile zf, String origin) throws IOException, HttpError {
+        ZipEntry e = zf.getEntry(JarFile.MANIFEST_NAME);
+        if (e == null) {
+            return null;
+        }
+        try (InputStream in = zf.getInputStream(e)) {
+            byte[] b = in.readNBytes(MAX_MANIFEST + 1);
+            if (b.length > MAX_MANIFEST) {
+                throw new HttpError(400, origin + ": entry " + JarFile.MANIFEST_NAME + " inflates past the limit of "
+                        + MAX_MANIFEST + " bytes per manifest");
+            }
+            return new Manifest(new ByteArrayInputStream(b));
         }
     }
 }

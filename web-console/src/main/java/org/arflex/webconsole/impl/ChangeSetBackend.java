@@ -56,14 +56,44 @@ final class ChangeSetBackend {
     private final Runner runner;
     private final Audit audit;
     private final LongSupplier clock;
+    private final StagingSources sources;
     private final AtomicReference<Running> running = new AtomicReference<>();
     private volatile Map<String, Object> last;
 
+    /** A backend that takes no {@code file:} URL (no staging folder configured). */
     ChangeSetBackend(Supplier<ChangeSetService> service, Runner runner, Audit audit, LongSupplier wallClockMillis) {
+        this(service, runner, audit, wallClockMillis, StagingSources.parse(null));
+    }
+
+    /**
+     * @param sources the folders an update's {@code file:} URL may name, the Deploy page's
+     *                (issue 30, finding 9: the DRCR reads the location, and answers with its digest)
+     */
+    ChangeSetBackend(Supplier<ChangeSetService> service, Runner runner, Audit audit, LongSupplier wallClockMillis,
+                     StagingSources sources) {
         this.service = service;
         this.runner = runner;
         this.audit = audit;
         this.clock = wallClockMillis;
+        this.sources = sources;
+    }
+
+    /** Every update's {@code file:} URL names a file in a staging folder, else a 400 naming its line. */
+    private ChangeSetInput staged(ChangeSetInput in) throws HttpError {
+        for (int i = 0; i < in.lines().size(); i++) {
+            String[] t = in.lines().get(i).split(" ");
+            if (t[0].equals("update") && t[2].regionMatches(true, 0, "file:", 0, 5)) {
+                try {
+                    sources.file(java.net.URI.create(t[2]));
+                } catch (HttpError e) {
+                    throw new HttpError(e.status, "line " + in.number().get(i) + ": " + e.getMessage());
+                } catch (IllegalArgumentException | java.io.IOException e) {
+                    throw new HttpError(400, "line " + in.number().get(i) + ": url: '" + t[2] + "' is not a file URL ("
+                            + e.getMessage() + ")");
+                }
+            }
+        }
+        return in;
     }
 
     Routes routes() {
@@ -85,7 +115,7 @@ final class ChangeSetBackend {
 
     /** The dry run of the whole set, with its parts and the id that an apply must name. */
     Map<String, Object> plan(String text) throws HttpError {
-        ChangeSetInput in = ChangeSetInput.parse(text);
+        ChangeSetInput in = staged(ChangeSetInput.parse(text));
         ChangeSetDTO d = dryRun(in);
         return view(in, d);
     }
@@ -129,7 +159,7 @@ final class ChangeSetBackend {
      * gives now is another one or is not admitted, or while another set is applied.
      */
     Map<String, Object> apply(String text, String shownPlanId, String user, String remote) throws HttpError {
-        ChangeSetInput in = ChangeSetInput.parse(text);
+        ChangeSetInput in = staged(ChangeSetInput.parse(text));
         if (shownPlanId == null || !shownPlanId.matches("[0-9a-f]{64}")) {
             throw new HttpError(400, "plan: the id of the plan shown is missing or malformed: plan the set first,"
                     + " then apply the plan shown");

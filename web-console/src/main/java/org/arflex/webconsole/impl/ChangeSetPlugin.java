@@ -35,12 +35,12 @@ public class ChangeSetPlugin extends PluginBase {
     private Routes routes;
 
     @Activate
-    void activate() {
+    void activate(org.osgi.framework.BundleContext bc) {
         ChangeSetBackend sets = new ChangeSetBackend(() -> changeSets, apply -> {
             Thread t = new Thread(apply, "arflex-console-changeset");
             t.setDaemon(true);
             t.start();
-        }, this::audit, System::currentTimeMillis);
+        }, this::audit, System::currentTimeMillis, StagingSources.parse(bc.getProperty(StagingSources.PROPERTY)));
         this.routes = new Routes().add(backend.routes()).add(sets.routes());
     }
 

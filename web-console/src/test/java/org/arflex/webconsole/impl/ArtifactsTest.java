@@ -108,4 +108,23 @@ class ArtifactsTest {
         assertEquals(0, staged());
         assertFalse(Files.exists(dir.resolve("staging/x.jar")));
     }
+
+    @Test
+    void anUploadWhoseManifestInflatesPastItsLimitIsRefused() throws IOException {
+        // issue 30, finding 1: the manifest is read within a limit, whatever the jar declares
+        java.io.ByteArrayOutputStream b = new java.io.ByteArrayOutputStream();
+        try (java.util.zip.ZipOutputStream z = new java.util.zip.ZipOutputStream(b)) {
+            z.putNextEntry(new java.util.zip.ZipEntry("META-INF/MANIFEST.MF"));
+            z.write("Manifest-Version: 1.0\r\nBundle-SymbolicName: bomb\r\n".getBytes());
+            byte[] pad = "X-Pad: 0\r\n".repeat(1 << 16).getBytes();
+            for (int i = 0; i < 8; i++) {
+                z.write(pad); // 5 MiB of headers in all
+            }
+        }
+        HttpError e = assertThrows(HttpError.class, () -> Artifacts.upload(new ByteArrayInputStream(b.toByteArray()),
+                "bomb.jar", dir.resolve("staging")));
+        assertTrue(e.getMessage().contains("upload bomb.jar: entry META-INF/MANIFEST.MF inflates past the limit of "
+                + Artifacts.MAX_MANIFEST + " bytes"), e.getMessage());
+        assertEquals(0, staged());
+    }
 }

@@ -7,6 +7,8 @@ import static org.junit.jupiter.api.Assertions.assertNull;
 import static org.junit.jupiter.api.Assertions.assertThrows;
 import static org.junit.jupiter.api.Assertions.assertTrue;
 
+import java.nio.file.Files;
+import java.nio.file.Path;
 import java.util.ArrayList;
 import java.util.List;
 import java.util.Map;
@@ -14,6 +16,7 @@ import org.arflex.drcr.ChangeSetService;
 import org.arflex.drcr.dto.ChangeSetDTO;
 import org.junit.jupiter.api.BeforeEach;
 import org.junit.jupiter.api.Test;
+import org.junit.jupiter.api.io.TempDir;
 
 /**
  * The Change sets page's backend (D46) against a fake ChangeSetService that answers with the
@@ -411,5 +414,33 @@ class ChangeSetBackendTest {
         // a DRCR before 0.13 of its DTOs keeps no entries
         applyAnswer.updates = null;
         assertEquals(List.of(), ((List<Map<String, Object>>) backend.status().get("history")).get(0).get("entries"));
+    }
+
+    @Test
+    void anUpdateFromAFileOutsideTheStagingFoldersIsRefusedBeforeTheDrcrReadsIt(@TempDir Path dir) throws Exception {
+        // issue 30, finding 9: the page answered with the SHA-256 of any file the runtime can read
+        String pin = " " + "0".repeat(64);
+        for (String url : List.of("file:/etc/shadow", "file:/no/such/file.jar")) {
+            HttpError e = assertThrows(HttpError.class, () -> backend.plan("install teach\nupdate sample-counter " + url
+                    + pin));
+            assertEquals(400, e.status);
+            assertTrue(e.getMessage().startsWith("line 2: ") && e.getMessage().contains("file: URLs are refused"),
+                    e.getMessage());
+            assertThrows(HttpError.class, () -> backend.apply("update sample-counter " + url + pin, "a".repeat(64),
+                    "alice", "127.0.0.1"));
+        }
+        assertEquals(List.of(), planned, "the DRCR never saw the location");
+
+        Path folder = Files.createDirectories(dir.resolve("updates"));
+        Path jar = Files.write(folder.resolve("counter.jar"), new byte[] {1});
+        Files.writeString(dir.resolve("secret"), "s");
+        ChangeSetBackend staged = new ChangeSetBackend(() -> service, started::add, (u, r, a, v) -> { },
+                () -> 1_700_000_000_000L, StagingSources.parse(folder.toString()));
+        HttpError outside = assertThrows(HttpError.class, () -> staged.plan("update sample-counter "
+                + dir.resolve("updates/../secret").toUri() + pin));
+        assertTrue(outside.getMessage().contains("is outside the folders configured"), outside.getMessage());
+        assertEquals(List.of(), planned);
+        staged.plan("update sample-counter " + jar.toUri() + pin);
+        assertEquals(List.of(List.of("update sample-counter " + jar.toUri() + pin)), planned, "inside: planned");
     }
 }

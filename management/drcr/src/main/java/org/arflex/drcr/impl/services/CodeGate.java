@@ -70,15 +70,22 @@ public final class CodeGate {
 
     /** Records a jar whose SHA-256 the verifier checked (its content digest, and from where). */
     void verified(byte[] jar, String origin) throws IOException {
-        String d = ContentDigest.ofJar(jar);
+        String d = ContentDigest.of(ContentDigest.entries(origin, jar));
         verified.put(d, origin);
         log.accept("arflex: code gate: content " + d + " verified (" + origin + ")");
     }
 
     /** Whether a jar is signed entirely by a key of the trust store as it is now. */
     JarSignatures.Verdict signature(byte[] jar) {
+        return signature("the jar", jar);
+    }
+
+    /** As {@link #signature(byte[])}, the jar named {@code name} (its location) when it is refused. */
+    JarSignatures.Verdict signature(String name, byte[] jar) {
         try {
-            return signature(ContentDigest.entries(jar));
+            return signature(ContentDigest.entries(name, jar));
+        } catch (BoundedJar.Refused e) {
+            return JarSignatures.Verdict.refused("refused: " + e.getMessage());
         } catch (IOException e) {
             return JarSignatures.Verdict.refused("unreadable jar: " + e.getMessage());
         }
@@ -112,6 +119,8 @@ public final class CodeGate {
         try {
             entries = ContentDigest.entries(b);
             digest = ContentDigest.of(entries);
+        } catch (BoundedJar.Refused e) {
+            return new Decision(false, e.getMessage()); // a verdict: the same each time it is read
         } catch (IOException | RuntimeException e) {
             digest = "(unreadable: " + e.getMessage() + ")";
         }

@@ -1,21 +1,13 @@
 package org.arflex.drcr.impl.services;
 
-import java.io.ByteArrayInputStream;
 import java.io.IOException;
-import java.io.InputStream;
-import java.net.URL;
 import java.nio.ByteBuffer;
 import java.nio.charset.StandardCharsets;
-import java.nio.file.Files;
 import java.nio.file.Path;
 import java.security.MessageDigest;
 import java.security.NoSuchAlgorithmException;
-import java.util.Enumeration;
 import java.util.HexFormat;
 import java.util.Map;
-import java.util.TreeMap;
-import java.util.zip.ZipEntry;
-import java.util.zip.ZipInputStream;
 import org.osgi.framework.Bundle;
 
 /**
@@ -34,17 +26,14 @@ final class ContentDigest {
         return of(entries(jar));
     }
 
-    /** The file entries of a jar held in memory, by name (what its digest covers). */
+    /** The file entries of a jar held in memory, by name (what its digest covers), read within limits. */
     static Map<String, byte[]> entries(byte[] jar) throws IOException {
-        Map<String, byte[]> entries = new TreeMap<>();
-        try (ZipInputStream in = new ZipInputStream(new ByteArrayInputStream(jar))) {
-            ZipEntry e;
-            while ((e = in.getNextEntry()) != null) {
-                if (!e.isDirectory() && entries.put(e.getName(), in.readAllBytes()) != null) {
-                    throw new IOException("entry " + e.getName() + " appears twice");
-                }
-            }
-        }
+        return entries("the jar", jar);
+    }
+
+    /** As {@link #entries(byte[])}, the jar named {@code name} in a refusal. */
+    static Map<String, byte[]> entries(String name, byte[] jar) throws IOException {
+        Map<String, byte[]> entries = new BoundedJar(name).entries(jar);
         if (entries.isEmpty()) {
             throw new IOException("not a jar (no entries)");
         }
@@ -53,40 +42,13 @@ final class ContentDigest {
 
     /** The digest of a jar file. */
     static String ofJar(Path jar) throws IOException {
-        return ofJar(Files.readAllBytes(jar));
-    }
-
-    /** The digest of an installed bundle's current revision, from its entries. */
-    static String ofBundle(Bundle b) throws IOException {
-        return of(entries(b));
+        BoundedJar reader = new BoundedJar(jar.toString());
+        return of(reader.entries(reader.file(jar)));
     }
 
     /** The file entries of an installed bundle's current revision, by name (what its digest covers). */
     static Map<String, byte[]> entries(Bundle b) throws IOException {
-        Map<String, byte[]> entries = new TreeMap<>();
-        collect(b, "/", entries);
-        return entries;
-    }
-
-    private static void collect(Bundle b, String dir, Map<String, byte[]> into) throws IOException {
-        Enumeration<String> paths = b.getEntryPaths(dir);
-        if (paths == null) {
-            return;
-        }
-        while (paths.hasMoreElements()) {
-            String p = paths.nextElement();
-            if (p.endsWith("/")) {
-                collect(b, p, into);
-                continue;
-            }
-            URL u = b.getEntry(p);
-            if (u == null) {
-                continue;
-            }
-            try (InputStream in = u.openStream()) {
-                into.put(p.startsWith("/") ? p.substring(1) : p, in.readAllBytes());
-            }
-        }
+        return new BoundedJar("bundle " + b.getBundleId() + " (" + b.getLocation() + ")").entries(b);
     }
 
     static String of(Map<String, byte[]> sortedEntries) {

@@ -325,7 +325,7 @@ public final class DeploymentSets {
         byte[] jar = installer.fetch(location, e.sha256()); // the pin checked (and recorded by the gate)
         String how = "sha256 verified";
         if (e.sha256() == null) {
-            JarSignatures.Verdict v = gate.signature(jar);
+            JarSignatures.Verdict v = gate.signature(location, jar);
             if (!v.accepted()) {
                 throw new IOException("not signed by a trusted key: " + v.reason() + "; pin its SHA-256 (sha256=\"...\") "
                         + "or sign it with a key of the trust store " + gate.trustStore());

@@ -55,6 +55,10 @@ final class Fetch {
                 throw new IOException("HTTP " + code);
             }
         }
+        long declared = conn.getContentLengthLong(); // a file's size, an HTTP Content-Length: refused unread
+        if (declared > MAX_JAR) {
+            throw new IOException(declared + " bytes, larger than the limit of " + MAX_JAR + " bytes per jar");
+        }
         try (InputStream in = conn.getInputStream()) {
             ByteArrayOutputStream out = new ByteArrayOutputStream();
             byte[] buf = new byte[65536];
@@ -62,7 +66,7 @@ final class Fetch {
             while ((n = in.read(buf)) > 0) {
                 out.write(buf, 0, n);
                 if (out.size() > MAX_JAR) {
-                    throw new IOException("larger than " + MAX_JAR + " bytes");
+                    throw new IOException("larger than the limit of " + MAX_JAR + " bytes per jar");
                 }
             }
             return out.toByteArray();

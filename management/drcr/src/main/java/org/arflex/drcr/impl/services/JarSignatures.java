@@ -96,7 +96,8 @@ final class JarSignatures {
     /** Checks a jar file. */
     static Verdict check(Path jar, KeyStore trusted) {
         try {
-            return check(Files.readAllBytes(jar), trusted);
+            BoundedJar reader = new BoundedJar(jar.toString());
+            return check(reader.entries(reader.file(jar)), trusted);
         } catch (IOException e) {
             return Verdict.refused("cannot read " + jar + ": "
                     + (e instanceof java.nio.file.NoSuchFileException ? "no such file" : e.getMessage()));
@@ -121,6 +122,12 @@ final class JarSignatures {
         if (manifestName == null || sigFiles.isEmpty()) {
             return Verdict.refused("unsigned: " + (manifestName == null ? "no manifest" : "no signature file in META-INF"));
         }
+        List<String> strays = strays(sigFiles, blocks);
+        if (!strays.isEmpty()) {
+            return Verdict.refused("refused: " + named(strays) + (strays.size() == 1 ? " is" : " are")
+                    + " not covered by the signature (named like a signature file but not a signature file with its"
+                    + " one block: added after signing?)");
+        }
         for (String sf : sigFiles) {
             try {
                 Attributes main = new Manifest(new ByteArrayInputStream(entries.get(sf))).getMainAttributes();
@@ -144,7 +151,7 @@ final class JarSignatures {
             JarEntry e;
             while ((e = in.getNextJarEntry()) != null) {
                 current = e.getName();
-                in.readAllBytes();
+                in.transferTo(java.io.OutputStream.nullOutputStream()); // bounded: the entries were read within limits
                 if (signingFile(current)) {
                     continue;
                 }
@@ -217,6 +224,47 @@ final class JarSignatures {
         n = n.substring(9);
         return n.equals("MANIFEST.MF") || n.endsWith(".SF") || n.endsWith(".RSA") || n.endsWith(".DSA")
                 || n.endsWith(".EC") || n.startsWith("SIG-");
+    }
+
+    /**
+     * The signature-like files that are not a signature (issue 30, finding 10): the JDK leaves
+     * every {@code META-INF/*.SF|RSA|DSA|EC} and {@code SIG-*} out of its coverage, but only a
+     * signature file with exactly one block of the same name, and that block, are a signature.
+     */
+    private static List<String> strays(List<String> sigFiles, List<String> blocks) {
+        List<String> strays = new ArrayList<>();
+        Map<String, List<String>> blocksOf = new LinkedHashMap<>();
+        for (String b : blocks) {
+            String base = base(b);
+            if (base.startsWith("META-INF/SIG-")) {
+                strays.add(b);
+            } else {
+                blocksOf.computeIfAbsent(base, k -> new ArrayList<>()).add(b);
+            }
+        }
+        Set<String> bases = new LinkedHashSet<>();
+        for (String sf : sigFiles) {
+            List<String> own = blocksOf.get(base(sf));
+            if (own == null || own.size() != 1 || !bases.add(base(sf))) {
+                strays.add(sf);
+            }
+            if (own != null && own.size() > 1) {
+                strays.addAll(own);
+            }
+        }
+        for (var e : blocksOf.entrySet()) {
+            if (!bases.contains(e.getKey()) && sigFiles.stream().noneMatch(sf -> base(sf).equals(e.getKey()))) {
+                strays.addAll(e.getValue());
+            }
+        }
+        return strays;
+    }
+
+    /** A name in upper case without its extension ({@code META-INF/ONE.SF}: {@code META-INF/ONE}). */
+    private static String base(String name) {
+        String n = name.toUpperCase(Locale.ROOT);
+        int dot = n.lastIndexOf('.');
+        return dot > n.lastIndexOf('/') ? n.substring(0, dot) : n;
     }
 
     /** The entries as a jar the JDK verifier reads: manifest, signature files, blocks, the rest. */

@@ -6,14 +6,11 @@ import java.net.URI;
 import java.security.MessageDigest;
 import java.security.NoSuchAlgorithmException;
 import java.util.ArrayList;
-import java.util.HashMap;
 import java.util.HexFormat;
 import java.util.List;
 import java.util.Map;
 import java.util.Optional;
 import java.util.function.Consumer;
-import java.util.jar.JarEntry;
-import java.util.jar.JarInputStream;
 import java.util.jar.Manifest;
 import org.arflex.contract.Contract;
 import org.arflex.contract.UpdateSpec;
@@ -211,20 +208,15 @@ public final class Services implements DrcrService, UpdateService {
 
     /** Reads the contracts of a jar held in memory (a broken jar is a problem, not an exception). */
     public ContractReader.Result readJar(String label, byte[] jar) {
-        Map<String, byte[]> entries = new HashMap<>();
+        Map<String, byte[]> entries;
         String header;
-        try (JarInputStream in = new JarInputStream(new ByteArrayInputStream(jar))) {
-            Manifest m = in.getManifest();
+        try {
+            entries = new BoundedJar(label).entries(jar);
+            Manifest m = BoundedJar.manifest(entries);
             if (m == null) {
                 return new ContractReader.Result(List.of(), List.of(label + ": not a bundle (no manifest)"));
             }
             header = m.getMainAttributes().getValue(ContractReader.HEADER);
-            JarEntry e;
-            while ((e = in.getNextJarEntry()) != null) {
-                if (!e.isDirectory()) {
-                    entries.put(e.getName(), in.readAllBytes());
-                }
-            }
         } catch (IOException | RuntimeException e) {
             return new ContractReader.Result(List.of(), List.of(label + ": broken jar: " + e.getMessage()));
         }

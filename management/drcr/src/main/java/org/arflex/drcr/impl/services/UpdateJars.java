@@ -3,10 +3,7 @@ package org.arflex.drcr.impl.services;
 import java.io.ByteArrayInputStream;
 import java.io.IOException;
 import java.nio.file.Path;
-import java.util.HashMap;
 import java.util.Map;
-import java.util.jar.JarEntry;
-import java.util.jar.JarInputStream;
 import java.util.jar.Manifest;
 import org.arflex.contract.Contract;
 import org.arflex.drcr.impl.runtime.ContractReader;
@@ -51,26 +48,19 @@ public final class UpdateJars implements ChangeSets.Versions {
         if (sha256 != null) {
             how = "sha256 verified";
         } else {
-            JarSignatures.Verdict v = gate.signature(jar);
+            JarSignatures.Verdict v = gate.signature(location, jar);
             if (!v.accepted()) {
                 throw new IOException(location + " has no pinned SHA-256 and is not signed by a trusted key: " + v.reason()
                         + "; give its SHA-256 after the URL or sign it with a key of the trust store");
             }
             how = v.describe();
         }
-        // one pass over the jar: the names, and the bytes of everything but native code (an
-        // executable of tens of MB is streamed from the jar only when it is extracted)
-        Map<String, byte[]> entries = new HashMap<>();
-        String header;
-        try (JarInputStream in = new JarInputStream(new ByteArrayInputStream(jar))) {
-            Manifest m = in.getManifest();
-            header = m == null ? null : m.getMainAttributes().getValue(ContractReader.HEADER);
-            for (JarEntry e = in.getNextJarEntry(); e != null; e = in.getNextJarEntry()) {
-                if (!e.isDirectory()) {
-                    entries.put(e.getName(), e.getName().startsWith("native/") ? NATIVE : in.readAllBytes());
-                }
-            }
-        }
+        // the names, and the bytes of everything but native code (an executable of tens of MB is
+        // streamed from the jar only when it is extracted); every entry within the bounded reader's limits
+        BoundedJar bounded = new BoundedJar(location);
+        Map<String, byte[]> entries = bounded.entries(jar, n -> !n.startsWith("native/"));
+        Manifest m = BoundedJar.manifest(entries);
+        String header = m == null ? null : m.getMainAttributes().getValue(ContractReader.HEADER);
         if (header == null) {
             throw new IOException(location + " has no " + ContractReader.HEADER + " header");
         }
@@ -87,22 +77,7 @@ public final class UpdateJars implements ChangeSets.Versions {
         String exe = ContractReader.NATIVE_DIR + c.executable();
         String digest = Services.sha256(jar);
         Path into = dir.resolve(component + "-" + digest.substring(0, 16).toLowerCase(java.util.Locale.ROOT));
-        return new ChangeSets.Version(c, location, how, () -> executables.extract(into, c.executable(), () -> open(jar, exe)),
+        return new ChangeSets.Version(c, location, how, () -> executables.extract(into, c.executable(), () -> bounded.open(jar, exe)),
                 jar);
-    }
-
-    /** Stands for an entry under native/ whose bytes are not kept. */
-    private static final byte[] NATIVE = new byte[0];
-
-    /** The jar's entry {@code name} as a stream (the jar verified above, held in memory). */
-    private static java.io.InputStream open(byte[] jar, String name) throws IOException {
-        JarInputStream in = new JarInputStream(new ByteArrayInputStream(jar));
-        for (JarEntry e = in.getNextJarEntry(); e != null; e = in.getNextJarEntry()) {
-            if (e.getName().equals(name)) {
-                return in;
-            }
-        }
-        in.close();
-        throw new IOException(name + " is not in the jar");
     }
 }

@@ -66,7 +66,7 @@ public final class VerifiedInstaller {
         byte[] jar = fetch(location, sha256);
         String how = "sha256 verified";
         if (sha256 == null) {
-            JarSignatures.Verdict v = gate.signature(jar);
+            JarSignatures.Verdict v = gate.signature(location, jar);
             if (!v.accepted()) {
                 throw new IllegalStateException("not installed: " + location
                         + " has no pinned SHA-256 and is not signed by a trusted key: " + v.reason()

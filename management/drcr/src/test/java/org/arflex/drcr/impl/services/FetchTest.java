@@ -54,4 +54,17 @@ class FetchTest {
         Files.write(f, b);
         assertArrayEquals(b, Fetch.read(f.toUri()));
     }
+
+    @Test
+    void aFileLargerThanTheLimitIsRefusedUnread(@TempDir Path dir) throws IOException {
+        Path f = dir.resolve("big.jar");
+        try (java.io.RandomAccessFile r = new java.io.RandomAccessFile(f.toFile(), "rw")) {
+            r.setLength(Fetch.MAX_JAR + 1L); // sparse: nothing to read but zeros
+        }
+        Bombs.Measured<byte[]> m = Bombs.allocation(() -> Fetch.read(f.toUri()));
+        assertTrue(m.thrown() instanceof IOException && m.thrown().getMessage().equals(
+                (Fetch.MAX_JAR + 1L) + " bytes, larger than the limit of " + Fetch.MAX_JAR + " bytes per jar"),
+                String.valueOf(m.thrown()));
+        assertTrue(m.allocated() < 1 << 20, "allocated " + m.allocated());
+    }
 }

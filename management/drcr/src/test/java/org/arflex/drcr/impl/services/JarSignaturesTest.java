@@ -107,6 +107,22 @@ class JarSignaturesTest {
     }
 
     @Test
+    void anUnsignedSignatureLikeFileAddedAfterSigningIsRefusedByName(@TempDir Path dir) throws Exception {
+        // issue 30, finding 10: the JDK skips these names when it checks coverage, the gate must not
+        byte[] signed = Signing.sign(dir, bundle("good"), one);
+        for (String added : List.of("META-INF/EVIL.EC", "META-INF/SIG-EVIL", "META-INF/EVIL.RSA", "META-INF/EVIL.DSA",
+                "META-INF/EVIL.SF")) {
+            byte[] jar = Signing.rewrite(signed, l -> {
+                l.add(Map.entry(added, "evil".getBytes(StandardCharsets.UTF_8)));
+                return l;
+            });
+            JarSignatures.Verdict v = JarSignatures.check(jar, trusted);
+            assertFalse(v.accepted(), added + " was admitted: " + v.describe());
+            assertTrue(v.reason().contains(added), added + ": " + v.reason());
+        }
+    }
+
+    @Test
     void aModifiedEntryIsRefusedByName(@TempDir Path dir) throws Exception {
         byte[] signed = Signing.sign(dir, bundle("good"), one);
         byte[] modified = Signing.rewrite(signed, l -> l.stream()
