@@ -22,28 +22,15 @@ public final class MachineDiff {
     public static String cause(MachineView before, MachineView now) {
         Map<String, List<Integer>> cpus = new LinkedHashMap<>();
         boolean moved = !Objects.equals(before.cpusetGroup(), now.cpusetGroup());
-        for (int c : before.cpus()) {
-            if (!now.cpus().contains(c)) {
-                String how = !now.online().contains(c) ? "went offline"
-                        : moved ? "not in cpuset " + now.cpusetGroup() + ", which the runtime moved into from "
-                                + before.cpusetGroup()
-                        : "left the runtime's cpuset " + now.cpusetGroup();
-                cpus.computeIfAbsent(how, k -> new ArrayList<>()).add(c);
-            }
-        }
-        for (int c : now.cpus()) {
-            if (!before.cpus().contains(c)) {
-                String how = !before.online().contains(c) ? "came online"
-                        : moved ? "in cpuset " + now.cpusetGroup() + ", which the runtime moved into from "
-                                + before.cpusetGroup()
-                        : "joined the runtime's cpuset " + now.cpusetGroup();
-                cpus.computeIfAbsent(how, k -> new ArrayList<>()).add(c);
-            }
-        }
+        String into = ", which the runtime moved into from " + before.cpusetGroup();
+        sort(before.cpus(), now.cpus(), now.online(), "went offline",
+                moved ? "not in cpuset " + now.cpusetGroup() + into : "left the runtime's cpuset " + now.cpusetGroup(), cpus);
+        sort(now.cpus(), before.cpus(), before.online(), "came online",
+                moved ? "in cpuset " + now.cpusetGroup() + into : "joined the runtime's cpuset " + now.cpusetGroup(), cpus);
         List<String> parts = new ArrayList<>();
         cpus.forEach((how, list) -> {
             boolean one = list.size() == 1;
-            String verb = how.startsWith("not in") ? (one ? "is " : "are ") : how.startsWith("in ") ? (one ? "is " : "are ") : "";
+            String verb = how.startsWith("not in") || how.startsWith("in ") ? (one ? "is " : "are ") : "";
             parts.add((one ? "cpu " : "cpus ") + CpuList.format(new TreeSet<>(list)) + " " + verb + how);
         });
         if (parts.isEmpty() && moved) {
@@ -61,6 +48,19 @@ public final class MachineDiff {
             parts.add("the runtime moved from memory cgroup " + before.memoryGroup() + " to " + now.memoryGroup());
         }
         return parts.isEmpty() ? null : String.join("; ", parts);
+    }
+
+    /**
+     * Files each CPU of {@code from} that is not in {@code to} under how it went: {@code hotplug}
+     * when {@code online} lacks it, else {@code cpuset}.
+     */
+    private static void sort(java.util.Set<Integer> from, java.util.Set<Integer> to, java.util.Set<Integer> online,
+            String hotplug, String cpuset, Map<String, List<Integer>> out) {
+        for (int c : from) {
+            if (!to.contains(c)) {
+                out.computeIfAbsent(online.contains(c) ? cpuset : hotplug, k -> new ArrayList<>()).add(c);
+            }
+        }
     }
 
     /** {@code 512 MiB}, {@code 1.5 GiB}, {@code 100 B}. */
