@@ -322,8 +322,10 @@ public final class Activator implements BundleActivator {
                 }, log));
         tracker = new BundleTracker<>(ctx, ContractExtender.MASK, extender);
         tracker.open();
-        log.accept("arflex: DRCR started, runtime id " + rid + ", cpus " + cpus + ", memory " + memory + ", network "
-                + network);
+        org.arflex.planner.Capacities started = actor.call(() -> cell.planner().capacities(), 10_000);
+        log.accept("arflex: DRCR started, runtime id " + rid + ", cpus "
+                + started.cpus().stream().map(org.arflex.planner.Capacities.Cpu::id).toList() + ", memory "
+                + started.memoryBytes() + ", network " + network);
     }
 
     /**
