@@ -39,6 +39,7 @@ public final class Change {
     private final SortedMap<String, String> blocks;
     private final SortedSet<String> unblocks;
     private final SortedMap<String, Overlap> overlaps;
+    private final Optional<String> cause;
 
     /**
      * An update whose old and new RT halves run side by side for a while (docs/DECISIONS.md D51):
@@ -72,6 +73,7 @@ public final class Change {
         blocks = Collections.unmodifiableSortedMap(new TreeMap<>(b.blocks));
         unblocks = Collections.unmodifiableSortedSet(new TreeSet<>(b.unblocks));
         overlaps = Collections.unmodifiableSortedMap(new TreeMap<>(b.overlaps));
+        cause = b.cause;
     }
 
     /** The empty change: planning it reconciles the Active set with what should run. */
@@ -118,6 +120,15 @@ public final class Change {
     /** New capacities from the Resource Manager. */
     public static Change capacities(Capacities capacities) {
         return builder().capacities(capacities).build();
+    }
+
+    /**
+     * New capacities with what caused them (for example {@code cpu 1 left the runtime's cpuset
+     * /x (cgroup v1)}): the plan's title and the reasons of the components it stops, moves or
+     * starts name it.
+     */
+    public static Change capacities(Capacities capacities, String cause) {
+        return builder().capacities(capacities).cause(cause).build();
     }
 
     /** A measured WCET of one component (0 clears it). */
@@ -186,6 +197,14 @@ public final class Change {
      */
     public SortedMap<String, Overlap> overlaps() {
         return overlaps;
+    }
+
+    /**
+     * What caused this change, when it was not asked for through an API: for example the machine
+     * took a CPU away. The plan appends it to its title and to the reasons of its actions.
+     */
+    public Optional<String> cause() {
+        return cause;
     }
 
     /** True when the change has no part at all. */
@@ -258,6 +277,7 @@ public final class Change {
         private final Map<String, String> blocks = new LinkedHashMap<>();
         private final List<String> unblocks = new ArrayList<>();
         private final Map<String, Overlap> overlaps = new LinkedHashMap<>();
+        private Optional<String> cause = Optional.empty();
 
         private Builder() {
         }
@@ -324,6 +344,19 @@ public final class Change {
         public Builder overlap(String component, long shadowCycles, long windowCycles) {
             overlaps.put(Objects.requireNonNull(component, "component"),
                     new Overlap(component, shadowCycles, windowCycles));
+            return this;
+        }
+
+        /**
+         * Says what caused the change (see {@link Change#cause()}).
+         *
+         * @throws IllegalArgumentException when the cause is blank
+         */
+        public Builder cause(String why) {
+            if (Objects.requireNonNull(why, "cause").isBlank()) {
+                throw new IllegalArgumentException("the cause of a change must not be blank");
+            }
+            cause = Optional.of(why.strip());
             return this;
         }
 

@@ -27,5 +27,5 @@
  * them: the load while both halves of a change set's update run (docs/DECISIONS.md D51).
  */
 @org.osgi.annotation.bundle.Export
-@org.osgi.annotation.versioning.Version("1.1.0")
+@org.osgi.annotation.versioning.Version("1.2.0")
 package org.arflex.planner;

@@ -16,4 +16,13 @@ public class ResourcesDTO {
     public double[] cpuUtilisation;
     /** Total measured WCET overruns reported by the RT halves. */
     public long wcetOverruns;
+    /**
+     * What the machine gives the runtime (D85): the CPUs online and in its cpuset, its memory
+     * limit and the cgroups they come from; null when it is not observed.
+     */
+    public String machine;
+    /** The cause of the last change of the machine, e.g. {@code cpu 1 left the runtime's cpuset /x (cgroup v1)}. */
+    public String machineChange;
+    /** Why the machine cannot be read now (the last good view is kept), null when it can. */
+    public String machineProblem;
 }

@@ -59,7 +59,9 @@ import org.osgi.util.tracker.BundleTracker;
  * {@code arflex.code.truststore} (the folder of certificates whose keys may sign component
  * bundles; default {@code trust} of the working directory, {@code none}: no signature is
  * trusted; D14), {@code arflex.test.hooks} (true: RT halves get {@code ARFLEX_TEST_HOOKS=1}, so
- * rt-core honours its test fault variables; the tests' runtimes only; D80).
+ * rt-core honours its test fault variables; the tests' runtimes only; D80), {@code arflex.machine.poll.ms}
+ * (how often the CPUs online and in the runtime's cpuset and its memory limit are read, default 1000;
+ * 0: not watched; D85).
  */
 @Header(name = Constants.BUNDLE_ACTIVATOR, value = "${@class}")
 public final class Activator implements BundleActivator {
@@ -81,6 +83,7 @@ public final class Activator implements BundleActivator {
     private Services services;
     private org.arflex.drcr.impl.services.HistoryStore history;
     private ScheduledExecutorService ticker;
+    private org.arflex.drcr.impl.machine.MachineWatch machineWatch;
     private HeartbeatBridge bridge;
     private CellWatch watch;
     private BundleTracker<ContractExtender.Tracked> tracker;
@@ -128,7 +131,8 @@ public final class Activator implements BundleActivator {
         Sweeper.sweep(rid, log);
         PortTypes types = PortTypes.builtin();
         double cap = Double.parseDouble(prop(ctx, "arflex.cpu.cap", "1.0"));
-        List<Integer> cpus = prop(ctx, "arflex.cpus", "").isEmpty() ? allCpus() : Commands.parseCpus(prop(ctx, "arflex.cpus", ""));
+        List<Integer> wanted = prop(ctx, "arflex.cpus", "").isEmpty() ? null : Commands.parseCpus(prop(ctx, "arflex.cpus", ""));
+        List<Integer> cpus = wanted == null ? allCpus() : wanted;
         java.util.Set<Integer> reserved = prop(ctx, "arflex.cpus.reserved", "").isEmpty() ? java.util.Set.of()
                 : new java.util.TreeSet<>(Commands.parseCpus(prop(ctx, "arflex.cpus.reserved", "")));
         if (!cpus.containsAll(reserved)) {
@@ -172,15 +176,40 @@ public final class Activator implements BundleActivator {
                 Boolean.parseBoolean(prop(ctx, "arflex.nomlock", "false")), types, Posix::monotonicNs,
                 Boolean.parseBoolean(prop(ctx, "arflex.evaluation", "false")));
         // The cell is built on the actor so that the planner is only ever touched there.
+        // what the machine gives the runtime: the capacities stay within it (D85)
+        long machinePollMs = Long.parseLong(prop(ctx, "arflex.machine.poll.ms", "1000"));
+        org.arflex.drcr.impl.machine.MachineReader machineReader = new org.arflex.drcr.impl.machine.MachineReader(
+                java.nio.file.Path.of("/"));
+        org.arflex.drcr.impl.machine.MachineView machine = null;
+        if (machinePollMs > 0) {
+            try {
+                machine = machineReader.read();
+                log.accept("arflex: machine: " + machine.describe());
+            } catch (org.arflex.drcr.impl.machine.MachineReadException e) {
+                log.accept("arflex: machine: " + e.getMessage() + "; capacities from the configuration until it reads");
+            }
+        }
+        org.arflex.drcr.impl.machine.MachineView machineAtStart = machine;
         ResourceManagerImpl[] rm = new ResourceManagerImpl[1];
         cell = actor.call(() -> {
-            ResourceManagerImpl tmp = new ResourceManagerImpl(null, cap, reserved);
-            Planner planner = new Planner(tmp.capacities(cpus, memory, network));
+            ResourceManagerImpl tmp = new ResourceManagerImpl(null, cap, reserved, wanted, memory, machineAtStart);
+            org.arflex.planner.Capacities caps = tmp.effective(cpus, memory, network);
+            if (wanted != null && caps.cpus().size() < wanted.size()) {
+                log.accept("arflex: machine: arflex.cpus " + wanted + " names cpus the runtime may not use now; using "
+                        + caps.cpus().stream().map(org.arflex.planner.Capacities.Cpu::id).toList());
+            }
+            Planner planner = new Planner(caps);
             Cell c = new Cell(cfg, actor, new RecordingLauncher(new ProcessLauncher(log, executables, halfEnv),
                     HalfRecords.system(log)), planner, log, stopper, launches);
-            rm[0] = new ResourceManagerImpl(c, cap, reserved);
+            rm[0] = new ResourceManagerImpl(c, cap, reserved, wanted, memory, machineAtStart);
             return c;
         }, 10_000);
+        if (machinePollMs > 0) {
+            machineWatch = new org.arflex.drcr.impl.machine.MachineWatch(machineReader, machine,
+                    (before, now, cause) -> rm[0].machine(now, cause), log);
+            rm[0].machineProblem(machineWatch::problem);
+            machineWatch.start(machinePollMs);
+        }
         ContractReader reader = new ContractReader(types);
         String store = prop(ctx, "arflex.code.truststore", "trust");
         CodeGate gate = new CodeGate(trustedFolders(prop(ctx, "arflex.code.trusted", "bundle,cell,tools,console")),
@@ -307,8 +336,10 @@ public final class Activator implements BundleActivator {
                 }, log));
         tracker = new BundleTracker<>(ctx, ContractExtender.MASK, extender);
         tracker.open();
-        log.accept("arflex: DRCR started, runtime id " + rid + ", cpus " + cpus + ", memory " + memory + ", network "
-                + network);
+        org.arflex.planner.Capacities started = actor.call(() -> cell.planner().capacities(), 10_000);
+        log.accept("arflex: DRCR started, runtime id " + rid + ", cpus "
+                + started.cpus().stream().map(org.arflex.planner.Capacities.Cpu::id).toList() + ", memory "
+                + started.memoryBytes() + ", network " + network);
     }
 
     /**
@@ -369,6 +400,9 @@ public final class Activator implements BundleActivator {
 
     @Override
     public void stop(BundleContext ctx) throws Exception {
+        if (machineWatch != null) {
+            machineWatch.close();
+        }
         if (tracker != null) {
             tracker.close();
         }

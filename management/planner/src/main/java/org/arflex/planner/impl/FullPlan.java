@@ -122,8 +122,12 @@ final class FullPlan {
                     why = "replaced by " + resolver.contract(n).get().version() + ", which cannot run: " + inactive.get(n);
                 } else {
                     why = inactive.get(n);
+                    if (change.cause().isPresent()) {
+                        // the component stops because of this change's cause: its reason says so
+                        inactive.put(n, why + "; " + change.cause().get());
+                    }
                 }
-                actions.add(new Plan.Action(Plan.Op.STOP, n, why));
+                actions.add(new Plan.Action(Plan.Op.STOP, n, because(change, why)));
                 stopping.add(n);
             } else if (!before && after) {
                 String admitted = adm.decisions().get(n).reason();
@@ -143,16 +147,16 @@ final class FullPlan {
                     }
                     why = ins.isEmpty() ? "now admitted" : "now satisfied (" + String.join(", ", ins) + ")";
                 }
-                actions.add(new Plan.Action(Plan.Op.START, n, why + "; " + admitted));
+                actions.add(new Plan.Action(Plan.Op.START, n, because(change, why + "; " + admitted)));
                 starting.add(n);
             } else {
                 List<String> why = new ArrayList<>();
                 boolean rewireOnly = restartReasons.collect(n, replaced, oldEff.get(n), newEff.get(n), oldContracts, adm, why);
                 if (!why.isEmpty() && rewireOnly) {
                     boolean holds = why.stream().anyMatch(w -> w.startsWith(RestartReasons.SAFETY_LOST));
-                    actions.add(new Plan.Action(holds ? Plan.Op.HOLD : Plan.Op.REBIND, n, String.join("; ", why)));
+                    actions.add(new Plan.Action(holds ? Plan.Op.HOLD : Plan.Op.REBIND, n, because(change, String.join("; ", why))));
                 } else if (!why.isEmpty()) {
-                    actions.add(new Plan.Action(Plan.Op.RESTART, n, String.join("; ", why)));
+                    actions.add(new Plan.Action(Plan.Op.RESTART, n, because(change, String.join("; ", why))));
                     stopping.add(n);
                     starting.add(n);
                 }
@@ -184,5 +188,10 @@ final class FullPlan {
                         n -> resolver.contract(n).orElseThrow(), cpuTest);
         return new Plan(change, PlanTitle.of(resolver, capacities, change, installed, replaced, uninstalled, newCaps), actions, stopOrder,
                 startGroups, active, target, inactive, wiring, adm, cycles, notes, transients);
+    }
+
+    /** A reason with the change's cause appended, when it has one. */
+    private static String because(Change change, String why) {
+        return change.cause().map(c -> why + "; " + c).orElse(why);
     }
 }

@@ -184,7 +184,7 @@ public final class PlanEngine {
 
         if (incremental && trace == null && installed.size() == 1 && puts.size() == 1 && uninstalled.isEmpty()
                 && change.blocks().isEmpty() && change.unblocks().isEmpty() && change.measuredWcetNs().isEmpty()
-                && change.capacities().isEmpty() && change.overlaps().isEmpty()) {
+                && change.capacities().isEmpty() && change.overlaps().isEmpty() && change.cause().isEmpty()) {
             Plan p = derive(change, puts.values().iterator().next(), commit, newBlocked, newMeasured);
             if (p != null) {
                 return p;

@@ -40,6 +40,7 @@ final class PlanTitle {
         if (change.capacities().isPresent()) {
             parts.add("capacities " + capacityDiff(capacities, newCaps));
         }
+        change.cause().ifPresent(c -> parts.add("because " + c));
         if (!change.measuredWcetNs().isEmpty()) {
             List<String> s = new ArrayList<>();
             change.measuredWcetNs().forEach((n, w) -> s.add(n + " " + (w == 0 ? "cleared" : Text.duration(w))));

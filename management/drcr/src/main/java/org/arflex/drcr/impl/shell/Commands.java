@@ -295,6 +295,15 @@ public final class Commands {
                 sb.append("\nmemory: ").append(r.memoryUsed).append(" of ").append(r.memoryBytes).append(" bytes\n");
                 sb.append("network: ").append(r.networkUsed).append(" of ").append(r.networkBps).append(" B/s\n");
                 sb.append("wcet overruns: ").append(r.wcetOverruns);
+                if (r.machine != null) {
+                    sb.append("\nmachine: ").append(r.machine);
+                }
+                if (r.machineChange != null) {
+                    sb.append("\nmachine change: ").append(r.machineChange);
+                }
+                if (r.machineProblem != null) {
+                    sb.append("\nmachine problem: ").append(r.machineProblem);
+                }
                 return sb.toString();
             }
             if (!args[0].equals("set") || args.length < 3) {
