@@ -98,6 +98,37 @@ final class CellRig {
         return Runtime.names(rt.dto(), i -> String.valueOf(i.get("holding")).startsWith("stopped: waits for a fresh command"));
     }
 
+    /**
+     * The start-up check of a test that builds an arm (D77): before anything moves, a component
+     * may wait for a reset after a stall of the runtime while it was installed (issue 15 finding
+     * 6: the heartbeat lost). That is reset, named in one printed line ({@code who}: what waited
+     * and why); a force trip of the guard is not: it fails the test with its force and flags.
+     * Returns the components reset.
+     */
+    static List<String> resetBeforeTheTest(Runtime rt, String who) throws IOException {
+        List<String> waiting = awaitingReset(rt);
+        if (waiting.isEmpty()) {
+            return waiting;
+        }
+        Path guard = rt.segment("force-guard", "safety");
+        if (waiting.contains("force-guard") && Files.exists(guard)) {
+            try (Port p = new Port(guard, SAFETY_SIZE)) {
+                Safety s = Safety.of(p.read());
+                org.junit.jupiter.api.Assertions.assertFalse(s != null && (s.flags() & 1) != 0,
+                        () -> who + ": the guard tripped before the test: " + s.causes() + " at " + s.forceNorm() + " N: " + s);
+            }
+        }
+        StringBuilder why = new StringBuilder();
+        for (Map<String, Object> i : Runtime.list(rt.dto(), "instances")) {
+            if (waiting.contains(i.get("name"))) {
+                why.append(why.length() > 0 ? "; " : "").append(i.get("name")).append(": ").append(i.get("holding"));
+            }
+        }
+        System.out.println(who + ": before the test, awaiting a reset, not a trip (" + why + ") -> "
+                + rt.cmd("arflex:reset --cell"));
+        return waiting;
+    }
+
     static List<String> awaitingReset(Runtime rt) {
         return Runtime.names(rt.dto(), i -> Boolean.TRUE.equals(i.get("awaitingReset"))
                 || (CellPorts.ctlFlags(Path.of("/dev/shm/arflex." + rt.rid + "." + i.get("name") + ".ctl"))
