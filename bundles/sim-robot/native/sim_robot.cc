@@ -26,8 +26,9 @@
 // Scripted disturbances come from parameters (see the contract, sim-robot.xml). The safe hook
 // stops the arm the same way and holds it.
 //
-// A release after a stall stands for every period elapsed since the one before (D77): the
-// physics steps steps_per_period for each of them (at most kMaxCatchUpPeriods), with the servo's
+// A cycle after a stall stands for every whole period elapsed since the world was last
+// simulated, by the clock at its start (PeriodClock, D77): the physics steps steps_per_period
+// for each of them (at most kMaxCatchUpPeriods), with the servo's
 // reference moved from the one it had to the new one in equal parts, because the world does not
 // stop while the host does not run this half: a real arm's servo goes on, and the motion sources
 // (other processes) went on moving the reference. Stepping one period instead made the arm follow
