@@ -869,6 +869,61 @@ TEST_F(SimComponents, RobotCatchesUpThePeriodsAStallCost) {
   Shutdown(&robot_);
 }
 
+// A stall in the middle of an acquisition's blend (D77): the catch-up takes the stall's share of
+// the blend over the periods it steps, not in the one period after them.
+TEST_F(SimComponents, RobotStalledInTheBlendKeepsItSmooth) {
+  CreateRobot(1 * kMs, 1, false);
+  CreateReference();
+  arflex_port js_port;
+  OpenReader(&robot_, "joint_state", ARFLEX_PORT_STATE, &kJointStateType, &js_port);
+  ASSERT_EQ(arflex_host_start(&robot_, kCall), 0);
+  ASSERT_EQ(arflex_host_bind(&robot_, "joint_ref", ref_name_.c_str(), kCall), 0);
+  AcquireAtHome(&js_port);
+  ASSERT_EQ(arflex_host_unbind(&robot_, "joint_ref", kCall), 0);
+  // 15 mrad from the arm: acquired and blended in over 0.5 s (peak speed 0.056 rad/s at 0.25 s)
+  double near_arm[6];
+  for (int i = 0; i < 6; ++i) near_arm[i] = kHome[i];
+  near_arm[0] += 0.015;
+  WriteReference(near_arm);
+  arflex_joint_state js{};
+  bool have = false;
+  ASSERT_TRUE(WaitFor([&] { return Latest(&js_port, &js, &have); }));
+  const uint64_t seq0 = js.seq;
+  ASSERT_EQ(arflex_host_bind(&robot_, "joint_ref", ref_name_.c_str(), kCall), 0);
+  WriteReference(near_arm);
+  ASSERT_TRUE(WaitFor([&] { return Latest(&js_port, &js, &have) && std::fabs(js.q[0] - kHome[0]) > 2e-3; }));
+  // about 0.2 s into the blend: a 30 ms stall
+  ASSERT_TRUE(WaitFor([&] { return Latest(&js_port, &js, &have) && std::fabs(js.q[0] - kHome[0]) > 5e-3; }));
+  uint64_t last_seq = js.seq;
+  int64_t gap = 0, last_t = js.t_ns;
+  ASSERT_EQ(kill(robot_.pid, SIGSTOP), 0);
+  const timespec stall = {0, 30000000};
+  nanosleep(&stall, nullptr);
+  ASSERT_EQ(kill(robot_.pid, SIGCONT), 0);
+  double peak_qd = 0;
+  ASSERT_TRUE(WaitFor([&] {
+    arflex_joint_state v;
+    if (arflex_state_read(&js_port, &v, sizeof(v), nullptr) == 1) {
+      js = v;
+      peak_qd = std::max(peak_qd, std::fabs(v.qd[0]));
+      // releases skipped: more time between two values read than their seqs account for
+      gap = std::max(gap, v.t_ns - last_t - static_cast<int64_t>((v.seq - last_seq - 1) * kMs));
+      last_seq = v.seq;
+      last_t = v.t_ns;
+    }
+    return std::fabs(js.q[0] - near_arm[0]) < 1e-4;
+  })) << "joint 1 at " << js.q[0];
+  std::printf("a 30 ms stall in the blend: release gap %.1f ms, peak joint speed %.4f rad/s (%llu cycles)\n",
+              static_cast<double>(gap) * 1e-6, peak_qd, static_cast<unsigned long long>(js.seq - seq0));
+  EXPECT_GE(gap, static_cast<int64_t>(20 * kMs)) << "the stall did not show as a gap of releases";
+  // the quintic's own peak is 1.875 * 0.015 / 0.5 = 0.05625 rad/s (0.0558 measured without a
+  // stall); taking the 30 ms share of the blend in one period reached 0.0675-0.0679
+  EXPECT_LT(peak_qd, 0.062) << "the stall's share of the blend was taken at once";
+  EXPECT_EQ(arflex_host_stop(&robot_, kCall), 0);
+  arflex_port_close(&js_port);
+  Shutdown(&robot_);
+}
+
 TEST_F(SimComponents, RobotWithoutItsOutputSegmentFailsCleanly) {
   // A manager that did not create the wrench segment: configure fails (exit code 4, state
   // FAILED, the error in the control block), and destroying the instance leaves nothing.
