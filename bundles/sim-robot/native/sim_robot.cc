@@ -48,6 +48,7 @@
 #include <arflex_types/sample.h>
 #include <arflex_types/wrench.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -573,10 +574,16 @@ int Update(arflex_component* c, void* user, uint64_t release_ns) {
     arflex_component_hold(c, ARFLEX_HOLD_NONE, 0, 0);
   JointVector servo = r.q_ref;
   if (r.blend_t < kBlendSeconds) {
-    const double u = r.blend_t / kBlendSeconds;
+    // The blend where this cycle's last period starts (as one period per cycle had it), so that
+    // a catch-up interpolates from the last cycle's value to this one's and the next cycle goes
+    // on from there, instead of taking the stall's share of the blend in its one period.
+    const double step = P(c, r, kStepsPerPeriod) * r.cell->timestep();
+    const double t =
+        r.blend_wait ? r.blend_t : std::min(kBlendSeconds, r.blend_t + (periods - 1) * step);
+    const double u = t / kBlendSeconds;
     const double rest = 1.0 - u * u * u * (10.0 + u * (-15.0 + 6.0 * u));  // 1 - quintic
     for (int i = 0; i < kNumJoints; ++i) servo[i] -= r.blend_offset[i] * rest;
-    if (!r.blend_wait) r.blend_t += periods * P(c, r, kStepsPerPeriod) * r.cell->timestep();
+    if (!r.blend_wait) r.blend_t += periods * step;
   }
   const int pub = StepAndPublish(c, r, release_ns, periods, &servo);
   return ret < 0 ? ret : pub;
