@@ -3,7 +3,9 @@
 # main job runs it, under stress-ng on every core for M minutes (10 by default); counts safe
 # stops, hang kills and restarts of healthy components, then checks that a real hang (SIGSTOP of
 # the guard) is still caught. Writes target/bench/stress.json; the last line is
-# "stress: S safe stops, K hang kills, R restarts in M min; hang caught in H ms".
+# "stress: S safe stops, K hang kills, R restarts in M min; hang caught in H ms", then the force
+# guard's trips over the stressed run (each printed with its cause, D77):
+# "trips: N in S s under stress-ng".
 # Needs the build of ./arflex test or ./arflex run, and stress-ng (scripts/setup.sh installs it).
 set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
@@ -24,7 +26,7 @@ mvn -B -o -Darflex.native.skip=true -Darflex.native.tests.skip=true -pl tests ve
   -Darflex.bench.minutes="$minutes" -Darflex.bench.out="$ROOT/target/bench/stress.json" >"$log" 2>&1
 status=$?
 set -e
-grep -E '^(stress:|JSON:)' "$log" || true
+grep -E '^(stress:|JSON:|trips:)' "$log" || true
 if ! grep -q '^stress: [0-9]* safe stops' "$log"; then
   tail -40 "$log" >&2
   exit 1

@@ -26,6 +26,14 @@
 // Scripted disturbances come from parameters (see the contract, sim-robot.xml). The safe hook
 // stops the arm the same way and holds it.
 //
+// A cycle after a stall stands for every whole period elapsed since the world was last
+// simulated, by the clock at its start (PeriodClock, D77): the physics steps steps_per_period
+// for each of them (at most kMaxCatchUpPeriods), with the servo's
+// reference moved from the one it had to the new one in equal parts, because the world does not
+// stop while the host does not run this half: a real arm's servo goes on, and the motion sources
+// (other processes) went on moving the reference. Stepping one period instead made the arm follow
+// a reference several periods ahead at once, and the step read as contact force (D75).
+//
 // Everything is allocated in configure; update/safe only step the Cell (no allocation, no
 // printing, no blocking).
 #include <fcntl.h>
@@ -40,6 +48,7 @@
 #include <arflex_types/sample.h>
 #include <arflex_types/wrench.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -51,6 +60,7 @@
 #include "arflex_sim/cell.h"
 #include "arflex_sim/ground_truth.h"
 #include "arflex_sim/params.h"
+#include "period_clock.h"
 
 namespace {
 
@@ -125,6 +135,9 @@ constexpr double kBlendSeconds = 0.5;
 constexpr int kRestValues = 50;
 constexpr double kRestTol = 1e-4;  // rad, any joint
 constexpr double kMoveTol = 5e-4;  // rad, any joint
+// The most periods one release catches up after a stall (50 ms at 1 ms): a longer stall loses
+// the rest of the world's time (PeriodClock::lost) rather than stepping without bound.
+constexpr int kMaxCatchUpPeriods = 50;
 
 struct Robot {
   std::unique_ptr<Cell> cell;
@@ -148,6 +161,8 @@ struct Robot {
   std::vector<PushSpec> push_buf;  // one element, allocated in configure
   uint64_t cycles = 0;
   uint64_t seq = 0;
+  PeriodClock clock{kMaxCatchUpPeriods};
+  uint64_t periods = 0;  // periods simulated: one per cycle plus those caught up after stalls
   bool safe = false;
   JointVector q_ref = kHome;
   // Reference acquisition: the servo follows joint_ref only once a value from the current
@@ -243,11 +258,26 @@ void ApplyParams(const arflex_component* c, Robot& r) {
   }
 }
 
-// Steps the physics for one period and publishes the outputs.
-int StepAndPublish(const arflex_component* c, Robot& r, uint64_t release_ns) {
+// Steps the physics for @periods periods (1, or every period a stall skipped: PeriodClock)
+// and publishes the outputs once. With @to, the servo's reference goes from the one it had to
+// @to in equal parts over those periods (as the motion source's did meanwhile); without it the
+// cell keeps its own (a hold: the stop profile, then where it ended).
+int StepAndPublish(const arflex_component* c, Robot& r, uint64_t release_ns, int periods,
+                   const JointVector* to) {
   Cell& cell = *r.cell;
   const double spp = P(c, r, kStepsPerPeriod);
-  cell.Step(spp >= 1.0 ? static_cast<int>(spp) : 1);
+  const int steps = spp >= 1.0 ? static_cast<int>(spp) : 1;
+  const JointVector from = cell.joint_reference();
+  for (int p = 1; p <= periods; ++p) {
+    if (to) {
+      const double u = static_cast<double>(p) / periods;
+      JointVector q;
+      for (int i = 0; i < kNumJoints; ++i) q[i] = from[i] + u * ((*to)[i] - from[i]);
+      cell.SetJointReference(q);
+    }
+    cell.Step(steps);
+  }
+  r.periods += static_cast<uint64_t>(periods);
   ++r.cycles;
   ++r.seq;
 
@@ -288,6 +318,7 @@ int StepAndPublish(const arflex_component* c, Robot& r, uint64_t release_ns) {
     g.seq = r.seq;
     g.steps = cell.step_count();
     g.cycles = r.cycles;
+    g.periods = r.periods;
     g.sim_time = cell.time();
     const Eigen::Isometry3d tcp = cell.TrueTcp();
     const Eigen::Quaterniond qt(tcp.linear());
@@ -449,6 +480,7 @@ int Start(arflex_component* c, void* user) {
   r.guard_hold = false;
   r.guard_permitted = false;
   r.loss_latched = false;
+  r.clock.Restart();  // the time between two runs is not simulated
   arflex_safety_gate_init(&r.gate, r.safety,
                           static_cast<uint64_t>(P(c, r, kSafetyMaxAgeMs) * 1e6));
   ApplyParams(c, r);
@@ -457,6 +489,8 @@ int Start(arflex_component* c, void* user) {
 
 int Update(arflex_component* c, void* user, uint64_t release_ns) {
   Robot& r = *static_cast<Robot*>(user);
+  const int periods =
+      r.clock.Periods(arflex_sys_now_ns(), arflex_component_ctl(c)->config.period_ns);
   if (r.safe) {  // the first cycle after safe mode (the reset): hold where the arm is now
     r.after_stop = true;
     r.rest_values = 0;
@@ -474,7 +508,7 @@ int Update(arflex_component* c, void* user, uint64_t release_ns) {
       r.guard_hold = true;
       r.hold_stops_motion = r.guard_permitted;  // not merely waiting for a first guard
     }
-    return StepAndPublish(c, r, release_ns);
+    return StepAndPublish(c, r, release_ns, periods, nullptr);
   }
   if (r.guard_hold) {  // the reference must meet the arm again (D9)
     r.guard_hold = false;
@@ -540,13 +574,18 @@ int Update(arflex_component* c, void* user, uint64_t release_ns) {
     arflex_component_hold(c, ARFLEX_HOLD_NONE, 0, 0);
   JointVector servo = r.q_ref;
   if (r.blend_t < kBlendSeconds) {
-    const double u = r.blend_t / kBlendSeconds;
+    // The blend where this cycle's last period starts (as one period per cycle had it), so that
+    // a catch-up interpolates from the last cycle's value to this one's and the next cycle goes
+    // on from there, instead of taking the stall's share of the blend in its one period.
+    const double step = P(c, r, kStepsPerPeriod) * r.cell->timestep();
+    const double t =
+        r.blend_wait ? r.blend_t : std::min(kBlendSeconds, r.blend_t + (periods - 1) * step);
+    const double u = t / kBlendSeconds;
     const double rest = 1.0 - u * u * u * (10.0 + u * (-15.0 + 6.0 * u));  // 1 - quintic
     for (int i = 0; i < kNumJoints; ++i) servo[i] -= r.blend_offset[i] * rest;
-    if (!r.blend_wait) r.blend_t += P(c, r, kStepsPerPeriod) * r.cell->timestep();
+    if (!r.blend_wait) r.blend_t += periods * step;
   }
-  r.cell->SetJointReference(servo);
-  const int pub = StepAndPublish(c, r, release_ns);
+  const int pub = StepAndPublish(c, r, release_ns, periods, &servo);
   return ret < 0 ? ret : pub;
 }
 
@@ -562,7 +601,8 @@ int Safe(arflex_component* c, void* user, arflex_safe_mode /*mode*/, bool first)
   }
   JudgeSafety(c, r, true);
   r.safe = true;
-  return StepAndPublish(c, r, arflex_sys_now_ns());
+  r.clock.Restart();  // safe cycles step one period each; update starts counting afresh
+  return StepAndPublish(c, r, arflex_sys_now_ns(), 1, nullptr);
 }
 
 void Cleanup(arflex_component*, void* user) {

@@ -50,6 +50,7 @@ class Cell {
   // The joint reference the servo follows, and the correction added to it (the only way a
   // correction component acts on the arm). Both in rad, motor side.
   void SetJointReference(const JointVector& q_ref) { q_ref_ = q_ref; }
+  const JointVector& joint_reference() const { return q_ref_; }
   void SetCorrection(const JointVector& dq) { correction_ = dq; }
   // Power limit of the drives (a safety controller's reduced-power mode): the servo's
   // corrective torque (the P term, gravity compensation excluded, so a limited arm does not

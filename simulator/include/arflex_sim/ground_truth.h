@@ -37,12 +37,15 @@ struct arflex_sim_ground_truth {
 	uint32_t safe;       /**< 1 while the safe hook (hold) drives the arm */
 	uint32_t warnings;   /**< simulator warnings (MuJoCo + refused inputs) */
 	uint32_t pad0;
-	uint64_t reserved;
+	uint64_t periods;    /**< periods simulated since the process started: one per cycle, plus the
+	                          periods a release after a stall caught up (D77; steps =
+	                          steps_per_period x periods). Was a reserved 0 before. */
 };
 
 #ifdef __cplusplus
 static_assert(sizeof(struct arflex_sim_ground_truth) == ARFLEX_SIM_TRUTH_SIZE, "truth size");
 static_assert(offsetof(struct arflex_sim_ground_truth, p) == 40, "truth.p");
+static_assert(offsetof(struct arflex_sim_ground_truth, periods) == 184, "truth.periods");
 #else
 _Static_assert(sizeof(struct arflex_sim_ground_truth) == ARFLEX_SIM_TRUTH_SIZE, "truth size");
 _Static_assert(offsetof(struct arflex_sim_ground_truth, p) == 40, "truth.p");

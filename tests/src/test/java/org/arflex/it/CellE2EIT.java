@@ -84,8 +84,11 @@ class CellE2EIT {
 
     @AfterAll
     void stopRuntime() throws Exception {
-        report.add("operator resets (heartbeat losses, guard trips) during the run: "
+        report.add("operator resets (only trips the test caused; any other fails it, D77): "
                 + (operator == null ? "{}" : operator.resets));
+        if (operator != null) {
+            operator.close();
+        }
         System.out.println("CellE2EIT report:");
         report.forEach(r -> System.out.println("  " + r));
         try {
@@ -112,9 +115,9 @@ class CellE2EIT {
     CellRig.Operator operator;
 
     /**
-     * The operator at the cell (CellRig.Operator): resets what waits for a reset, at most once a
-     * second. Every reset is counted and printed in the report; the structural steps assert same
-     * pids and advancing cycle counters, which a safe-mode episode does not change.
+     * The operator at the cell (CellRig.Operator): at most once a second, resets the guard's trip
+     * the test caused (the push), and fails the test on any other component waiting for a reset,
+     * naming its cause (a trip's force and sim-robot's release gaps before it, D77).
      */
     void operator() {
         operator.tick();
@@ -310,8 +313,8 @@ class CellE2EIT {
         Map<String, Object> eval = (Map<String, Object>) rt.instance("sim-robot").get("evaluationSegments");
         assertTrue(eval != null && eval.containsKey("truth"), "no ground truth segment: " + eval);
         report.add("admitted: " + rt.cmd("arflex:resources").replace('\n', ';'));
-        // The operator's start-up check: a component that lost the runtime's heartbeat while the
-        // cell was being installed (this machine is small and shared) waits for a reset.
+        // The operator's start-up check: nothing waits for a reset once the cell is up (a
+        // component that does fails here with its cause, D77).
         report.add("awaiting a reset after start-up: " + CellRig.awaitingReset(rt));
         operator.tickNow();
     }
@@ -327,6 +330,7 @@ class CellE2EIT {
             // (after a stop the robot takes only a reference at rest that meets it, and the
             // corrected reference is never bit-identical while vision runs).
             CellRig.set(rt, "sim-robot", "push_duration_ms", "200");
+            operator.expectTrip("a 400 N push on the tool");
             CellRig.set(rt, "sim-robot", "push_force_n", "400");
             rt.waitUntil("the guard tripped by the push", 30_000, () -> CellRig.awaitingReset(rt).contains("force-guard"));
             CellRig.set(rt, "sim-robot", "push_force_n", "0");
@@ -504,5 +508,29 @@ class CellE2EIT {
                     && Runtime.rtProcesses(rt.rid).stream().noneMatch(p -> p.contains("--instance debug-monitor"));
         });
         assertLoopKeptCycling("debug monitor uninstalled");
+    }
+
+    @Test
+    @Order(6)
+    void aTripTheTestDidNotCauseFailsItWithItsCause() throws Exception {
+        // A push the test does not announce (D77): the operator must fail, naming the trip's
+        // flags, force and sim-robot's releases before it, instead of resetting it.
+        CellRig.set(rt, "sim-robot", "push_duration_ms", "200");
+        CellRig.set(rt, "sim-robot", "push_force_n", "400");
+        rt.waitUntil("the guard tripped by the push", 30_000, () -> CellRig.awaitingReset(rt).contains("force-guard"));
+        CellRig.set(rt, "sim-robot", "push_force_n", "0");
+        org.opentest4j.AssertionFailedError e = org.junit.jupiter.api.Assertions.assertThrows(
+                org.opentest4j.AssertionFailedError.class, operator::tickNow, "the operator reset a trip nobody announced");
+        report.add("an unannounced trip fails the test: " + e.getMessage().replace('\n', ';'));
+        assertTrue(e.getMessage().contains("the force guard tripped and the test did not cause it: FORCE_LIMIT|RESET_REQUIRED at "),
+                e.getMessage());
+        assertTrue(e.getMessage().contains("sim-robot: ") && e.getMessage().contains("release gaps"), e.getMessage());
+        assertTrue(CellRig.awaitingReset(rt).contains("force-guard"), "the operator reset it anyway");
+        // announced afterwards, it is reset as an expected one, and the cell waits for nothing
+        operator.expectTrip("the unannounced push, now accounted for");
+        rt.waitUntil("nothing waiting for a reset or a fresh command", 60_000, () -> {
+            operator.tickNow();
+            return CellRig.awaitingReset(rt).isEmpty() && CellRig.awaitingCommand(rt).isEmpty();
+        });
     }
 }

@@ -47,10 +47,7 @@ class FailSafeIT {
         rt.awaitState("ACTIVE", T, "sim-robot", "force-guard");
         // A stall of the runtime longer than the heartbeat timeout (issue 15 finding 6, not
         // solved on the Java side yet) latches the robot's reset; the operator resets it first.
-        if (!CellRig.awaitingReset(rt).isEmpty()) {
-            System.out.println("FailSafeIT: before the test, awaiting reset: " + CellRig.awaitingReset(rt) + " -> "
-                    + rt.cmd("arflex:reset --cell"));
-        }
+        CellRig.resetBeforeTheTest(rt, "FailSafeIT");
         CellRig.startTrajectory(rt, 1, "loop", "true");
         cell.add("trajectory");
         rt.waitUntil("the arm follows the trajectory", T, () -> CellRig.armFollows(rt, "trajectory"));

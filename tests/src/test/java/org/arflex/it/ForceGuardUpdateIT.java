@@ -61,10 +61,7 @@ class ForceGuardUpdateIT {
         try (Runtime rt = new Runtime("forceguard-update")) {
             CellRig.installArm(rt);
             rt.awaitState("ACTIVE", T, "sim-robot", "force-guard");
-            if (!CellRig.awaitingReset(rt).isEmpty()) {
-                System.out.println("ForceGuardUpdateIT: before the test, awaiting reset: " + CellRig.awaitingReset(rt)
-                        + " -> " + rt.cmd("arflex:reset --cell"));
-            }
+            CellRig.resetBeforeTheTest(rt, "ForceGuardUpdateIT");
             rt.waitUntil("the guard NORMAL", T, () -> {
                 CellRig.Safety s = safety(rt, "force-guard");
                 return s != null && s.mode() == CellRig.Safety.NORMAL;

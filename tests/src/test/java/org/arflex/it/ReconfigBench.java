@@ -128,7 +128,7 @@ class ReconfigBench {
             try (CellRig.Port jp = new CellRig.Port(rt.segment("sim-robot", "joint_state"), CellRig.JOINT_STATE_SIZE);
                     CellRig.Port sp = new CellRig.Port(rt.segment("force-guard", "safety"), CellRig.SAFETY_SIZE);
                     CellRig.Recorder rec = new CellRig.Recorder()) {
-                Cell c = new Cell(rt, new CellRig.Trace<>(), new CellRig.Trace<>(), new CellRig.Operator(rt), new int[1]);
+                Cell c = new Cell(rt, new CellRig.Trace<>(), new CellRig.Trace<>(), CellRig.Operator.lenient(rt), new int[1]);
                 rec.add(jp, CellRig.JointState::of, CellRig.JointState::seq, c.js()::add);
                 rec.add(sp, CellRig.Safety::of, CellRig.Safety::seq, c.safety()::add);
                 rec.start();

@@ -83,10 +83,7 @@ class StateConversionIT {
             String deployed = rt.cmd("arflex:deploy " + old.toUri() + " " + UpdateSetIT.sha256(old));
             assertTrue(!deployed.contains("error") && !deployed.contains("refused"), "deploy: " + deployed);
             rt.awaitState("ACTIVE", T, "sim-robot", "force-guard"); // tcp-correction waits for a motion source
-            if (!CellRig.awaitingReset(rt).isEmpty()) {
-                System.out.println("StateConversionIT: before the test, awaiting reset: " + CellRig.awaitingReset(rt)
-                        + " -> " + rt.cmd("arflex:reset --cell"));
-            }
+            CellRig.resetBeforeTheTest(rt, "StateConversionIT");
             CellRig.startTrajectory(rt, 1, "loop", "true");
             rt.awaitState("ACTIVE", T, "tcp-correction", "trajectory");
             assertTrue(rt.cmd("arflex:info tcp-correction").startsWith("tcp-correction 1.0.5 "),

@@ -20,7 +20,9 @@ import org.junit.jupiter.api.Test;
  * A safe stop is a component that ran its safe hook, awaited a reset or held the arm at any time.
  * Afterwards, one real hang (SIGSTOP of the guard) must still be caught within its contract's
  * timeout. Prints a table, writes target/bench/stress.json, and ends with
- * {@code stress: S safe stops, K hang kills, R restarts in M min; hang caught in H ms}. Not a
+ * {@code stress: S safe stops, K hang kills, R restarts in M min; hang caught in H ms}, then the
+ * guard's force trips over the stressed run, each printed with its cause (TripWatch, D77):
+ * {@code trips: N in S s under stress-ng}. Not a
  * test: run by the script only.
  */
 class StressBench {
@@ -49,8 +51,10 @@ class StressBench {
             Map<String, Integer> holdingSeen = new TreeMap<>();
             java.util.Set<String> stopped = new java.util.TreeSet<>();
             int resetsSeen = 0;
+            int trips = 0; // the guard's force trips (latched FORCE_LIMIT), each printed with its cause (D77)
+            boolean tripped = false;
             try (CellRig.Port jp = new CellRig.Port(rt.segment("sim-robot", "joint_state"), CellRig.JOINT_STATE_SIZE);
-                    CellRig.Recorder rec = new CellRig.Recorder()) {
+                    CellRig.Recorder rec = new CellRig.Recorder(); TripWatch watch = TripWatch.open(rt)) {
                 rec.add(jp, CellRig.JointState::of, CellRig.JointState::seq, js::add);
                 rec.start();
                 rt.waitUntil("the arm moving", 60_000, () -> FailSafeIT.moving(js));
@@ -82,6 +86,13 @@ class StressBench {
                             resetsSeen++;
                             stopped.addAll(awaiting);
                         }
+                        boolean latched = awaiting.contains("force-guard") && watch != null && watch.trip() != null;
+                        if (latched && !tripped) {
+                            trips++;
+                            System.out.println("stress: trip after " + windows + " s under stress-ng: " + watch.explain(watch.trip())
+                                    .replace("\n", "\nstress: "));
+                        }
+                        tripped = latched;
                     }
                 } finally {
                     stress.destroy();
@@ -148,6 +159,7 @@ class StressBench {
             rt.waitUntil("the guard back", 30_000, () -> rt.activeWithNewPid("force-guard", pid));
             System.out.printf(Locale.ROOT, "stress: %d safe stops, %d hang kills, %d restarts in %.0f min; hang caught in %.0f ms%n",
                     stops, hangKills, restarts, minutes, caught);
+            System.out.printf(Locale.ROOT, "trips: %d in %d s under stress-ng%n", trips, windows);
         }
     }
 
