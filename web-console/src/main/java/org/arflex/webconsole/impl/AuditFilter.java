@@ -78,7 +78,8 @@ public class AuditFilter implements Filter {
     void activate(BundleContext bc) {
         Path home = home(bc);
         this.trail = new AuditTrail(new AuditLog(home.resolve(AuditLog.FILE)),
-                new AuditLog(home.resolve(AuditTrail.SECURITY_FILE)), Clock.systemUTC());
+                new AuditLog(home.resolve(AuditTrail.SECURITY_FILE), AuditTrail.SECURITY_FILE_BYTES, AuditLog.DEFAULT_KEEP,
+                        Clock.systemUTC()), Clock.systemUTC());
     }
 
     @Deactivate

@@ -14,12 +14,15 @@ import java.util.Map;
  *
  * <p>Nothing an unauthenticated page or client can send is written one entry per request:
  * requests the guards refused before any effect (cross-site, CSRF token, transport) are sampled
- * per origin ({@link EventSampler}: the first 5 of an origin per minute, 20 in all, with their
- * parameters cut to {@value #SAMPLE_VALUE} characters; the rest counted, one summary line per
- * origin and minute, method {@code REFUSED}); failed logins and logins refused during a back-off
- * are sampled per client the same way (method {@code LOGIN}, status 401 or 429, the user name
- * cut to {@value #USER_CHARS} characters). So a flood writes at most about 60 lines a minute to
- * either file whatever its rate, and the history of changes and logins before it stays.
+ * per origin ({@link EventSampler}: the first 5 of an origin per minute, 10 over all origins,
+ * with their parameters cut to {@value #SAMPLE_VALUE} characters; the rest counted, and summed
+ * up in one line per minute, method {@code REFUSED}, with each origin's count); failed logins
+ * (5 per client, 10 in all) and logins refused during a back-off (2 per client, 5 in all) are
+ * sampled per client the same way (method {@code LOGIN}, status 401 or 429, the user name cut to
+ * {@value #USER_CHARS} characters). So floods of every kind together write at most 28 lines a
+ * minute to either file whatever their rate; the security history's files are larger
+ * ({@value #SECURITY_FILE_BYTES} bytes, 3 kept), so the changes and logins before a flood stay
+ * for hours of it (docs/decisions/D81 has the figures).
  */
 final class AuditTrail {
     /** The security history's file name under the home folder. */
@@ -29,6 +32,8 @@ final class AuditTrail {
     /** Longest user name a login entry keeps. */
     static final int USER_CHARS = 64;
     static final Duration WINDOW = Duration.ofMinutes(1);
+    /** Size of one file of the security history before it is rotated (3 rotated files kept). */
+    static final long SECURITY_FILE_BYTES = 4L << 20;
 
     private final AuditLog main;
     private final AuditLog security;
@@ -39,9 +44,9 @@ final class AuditTrail {
     AuditTrail(AuditLog main, AuditLog security, Clock clock) {
         this.main = main;
         this.security = security;
-        this.refusals = new EventSampler(clock, WINDOW, 5, 20, 16);
-        this.failedLogins = new EventSampler(clock, WINDOW, 5, 20, 16);
-        this.lockedLogins = new EventSampler(clock, WINDOW, 2, 10, 16);
+        this.refusals = new EventSampler(clock, WINDOW, 5, 10, 16);
+        this.failedLogins = new EventSampler(clock, WINDOW, 5, 10, 16);
+        this.lockedLogins = new EventSampler(clock, WINDOW, 2, 5, 16);
     }
 
     AuditLog main() {
@@ -117,17 +122,24 @@ final class AuditTrail {
         write(lockedLogins.due(), "LOGIN", 429, "logins refused during a back-off");
     }
 
+    /** One line for a minute's counts of one kind: the total, then each key's (at most 17 keys). */
     private void write(List<EventSampler.Summary> due, String method, int status, String what) {
-        for (EventSampler.Summary s : due) {
-            Map<String, String> p = new LinkedHashMap<>();
-            p.put("key", s.key());
-            p.put("count", Long.toString(s.notWritten()));
-            p.put("seen", Long.toString(s.seen()));
-            p.put("from", s.from().toString());
-            p.put("to", s.to().toString());
-            both(null, null, method, "(summary)", p, status, s.notWritten() + " more " + what + " from " + s.key()
-                    + " between " + s.from() + " and " + s.to() + ", counted and not written one by one");
+        if (due.isEmpty()) {
+            return;
         }
+        long notWritten = due.stream().mapToLong(EventSampler.Summary::notWritten).sum();
+        Map<String, String> p = new LinkedHashMap<>();
+        p.put("count", Long.toString(notWritten));
+        p.put("seen", Long.toString(due.stream().mapToLong(EventSampler.Summary::seen).sum()));
+        p.put("from", due.get(0).from().toString());
+        p.put("to", due.get(0).to().toString());
+        StringBuilder who = new StringBuilder();
+        for (EventSampler.Summary s : due) {
+            p.put(s.key(), Long.toString(s.notWritten()));
+            who.append(who.length() == 0 ? "" : ", ").append(s.key()).append(' ').append(s.notWritten());
+        }
+        both(null, null, method, "(summary)", p, status, notWritten + " more " + what + " between " + p.get("from")
+                + " and " + p.get("to") + ", counted and not written one by one: " + who);
     }
 
     private void both(String user, String remote, String method, String path, Map<String, String> params, int status,
