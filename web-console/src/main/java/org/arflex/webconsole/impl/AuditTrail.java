@@ -135,7 +135,7 @@ final class AuditTrail {
         p.put("to", due.get(0).to().toString());
         StringBuilder who = new StringBuilder();
         for (EventSampler.Summary s : due) {
-            p.put(s.key(), Long.toString(s.notWritten()));
+            p.putIfAbsent(s.key(), Long.toString(s.notWritten()));
             who.append(who.length() == 0 ? "" : ", ").append(s.key()).append(' ').append(s.notWritten());
         }
         both(null, null, method, "(summary)", p, status, notWritten + " more " + what + " between " + p.get("from")
