@@ -127,6 +127,18 @@ public class ConsoleLogin implements SecurityProvider {
             return accepted(req, cred[0]);
         }
         LoginLimiter.Lock lock = limiter.check(client);
+        if (lock == null) {
+            byte[] before = verified;
+            if (before == null || !MessageDigest.isEqual(before, tag)) {
+                Checked c = slowCheck(cred, tag, client, req.getRequestURI());
+                lock = c.lock();
+                if (lock == null && !c.right()) {
+                    trail.loginFailed(cred[0], client, req.getRequestURI());
+                    challenge(resp);
+                    return null;
+                }
+            }
+        }
         if (lock != null) {
             trail.loginLocked(cred[0], client, req.getRequestURI(), lock);
             resp.setHeader("Retry-After", Long.toString(lock.retryAfterSeconds()));
@@ -134,31 +146,41 @@ public class ConsoleLogin implements SecurityProvider {
                     + " s");
             return null;
         }
-        byte[] before = verified;
-        boolean ok = before != null && MessageDigest.isEqual(before, tag);
-        if (!ok) {
-            synchronized (slow) {
-                // the slow hash runs even for a wrong user name, so timing does not tell names apart
-                boolean rightUser = MessageDigest.isEqual(user.getBytes(StandardCharsets.UTF_8),
-                        cred[0].getBytes(StandardCharsets.UTF_8));
-                ok = hash.matches(cred[1]) && rightUser;
-            }
-            if (ok) {
-                verified = tag;
-                trail.loginSucceeded(cred[0], client, req.getRequestURI());
-            }
-        }
-        if (!ok) {
-            limiter.failed(client);
-            trail.loginFailed(cred[0], client, req.getRequestURI());
-            challenge(resp);
-            return null;
-        }
         limiter.succeeded(client);
         if (session != null) {
             session.setAttribute(SESSION_ATTR, tag);
         }
         return accepted(req, cred[0]);
+    }
+
+    /**
+     * The slow hash, one at a time. Guesses sent side by side wait here, and each asks the
+     * limiter again once it is its turn: by then the failures before it are counted, so a
+     * parallel burst gets no more checks than a sequential one. A wrong one is counted; a right
+     * one becomes {@link #verified}.
+     */
+    private Checked slowCheck(String[] cred, byte[] tag, String client, String path) {
+        synchronized (slow) {
+            LoginLimiter.Lock lock = limiter.check(client);
+            if (lock != null) {
+                return new Checked(lock, false);
+            }
+            // the slow hash runs even for a wrong user name, so timing does not tell names apart
+            boolean rightUser = MessageDigest.isEqual(user.getBytes(StandardCharsets.UTF_8),
+                    cred[0].getBytes(StandardCharsets.UTF_8));
+            boolean right = hash.matches(cred[1]) && rightUser;
+            if (right) {
+                verified = tag;
+                trail.loginSucceeded(cred[0], client, path);
+            } else {
+                limiter.failed(client);
+            }
+            return new Checked(null, right);
+        }
+    }
+
+    /** What the slow check said: refused unchecked ({@code lock}), or checked and right or not. */
+    private record Checked(LoginLimiter.Lock lock, boolean right) {
     }
 
     private static String accepted(HttpServletRequest req, String name) {

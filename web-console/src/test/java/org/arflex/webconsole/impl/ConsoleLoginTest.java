@@ -164,6 +164,31 @@ class ConsoleLoginTest {
     }
 
     @Test
+    void guessesSentSideBySideGetNoMoreChecksThanOneAfterTheOther() throws Exception {
+        ConsoleLogin login = login(STORED);
+        java.util.concurrent.ExecutorService pool = java.util.concurrent.Executors.newFixedThreadPool(32);
+        try {
+            List<java.util.concurrent.Future<Integer>> answers = new java.util.ArrayList<>();
+            for (int i = 0; i < 200; i++) {
+                String guess = "guess-" + i;
+                answers.add(pool.submit(() -> {
+                    Answer a = new Answer();
+                    attempt(login, "arflex", guess, "127.0.0.1", null, a);
+                    return a.status;
+                }));
+            }
+            Map<Integer, Integer> statuses = new TreeMap<>();
+            for (java.util.concurrent.Future<Integer> f : answers) {
+                statuses.merge(f.get(), 1, Integer::sum);
+            }
+            // the clock stands still: 5 free failures, the 6th locks
+            assertEquals(Map.of(401, 6, 429, 194), statuses);
+        } finally {
+            pool.shutdownNow();
+        }
+    }
+
+    @Test
     void aLoggedInSessionIsNotLockedOutByAGuesserOnTheSameAddress() throws Exception {
         ConsoleLogin login = login(STORED);
         HttpSession browser = session();
