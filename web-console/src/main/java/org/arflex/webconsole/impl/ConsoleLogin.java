@@ -165,6 +165,10 @@ public class ConsoleLogin implements SecurityProvider {
             if (lock != null) {
                 return new Checked(lock, false);
             }
+            byte[] meanwhile = verified;
+            if (meanwhile != null && MessageDigest.isEqual(meanwhile, tag)) {
+                return new Checked(null, true); // the same login, checked while this one waited
+            }
             // the slow hash runs even for a wrong user name, so timing does not tell names apart
             boolean rightUser = MessageDigest.isEqual(user.getBytes(StandardCharsets.UTF_8),
                     cred[0].getBytes(StandardCharsets.UTF_8));

@@ -183,6 +183,19 @@ class ConsoleLoginTest {
             }
             // the clock stands still: 5 free failures, the 6th locks
             assertEquals(Map.of(401, 6, 429, 194), statuses);
+            // the right login sent side by side from a fresh address: checked once, written once
+            List<java.util.concurrent.Future<Integer>> right = new java.util.ArrayList<>();
+            for (int i = 0; i < 16; i++) {
+                right.add(pool.submit(() -> {
+                    Answer a = new Answer();
+                    attempt(login, "arflex", "pässwörd", "127.0.0.2", null, a);
+                    return a.status;
+                }));
+            }
+            for (java.util.concurrent.Future<Integer> f : right) {
+                assertEquals(200, f.get());
+            }
+            assertEquals(1, security.recent(1000).stream().filter(e -> e.status() == 200).count());
         } finally {
             pool.shutdownNow();
         }
