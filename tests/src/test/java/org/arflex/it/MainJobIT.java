@@ -311,9 +311,15 @@ class MainJobIT {
                 }
             }
         }
+        // The home keeps the login and the console's audit of the logins tried above (D81), private.
         try (var l = Files.list(tmp.resolve("home"))) {
-            assertEquals(List.of("console.properties"), l.map(x -> x.getFileName().toString()).sorted().toList());
+            assertEquals(List.of("console-audit.log", "console-security.log", "console.properties"),
+                    l.map(x -> x.getFileName().toString()).sorted().toList());
         }
+        Path security = tmp.resolve("home/console-security.log");
+        assertEquals("rw-------", PosixFilePermissions.toString(Files.getPosixFilePermissions(security)));
+        String history = Files.readString(security);
+        assertTrue(history.contains("\"method\":\"LOGIN\"") && history.contains("\"status\":401"), history);
         Runtime.deleteTree(copy);
     }
 }
