@@ -32,7 +32,7 @@ fi
 
 # Web Console credentials (scripts/console-login.sh): ARFLEX_CONSOLE_USER/ARFLEX_CONSOLE_PASSWORD
 # when set, otherwise the private file in ARFLEX_HOME generated at first start (its password
-# printed once). Only the hash is stored, mode 0600.
+# printed once). Only a salted slow hash is stored (PBKDF2), mode 0600.
 ARFLEX_HOME=${ARFLEX_HOME:-$HOME/.arflex}
 login=$("$(dirname "${BASH_SOURCE[0]}")/console-login.sh" "$ARFLEX_HOME")
 CREDS=$(printf '%s\n' "$login" | tail -n 1)
@@ -49,6 +49,9 @@ port=$(sed -n 's/^org.osgi.service.http.port=//p' conf/config.properties)
 CONF=$(umask 077 && mktemp "$ARFLEX_HOME/config.XXXXXX.properties")
 trap 'rm -f "$CONF"' EXIT
 cp conf/config.properties "$CONF"
+# The console's login is ours (ConsoleLogin: salted slow hash, back-off, audited; D81): the Web
+# Console serves nothing until that provider is there, and its own password check is off.
+echo "felix.webconsole.security.providers=arflex" >> "$CONF"
 host=${ARFLEX_CONSOLE_HOST:-127.0.0.1}
 TLS_PASS=
 tls=${ARFLEX_CONSOLE_TLS:-}

@@ -67,9 +67,20 @@ class MainJobIT {
         return new Run(p.exitValue(), out.lines().toList());
     }
 
-    static String sha256Form(String password) throws Exception {
-        byte[] d = MessageDigest.getInstance("SHA-256").digest(password.getBytes(StandardCharsets.UTF_8));
-        return "{sha-256}" + Base64.getEncoder().encodeToString(d);
+    static final Pattern PBKDF2 = Pattern.compile("arflex\\.console\\.password=\\{pbkdf2-sha256\\}(\\d+)\\$([A-Za-z0-9+/=]+)\\$([A-Za-z0-9+/=]+)");
+
+    /** Whether {@code stored} (a credentials file) holds {@code password} as a salted PBKDF2 hash (D81). */
+    static boolean holdsPbkdf2Of(String stored, String password) throws Exception {
+        Matcher m = PBKDF2.matcher(stored);
+        if (!m.find()) {
+            return false;
+        }
+        byte[] salt = Base64.getDecoder().decode(m.group(2));
+        byte[] want = Base64.getDecoder().decode(m.group(3));
+        javax.crypto.spec.PBEKeySpec spec = new javax.crypto.spec.PBEKeySpec(password.toCharArray(), salt,
+                Integer.parseInt(m.group(1)), 256);
+        byte[] got = javax.crypto.SecretKeyFactory.getInstance("PBKDF2WithHmacSHA256").generateSecret(spec).getEncoded();
+        return salt.length >= 16 && Integer.parseInt(m.group(1)) >= 100_000 && MessageDigest.isEqual(want, got);
     }
 
     @Test
@@ -87,8 +98,8 @@ class MainJobIT {
         assertEquals("rwx------", PosixFilePermissions.toString(Files.getPosixFilePermissions(home)));
         String stored = Files.readString(creds);
         assertFalse(stored.contains(password), "the password itself is stored");
-        assertTrue(stored.contains("felix.webconsole.password=" + sha256Form(password)), stored);
-        assertTrue(stored.contains("felix.webconsole.username=arflex"), stored);
+        assertTrue(holdsPbkdf2Of(stored, password), stored);
+        assertTrue(stored.contains("arflex.console.username=arflex"), stored);
 
         // Second start: nothing printed, nothing changed.
         Run second = login(home, Map.of());
@@ -103,7 +114,7 @@ class MainJobIT {
         assertNotEquals(creds, tmpCreds);
         assertEquals("rw-------", PosixFilePermissions.toString(Files.getPosixFilePermissions(tmpCreds)));
         String t = Files.readString(tmpCreds);
-        assertTrue(t.contains("felix.webconsole.username=integrator") && t.contains(sha256Form("s3cret-Pass")), t);
+        assertTrue(t.contains("arflex.console.username=integrator") && holdsPbkdf2Of(t, "s3cret-Pass"), t);
         assertFalse(t.contains("s3cret-Pass"), t);
         assertEquals(stored, Files.readString(creds));
 
@@ -111,6 +122,22 @@ class MainJobIT {
         Run bad = login(home, Map.of("ARFLEX_CONSOLE_USER", "x\nfelix.webconsole.password=", "ARFLEX_CONSOLE_PASSWORD", "p"));
         assertEquals(2, bad.exit(), bad.text());
         assertTrue(bad.text().contains("ARFLEX_CONSOLE_USER"), bad.text());
+
+        // The same password stored twice gets two salts.
+        Run again = login(home, Map.of("ARFLEX_CONSOLE_PASSWORD", "s3cret-Pass"));
+        String t2 = Files.readString(Path.of(again.lines().get(again.lines().size() - 1)));
+        assertTrue(holdsPbkdf2Of(t2, "s3cret-Pass"), t2);
+        assertNotEquals(t.substring(t.indexOf('$')), t2.substring(t2.indexOf('$')), "no salt");
+
+        // A file of an earlier version (unsalted SHA-256) is refused, saying what to do, and kept.
+        String old = "felix.webconsole.username=arflex\nfelix.webconsole.password={sha-256}jGl25bVBBBW96Qi9Te4V37Fnqchz/Eu4qB9vKrRIqRg=\n";
+        Files.writeString(creds, old);
+        Run refused = login(home, Map.of());
+        assertEquals(2, refused.exit(), refused.text());
+        assertTrue(refused.text().contains(creds.toString()) && refused.text().contains("unsalted")
+                && refused.text().contains("Remove that file") && refused.text().contains("ARFLEX_CONSOLE_PASSWORD"),
+                refused.text());
+        assertEquals(old, Files.readString(creds));
     }
 
     static int status(URI uri, String basicAuth) {
@@ -284,9 +311,15 @@ class MainJobIT {
                 }
             }
         }
+        // The home keeps the login and the console's audit of the logins tried above (D81), private.
         try (var l = Files.list(tmp.resolve("home"))) {
-            assertEquals(List.of("console.properties"), l.map(x -> x.getFileName().toString()).sorted().toList());
+            assertEquals(List.of("console-audit.log", "console-security.log", "console.properties"),
+                    l.map(x -> x.getFileName().toString()).sorted().toList());
         }
+        Path security = tmp.resolve("home/console-security.log");
+        assertEquals("rw-------", PosixFilePermissions.toString(Files.getPosixFilePermissions(security)));
+        String history = Files.readString(security);
+        assertTrue(history.contains("\"method\":\"LOGIN\"") && history.contains("\"status\":401"), history);
         Runtime.deleteTree(copy);
     }
 }

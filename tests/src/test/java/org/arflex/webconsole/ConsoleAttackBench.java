@@ -31,7 +31,9 @@ import org.junit.jupiter.api.Test;
  * its effect is seen (bundle stopped, component stopped, parameter or file written) or the
  * server accepted it (status below 400). Controls: the same requests from the console's origin
  * with its token have their effect. Then the hostile contracts of the tests through the
- * validate API: succeeded when it answers 500 or the console stops answering. Prints one line
+ * validate API: succeeded when it answers 500 or the console stops answering. Last, issue 30's
+ * doors ({@link LoginAndAuditDoors}): a cross-site flood of the audit log, a password-guessing
+ * burst. Prints one line
  * per door (variants summed) and {@code attack-part: console S/N attempts succeeded}; writes
  * target/bench/attack-console.json. Not a test: run by the script only.
  */
@@ -139,6 +141,7 @@ class ConsoleAttackBench {
             corpus();
             ChangeSetFileDoor.Result f = ChangeSetFileDoor.tryOn(rt, counter.toUri().toString());
             record(ChangeSetFileDoor.DOOR + (f.controlSeen() ? "" : " (CONTROL NOT SEEN)"), f.tries(), f.succeeded(), f.detail());
+            new LoginAndAuditDoors(rt, this::record).run(); // issue 30: audit flood, password guessing (last: back-off)
             assertTrue(rt.get("/system/console/arflex-cell/api/cell", true).statusCode() == 200, "the runtime still runs");
         }
         StringBuilder json = new StringBuilder("{\"part\":\"console\",\"attempts\":[");

@@ -72,6 +72,7 @@ final class ApiCall {
         if (why == null) {
             return false;
         }
+        req.setAttribute(AuditFilter.REFUSED, Boolean.TRUE);
         refuse(403, why);
         return true;
     }

@@ -11,6 +11,7 @@ import java.io.IOException;
 import java.net.URLDecoder;
 import java.nio.charset.StandardCharsets;
 import java.nio.file.Path;
+import java.time.Clock;
 import java.util.Base64;
 import java.util.LinkedHashMap;
 import java.util.List;
@@ -20,6 +21,7 @@ import java.util.Set;
 import org.osgi.framework.BundleContext;
 import org.osgi.service.component.annotations.Activate;
 import org.osgi.service.component.annotations.Component;
+import org.osgi.service.component.annotations.Deactivate;
 
 /**
  * Writes every state-changing request to the console into the {@link AuditLog}: every method
@@ -27,7 +29,13 @@ import org.osgi.service.component.annotations.Component;
  * reads it (Felix's own pages and ours, cross-site refusals included). It runs first of the
  * console's filters (highest ranking), after the Web Console's login (the whiteboard calls the
  * context's security check before any filter), so a request it sees has an authenticated
- * user; failed logins change nothing and are not audited.
+ * user; logins are audited by {@link ConsoleLogin} (issue 30).
+ *
+ * <p>A request a guard refused before it had any effect (it sets {@link #REFUSED}: the
+ * cross-site guard, the CSRF check, the transport filter) is not written one by one but
+ * sampled per origin ({@link AuditTrail}), so a page on another site cannot flush the log by
+ * making the operator's browser post at the console; an accepted change also goes to the
+ * security history ({@value AuditTrail#SECURITY_FILE}), which such refusals cannot rotate.
  *
  * <p>What is recorded of the request: the parameters that say what was asked ({@link #PARAMS})
  * from the query string and from an {@code application/x-www-form-urlencoded} body (never
@@ -42,6 +50,8 @@ import org.osgi.service.component.annotations.Component;
 public class AuditFilter implements Filter {
     /** Request attribute: why a request was refused or failed (set by our filters and pages). */
     static final String REASON = "org.arflex.webconsole.audit.reason";
+    /** Request attribute: set (to anything) when a guard refused the request before any effect. */
+    static final String REFUSED = "org.arflex.webconsole.audit.refused";
     /** Framework or system property naming the runtime's home (else env ARFLEX_HOME). */
     static final String HOME_PROPERTY = "arflex.home";
     /** The parameters recorded, when present. */
@@ -49,23 +59,40 @@ public class AuditFilter implements Filter {
             "sha256", "targets", "apply", "delete", "propertylist", "factoryPid", "shutdown_type", "actions", "plan");
     private static final Set<String> SAFE = Set.of("GET", "HEAD", "OPTIONS", "TRACE");
 
-    private AuditLog log;
+    private AuditTrail trail;
 
     /** For SCR. */
     public AuditFilter() {
     }
 
+    /** With the security history beside {@code log}. */
     AuditFilter(AuditLog log) {
-        this.log = log;
+        this(new AuditTrail(log, new AuditLog(log.file().resolveSibling(AuditTrail.SECURITY_FILE)), Clock.systemUTC()));
+    }
+
+    AuditFilter(AuditTrail trail) {
+        this.trail = trail;
     }
 
     @Activate
     void activate(BundleContext bc) {
-        this.log = new AuditLog(home(bc).resolve(AuditLog.FILE));
+        Path home = home(bc);
+        this.trail = new AuditTrail(new AuditLog(home.resolve(AuditLog.FILE)),
+                new AuditLog(home.resolve(AuditTrail.SECURITY_FILE), AuditTrail.SECURITY_FILE_BYTES, AuditLog.DEFAULT_KEEP,
+                        Clock.systemUTC()), Clock.systemUTC());
+    }
+
+    @Deactivate
+    void deactivate() {
+        trail.close();
     }
 
     AuditLog log() {
-        return log;
+        return trail.main();
+    }
+
+    AuditTrail trail() {
+        return trail;
     }
 
     /** The runtime's home: {@value #HOME_PROPERTY}, else env ARFLEX_HOME, else the bundle's data area. */
@@ -105,9 +132,30 @@ public class AuditFilter implements Filter {
             Object why = req.getAttribute(REASON);
             String reason = why != null ? why.toString()
                     : failure != null ? failure.getClass().getSimpleName() + ": " + failure.getMessage() : null;
-            log.record(user(req), req.getRemoteAddr(), req.getMethod(), path(req, where), params(req), status,
-                    reason);
+            if (req.getAttribute(REFUSED) != null) {
+                trail.refused(origin(req), user(req), req.getRemoteAddr(), req.getMethod(), path(req, where), params(req),
+                        status, reason);
+            } else {
+                trail.request(user(req), req.getRemoteAddr(), req.getMethod(), path(req, where), params(req), status,
+                        reason);
+            }
         }
+    }
+
+    /** Where a request says it comes from: its Origin, else its Referer's origin, else that it says neither. */
+    static String origin(HttpServletRequest req) {
+        String o = req.getHeader("Origin");
+        if (o == null) {
+            String r = req.getHeader("Referer");
+            if (r != null) {
+                int slash = r.indexOf('/', r.indexOf("//") < 0 ? 0 : r.indexOf("//") + 2);
+                o = slash < 0 ? r : r.substring(0, slash);
+            }
+        }
+        if (o == null) {
+            return "(no Origin or Referer)";
+        }
+        return AuditTrail.cut(o, 100);
     }
 
     /** The authenticated user: the container's, else the Basic login the console accepted. */

@@ -44,11 +44,14 @@ public class ChangeSetPlugin extends PluginBase {
         this.routes = new Routes().add(backend.routes()).add(sets.routes());
     }
 
-    /** The outcome of an apply, once known, as one more audit entry (method {@code OUTCOME}). */
+    /**
+     * The outcome of an apply, once known, as one more audit entry (method {@code OUTCOME}); a
+     * committed one is a change and goes to the security history too (D81).
+     */
     private void audit(String user, String remote, List<String> actions, Map<String, Object> view) {
         AuditFilter f = auditFilter;
-        AuditLog log = f == null ? null : f.log();
-        if (log == null) {
+        AuditTrail trail = f == null ? null : f.trail();
+        if (trail == null) {
             return;
         }
         Map<String, String> params = new LinkedHashMap<>();
@@ -56,7 +59,7 @@ public class ChangeSetPlugin extends PluginBase {
         params.put("outcome", String.valueOf(view.get("outcome")));
         Object why = view.get("why");
         boolean good = "committed".equals(view.get("outcome"));
-        log.record(user, remote, "OUTCOME", "/system/console/" + LABEL + "/api/changeset-apply", params,
+        trail.request(user, remote, "OUTCOME", "/system/console/" + LABEL + "/api/changeset-apply", params,
                 good ? 200 : 409, good ? null : why == null ? null : why.toString());
     }
 

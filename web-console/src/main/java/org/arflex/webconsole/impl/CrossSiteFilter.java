@@ -37,6 +37,7 @@ public class CrossSiteFilter implements Filter {
             String why = refusal(req);
             if (why != null) {
                 req.setAttribute(AuditFilter.REASON, why);
+                req.setAttribute(AuditFilter.REFUSED, Boolean.TRUE);
                 resp.sendError(HttpServletResponse.SC_FORBIDDEN, why);
                 return;
             }

@@ -34,6 +34,7 @@ public class TransportFilter implements Filter {
             String why = refusal(req.isSecure(), req.getLocalAddr());
             if (why != null) {
                 req.setAttribute(AuditFilter.REASON, why);
+                req.setAttribute(AuditFilter.REFUSED, Boolean.TRUE);
                 resp.sendError(421, why);
                 return;
             }

@@ -118,7 +118,7 @@ class AuditFilterTest {
         AuditLog.Entry e = log.recent(1).get(0);
         assertEquals(403, e.status());
         assertEquals("/system/console/bundles/42", e.path(), "the path as the guard reads it");
-        assertEquals(Map.of("action", "uninstall"), e.params());
+        assertEquals(Map.of("action", "uninstall", "origin", "http://127.0.0.1:9999"), e.params());
         assertTrue(e.reason().contains("cross-site"), e.reason());
     }
 
@@ -151,5 +151,88 @@ class AuditFilterTest {
         AuditLog log = log();
         new AuditFilter(log).doFilter(request("POST", "/other/thing", null, "arflex", Map.of(), null), response(), OK);
         assertEquals(List.of(), log.recent(10));
+    }
+
+    private static FilterChain guarded() {
+        return (rq, rs) -> new CrossSiteFilter().doFilter(rq, rs, (a, b) -> {
+            throw new AssertionError("must not reach the console");
+        });
+    }
+
+    /** Issue 30's flood: every recorded parameter 250 characters long. */
+    private static Map<String, String> floodForm() {
+        Map<String, String> form = new HashMap<>();
+        for (String k : AuditFilter.PARAMS) {
+            form.put(k, "v".repeat(250));
+        }
+        return form;
+    }
+
+    private static final Map<String, String> CROSS_SITE = Map.of("Origin", "http://evil.example", "Host", "127.0.0.1:8480",
+            "Sec-Fetch-Site", "cross-site");
+
+    @Test
+    void aCrossSiteFloodDoesNotPushEarlierEntriesOutOfTheLog() throws Exception {
+        // The console's rotation (files kept beside the current one) on smaller files.
+        AuditLog log = new AuditLog(tmp.resolve("console-audit.log"), 1 << 16, 3,
+                Clock.fixed(Instant.parse("2026-11-25T10:00:00Z"), ZoneOffset.UTC));
+        AuditFilter filter = new AuditFilter(log);
+        filter.doFilter(request("POST", "/system/console/bundles/42", null, "arflex",
+                Map.of("Origin", SELF, "Host", "127.0.0.1:8480"), Map.of("action", "uninstall")), response(), OK);
+        for (int i = 0; i < 1400; i++) {
+            filter.doFilter(request("POST", "/system/console/bundles/0", null, "arflex", CROSS_SITE, floodForm()), response(),
+                    guarded());
+        }
+        List<AuditLog.Entry> all = log.recent(100_000);
+        assertTrue(all.stream().anyMatch(e -> "/system/console/bundles/42".equals(e.path()) && e.status() == 200),
+                "the earlier entry was pushed out by the flood (" + all.size() + " entries left)");
+        List<AuditLog.Entry> flood = all.stream().filter(e -> e.status() == 403).toList();
+        assertTrue(flood.size() <= 10, flood.size() + " refusals written one by one");
+        assertTrue(flood.stream().allMatch(e -> e.params().values().stream().noneMatch(v -> v.contains("v".repeat(33)))),
+                "a refused request's parameters written in full");
+    }
+
+    @Test
+    void theRefusalsNotWrittenAreCountedPerOriginAndSummedUpOnceTheMinuteIsOver() throws Exception {
+        LoginLimiterTest.TestClock clock = new LoginLimiterTest.TestClock();
+        AuditLog main = new AuditLog(tmp.resolve("console-audit.log"), 1 << 16, 3, clock);
+        AuditLog security = new AuditLog(tmp.resolve("console-security.log"), 1 << 16, 3, clock);
+        AuditTrail trail = new AuditTrail(main, security, clock);
+        AuditFilter filter = new AuditFilter(trail);
+        filter.doFilter(request("POST", "/system/console/bundles/42", null, "arflex",
+                Map.of("Origin", SELF, "Host", "127.0.0.1:8480"), Map.of("action", "uninstall")), response(), OK);
+        for (int i = 0; i < 1400; i++) {
+            filter.doFilter(request("POST", "/system/console/bundles/0", null, "arflex", CROSS_SITE, floodForm()), response(),
+                    guarded());
+        }
+        assertEquals(Map.of("http://evil.example", 1395L), trail.refusalsNotWritten());
+        clock.advance(java.time.Duration.ofSeconds(61));
+        // the next entry brings the summary of the minute that is over first
+        filter.doFilter(request("POST", "/system/console/bundles/43", null, "arflex",
+                Map.of("Origin", SELF, "Host", "127.0.0.1:8480"), Map.of("action", "stop")), response(), OK);
+        for (AuditLog log : List.of(main, security)) {
+            List<AuditLog.Entry> all = log.recent(1000);
+            AuditLog.Entry summary = all.stream().filter(e -> "REFUSED".equals(e.method())).findFirst().orElseThrow();
+            assertEquals("1395", summary.params().get("count"), summary.toString());
+            assertEquals("1395", summary.params().get("http://evil.example"));
+            assertTrue(summary.reason().startsWith("1395 more refused requests between ")
+                    && summary.reason().endsWith("not written one by one: http://evil.example 1395"), summary.reason());
+            assertEquals(5, all.stream().filter(e -> "POST".equals(e.method()) && e.status() == 403).count());
+        }
+        // the security history holds the changes, not the ordinary traffic
+        assertTrue(security.recent(100).stream().anyMatch(e -> "/system/console/bundles/42".equals(e.path())));
+        assertTrue(security.recent(100).stream().anyMatch(e -> "/system/console/bundles/43".equals(e.path())));
+    }
+
+    @Test
+    void aFailedRequestIsInTheLogButNotTheSecurityHistory() throws Exception {
+        LoginLimiterTest.TestClock clock = new LoginLimiterTest.TestClock();
+        AuditLog main = new AuditLog(tmp.resolve("console-audit.log"), 1 << 16, 3, clock);
+        AuditLog security = new AuditLog(tmp.resolve("console-security.log"), 1 << 16, 3, clock);
+        FilterChain notFound = (rq, rs) -> ((HttpServletResponse) rs).sendError(404);
+        new AuditFilter(new AuditTrail(main, security, clock)).doFilter(request("POST", "/system/console/arflex-cell/api/command",
+                "name=nope&cmd=stop", "arflex", Map.of(), null), response(), notFound);
+        assertEquals(404, main.recent(1).get(0).status());
+        assertEquals(List.of(), security.recent(10));
     }
 }
