@@ -91,7 +91,8 @@ class ChangeSetUpdatesIT {
         assertEquals("ACTIVE", FX.state("sample-scaler"), "the scaler runs");
         long scalerPid = FX.pid("sample-scaler");
         Path work = FX.rt().work;
-        Path jar = version(Files.createDirectories(work.resolve("versions")), "sample-scaler", "1.0.1-live");
+        Path jar = version(Files.createDirectories(work.resolve(RuntimeUnderTest.STAGED).resolve("versions")),
+                "sample-scaler", "1.0.1-live");
         // 10 ms cycles: 300 shadow cycles take 3 s, the window 200 cycles 2 s
         String set = "update sample-scaler " + jar.toUri() + " " + sha256(jar)
                 + " shadow 300 tolerance y.value 0.000001 window 200";
@@ -153,7 +154,7 @@ class ChangeSetUpdatesIT {
                 () -> "ACTIVE".equals(FX.state("sample-counter")) && "ACTIVE".equals(FX.state("sample-scaler")));
         long counterPid = FX.pid("sample-counter");
         long scalerPid = FX.pid("sample-scaler");
-        Path dir = Files.createDirectories(FX.rt().work.resolve("versions-two"));
+        Path dir = Files.createDirectories(FX.rt().work.resolve(RuntimeUnderTest.STAGED).resolve("versions-two"));
         Path counter = version(dir, "sample-counter", "1.0.1-two");
         Path scaler = version(dir, "sample-scaler", "1.0.2-two");
         // the counter without a shadow run (its sine's phase is its own), the scaler with one; 10 ms cycles

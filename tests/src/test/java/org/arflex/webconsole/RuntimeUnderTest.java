@@ -28,6 +28,8 @@ import java.util.stream.Stream;
  */
 final class RuntimeUnderTest implements AutoCloseable {
     static final String USER = "arflex";
+    /** The folder under {@link #work} the console accepts file: update jars from (its staging rule, D78). */
+    static final String STAGED = "staged";
     final String password;
     final int port;
     final Path work;
@@ -97,9 +99,12 @@ final class RuntimeUnderTest implements AutoCloseable {
         Path conf = runtimeDir.resolve("conf/config.properties");
         String props = Files.readString(conf).replaceAll("(?m)^org\\.osgi\\.service\\.http\\.port=.*$",
                 "org.osgi.service.http.port=" + port);
-        // stage-url reads file: URLs only from configured folders: those of the sample bundles
-        String stageDirs = String.join(",", Stream.of("counter", "scaler")
-                .map(w -> org.arflex.it.Components.jar("sample-" + w).getParent().toString()).distinct().toList());
+        // stage-url and the change-set page's update lines read file: URLs only from configured
+        // folders (D78): those of the sample bundles, and work/staged, where a test puts the
+        // versions it makes, as an operator puts update jars in a staging folder
+        String stageDirs = String.join(",", Stream.concat(Stream.of("counter", "scaler")
+                .map(w -> org.arflex.it.Components.jar("sample-" + w).getParent().toString()),
+                Stream.of(work.resolve(STAGED).toString())).distinct().toList());
         props += "\narflex.console.stage.dirs=" + stageDirs + "\n";
         // The tests install cell bundles from the assembly they were copied from and from the
         // build: the code gate (D12) trusts those folders as it trusts the runtime's own.
