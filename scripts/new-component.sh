@@ -11,7 +11,7 @@
 # outside DIR/NAME is edited: the runtime pom, conf/cell.gosh and tests/pom.xml name no
 # component by themselves.
 #
-# Out of the tree (DIR not inside this repository; D84), the component is a project of its own
+# Out of the tree (DIR not inside this repository and not a bundles/ folder; D84), the component is a project of its own
 # that needs no checkout: its pom.xml (rt-core/template/standalone) has the published
 # org.arflex:arflex-parent as parent and builds native/ with CMake against an installed SDK
 # (mvn verify -Darflex.sdk=PREFIX), native/CMakeLists.txt finds that SDK by itself
@@ -46,7 +46,12 @@ fi
 [ -d "$dest" ] || { echo "new component: no directory '$dest'" >&2; exit 2; }
 dest=$(cd "$dest" && pwd -P)
 target="$dest/$name"
+# In the tree: DIR inside this repository, or DIR holding a copy of bundles/pom.xml (a tree built
+# elsewhere, the ctest tools.new_component).
 case "$dest/" in "$(cd "$ROOT" && pwd -P)/"*) in_tree=true ;; *) in_tree=false ;; esac
+if [ -f "$dest/pom.xml" ] && grep -q '<artifactId>arflex-bundles</artifactId>' "$dest/pom.xml"; then
+  in_tree=true
+fi
 if [ -e "$target" ]; then
   echo "new component: $target already exists; nothing changed (pick another name, or" \
        "remove that folder first)" >&2
