@@ -10,9 +10,16 @@
 # assembly (cell/) and the integration tests (build order) get every component. Nothing else
 # outside DIR/NAME is edited: the runtime pom, conf/cell.gosh and tests/pom.xml name no
 # component by themselves.
+#
+# Out of the tree (DIR not inside this repository and not a bundles/ folder; D84), the component is a project of its own
+# that needs no checkout: its pom.xml (rt-core/template/standalone) has the published
+# org.arflex:arflex-parent as parent and builds native/ with CMake against an installed SDK
+# (mvn verify -Darflex.sdk=PREFIX), native/CMakeLists.txt finds that SDK by itself
+# (find_package(arflex)), and DIR/pom.xml, if any, is left alone.
 set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 TEMPLATE="$ROOT/rt-core/template/component"
+STANDALONE_POM="$ROOT/rt-core/template/standalone/pom.xml"
 
 usage() {
   echo "usage: ./arflex new component NAME [--dest DIR]   (NAME: [a-z][a-z0-9-]{0,39})" >&2
@@ -37,8 +44,14 @@ if ! [[ "$name" =~ ^[a-z][a-z0-9-]{0,39}$ ]]; then
   exit 2
 fi
 [ -d "$dest" ] || { echo "new component: no directory '$dest'" >&2; exit 2; }
-dest=$(cd "$dest" && pwd)
+dest=$(cd "$dest" && pwd -P)
 target="$dest/$name"
+# In the tree: DIR inside this repository, or DIR holding a copy of bundles/pom.xml (a tree built
+# elsewhere, the ctest tools.new_component).
+case "$dest/" in "$(cd "$ROOT" && pwd -P)/"*) in_tree=true ;; *) in_tree=false ;; esac
+if [ -f "$dest/pom.xml" ] && grep -q '<artifactId>arflex-bundles</artifactId>' "$dest/pom.xml"; then
+  in_tree=true
+fi
 if [ -e "$target" ]; then
   echo "new component: $target already exists; nothing changed (pick another name, or" \
        "remove that folder first)" >&2
@@ -47,8 +60,12 @@ fi
 c_name=${name//-/_}
 # The CMake targets NAME and test_C_NAME share one namespace with every other target of the
 # superbuild: refuse a name that is already taken there (the configure step would fail).
-clash=$(cd "$ROOT" && grep -rlE --include=CMakeLists.txt \
-  "add_(executable|library)\((test_)?($name|$c_name)[ )]" rt-core bundles simulator contracts 2>/dev/null || true)
+# (Out of the tree the component is a CMake project of its own.)
+clash=""
+if $in_tree; then
+  clash=$(cd "$ROOT" && grep -rlE --include=CMakeLists.txt \
+    "add_(executable|library)\((test_)?($name|$c_name)[ )]" rt-core bundles simulator contracts 2>/dev/null || true)
+fi
 if [ -n "$clash" ]; then
   echo "new component: '$name' clashes with a CMake target defined in:" $clash >&2
   exit 1
@@ -66,13 +83,18 @@ trap 'rm -rf "$tmp"' EXIT
   mkdir -p "$tmp/$(dirname "$out")"
   sed -e "s/@NAME@/$name/g" -e "s/@C_NAME@/$c_name/g" "$TEMPLATE/$rel" >"$tmp/$out"
 done
+if ! $in_tree; then
+  # the version of the ARFLEX artifacts this tree publishes (mvn install): the parent's
+  version=$(sed -n '0,/<version>/s:.*<version>\([^<]*\)</version>.*:\1:p' "$ROOT/pom.xml")
+  sed -e "s/@NAME@/$name/g" -e "s/@VERSION@/$version/g" "$STANDALONE_POM" >"$tmp/pom.xml"
+fi
 mv "$tmp" "$target"
 trap - EXIT
 echo "created $target"
 
 pom="$dest/pom.xml"
 artifact="org.arflex.cell.$name" # the template's pom.xml
-if [ -f "$pom" ]; then
+if $in_tree && [ -f "$pom" ]; then
   if grep -q "<module>$name</module>" "$pom"; then
     echo "$pom already lists <module>$name</module>"
   elif grep -q '</modules>' "$pom"; then
@@ -93,6 +115,16 @@ if [ -f "$pom" ]; then
   else
     echo "new component: $pom has no <dependencies>; add a dependency on $artifact yourself" >&2
   fi
+fi
+if ! $in_tree; then
+  cat <<MSG
+next (out of the tree: a project of its own, built against the installed SDK):
+  install the SDK once, from an ARFLEX build:  cmake --install <arflex>/target/native --prefix SDK
+  and the ARFLEX artifacts into your Maven repository (mvn install in the ARFLEX tree), then:
+    cd $target && mvn verify -Darflex.sdk=SDK
+  see $target/README.md
+MSG
+  exit 0
 fi
 cat <<MSG
 next:

@@ -15,6 +15,9 @@
 # The runtime runs as an evaluation run (-Darflex.evaluation=true): sim-robot publishes the
 # simulator's ground truth (the true TCP), which only the summary reads (simulator/README.md,
 # "Ground truth"). ARFLEX_EVALUATION=false turns it off.
+# ARFLEX_CELL_GOSH (./arflex run --empty: /dev/null): the commands that install the cell instead
+# of conf/cell.gosh; with none, the runtime (DRCR, shell, console) comes up with no component, and
+# the headless loop prints only `arflex:list` (D84).
 set -euo pipefail
 # Everything the runtime creates (felix-cache, the extracted RT executables, logs) is private to
 # its user: under umask 000 another user could replace an RT executable that runs as root
@@ -24,6 +27,7 @@ umask 077
 RUNTIME_DIR=${1:?runtime directory}
 HEADLESS=${2:-}
 cd "$RUNTIME_DIR"
+CELL_GOSH=${ARFLEX_CELL_GOSH:-conf/cell.gosh}
 
 if [ -n "$HEADLESS" ] && ! [[ "$HEADLESS" =~ ^[0-9]+$ ]]; then
   echo "arflex run: --headless takes whole seconds, not '$HEADLESS'" >&2
@@ -99,7 +103,11 @@ fi
 # readiness comes from the DRCR (arflex:await), the summary from arflex:summary, nothing from the
 # log (docs/DECISIONS.md D31).
 commands() {
-  echo "echo 'ARFLEX runtime up; installing the cell (conf/cell.gosh)'"
+  if [ "$CELL_GOSH" = /dev/null ]; then
+    echo "echo 'ARFLEX runtime up; no cell (--empty): install components with start file:<bundle.jar>'"
+  else
+    echo "echo 'ARFLEX runtime up; installing the cell ($CELL_GOSH)'"
+  fi
   # Felix's start installs a bundle from its URL and starts it; the DRCR's extender then reads
   # its contract, plans, and starts its RT half once its inputs are satisfied.
   local line name awaited=" " cell=
@@ -121,7 +129,7 @@ commands() {
         printf '%s\n' "$line" ;;
       *) printf '%s\n' "${line//@CELL@/$RUNTIME_DIR/cell}" ;;
     esac
-  done < conf/cell.gosh
+  done < "$CELL_GOSH"
   # the console answers once the whole cell is ACTIVE (or says which component is not, and why);
   # a cell.gosh that starts nothing (the browser tests' own) is not waited for
   if [ -n "$cell" ]; then
@@ -136,8 +144,10 @@ commands() {
     while [ $SECONDS -lt $end ]; do
       sleep 5
       echo "arflex:list"
-      echo "arflex:stats sim-robot"
-      echo "arflex:summary"
+      if [ -n "$cell" ]; then
+        echo "arflex:stats sim-robot"
+        echo "arflex:summary"
+      fi
     done
     echo "stop 0"
   else

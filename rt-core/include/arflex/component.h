@@ -245,6 +245,17 @@ ARFLEX_API void arflex_input_reject(struct arflex_input *in);
 
 /** The control block (read-only use; e.g. config.period_ns). */
 ARFLEX_API const struct arflex_ctl *arflex_component_ctl(const struct arflex_component *c);
+
+/** @period_ns in seconds, the time step of a control law: equal to the decimal constant a
+ *  legacy loop wrote for it (`#define DT 0.009` for 9 ms, bit for bit), at every period. The
+ *  division is rounded once from the exact quotient, as the compiler rounds that literal;
+ *  period_ns * 1e-9 multiplies by an inexact 1e-9 and differs at 9, 11, 13 ms and 40% of all
+ *  whole-microsecond periods (rt-core/template/GUIDE.md, "A bit-exact time step"; ctest
+ *  rt.template.dt). Usage: dt = arflex_period_s(arflex_component_ctl(c)->config.period_ns). */
+static inline double arflex_period_s(uint64_t period_ns)
+{
+	return (double)period_ns / 1e9;
+}
 /** Runtime id and instance name. */
 ARFLEX_API const char *arflex_component_runtime(const struct arflex_component *c);
 ARFLEX_API const char *arflex_component_instance(const struct arflex_component *c);

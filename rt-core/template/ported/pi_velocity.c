@@ -91,7 +91,7 @@ static int pi_configure(struct arflex_component *c, void *user)
 		fprintf(stderr, "pi-velocity: parameters kp, ki and setpoint are required\n");
 		return -ENOENT;
 	}
-	s->dt = (double)arflex_component_ctl(c)->config.period_ns * 1e-9;
+	s->dt = arflex_period_s(arflex_component_ctl(c)->config.period_ns);
 	ret = arflex_component_output(c, "velocity", ARFLEX_PORT_STATE, &sample_type,
 				      &s->velocity_out);
 	if (ret == 0)
