@@ -6,8 +6,6 @@ import static org.junit.jupiter.api.Assertions.assertTrue;
 import java.io.BufferedReader;
 import java.io.IOException;
 import java.io.InputStreamReader;
-import java.net.InetAddress;
-import java.net.ServerSocket;
 import java.nio.charset.StandardCharsets;
 import java.nio.file.Files;
 import java.nio.file.Path;
@@ -43,22 +41,10 @@ class EmptyRunIT {
 
     @Test
     void theRuntimeComesUpWithTheDrcrAndNoCellAndStopsLeavingNothing(@TempDir Path tmp) throws Exception {
-        Path copy = Path.of(System.getProperty("arflex.it.work")).resolve("empty-assembly");
-        Runtime.deleteTree(copy);
-        Runtime.copyTree(Path.of(System.getProperty("arflex.it.runtime")), copy);
-        int port;
-        try (ServerSocket s = new ServerSocket(0, 1, InetAddress.getLoopbackAddress())) {
-            port = s.getLocalPort();
-        }
-        Path conf = copy.resolve("conf/config.properties");
-        Files.writeString(conf, Files.readString(conf).replace("org.osgi.service.http.port=8480",
-                "org.osgi.service.http.port=" + port));
+        HeadlessRun run = HeadlessRun.copy("empty-assembly");
+        Path copy = run.assembly();
         int seconds = 8;
-        ProcessBuilder pb = new ProcessBuilder("bash", ROOT.resolve("scripts/run-cell.sh").toString(), copy.toString(),
-                Integer.toString(seconds)).redirectErrorStream(true);
-        pb.environment().remove("ARFLEX_CONSOLE_PASSWORD");
-        pb.environment().remove("ARFLEX_CONSOLE_USER");
-        pb.environment().put("ARFLEX_HOME", tmp.resolve("home").toString());
+        ProcessBuilder pb = run.command(seconds, tmp.resolve("home"));
         pb.environment().put("ARFLEX_CELL_GOSH", "/dev/null"); // what ./arflex run --empty sets
         List<String> out = new CopyOnWriteArrayList<>();
         Process p = pb.start();

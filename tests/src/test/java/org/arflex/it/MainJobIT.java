@@ -15,7 +15,6 @@ import java.net.Inet4Address;
 import java.net.InetAddress;
 import java.net.InetSocketAddress;
 import java.net.NetworkInterface;
-import java.net.ServerSocket;
 import java.net.Socket;
 import java.net.URI;
 import java.nio.charset.StandardCharsets;
@@ -175,22 +174,11 @@ class MainJobIT {
 
     @Test
     void theHeadlessMainJobRunsTheCellBehindTheLoginOnLoopbackOnlyAndStopsCleanly(@TempDir Path tmp) throws Exception {
-        Path copy = Path.of(System.getProperty("arflex.it.work")).resolve("mainjob-assembly");
-        Runtime.deleteTree(copy);
-        Runtime.copyTree(Path.of(System.getProperty("arflex.it.runtime")), copy);
-        int port;
-        try (ServerSocket s = new ServerSocket(0, 1, InetAddress.getLoopbackAddress())) {
-            port = s.getLocalPort();
-        }
-        Path conf = copy.resolve("conf/config.properties");
-        Files.writeString(conf, Files.readString(conf).replace("org.osgi.service.http.port=8480",
-                "org.osgi.service.http.port=" + port));
+        HeadlessRun run = HeadlessRun.copy("mainjob-assembly");
+        Path copy = run.assembly();
+        int port = run.port();
         int seconds = 40;
-        ProcessBuilder pb = new ProcessBuilder("bash", ROOT.resolve("scripts/run-cell.sh").toString(), copy.toString(),
-                Integer.toString(seconds)).redirectErrorStream(true);
-        pb.environment().remove("ARFLEX_CONSOLE_PASSWORD");
-        pb.environment().remove("ARFLEX_CONSOLE_USER");
-        pb.environment().put("ARFLEX_HOME", tmp.resolve("home").toString());
+        ProcessBuilder pb = run.command(seconds, tmp.resolve("home"));
         List<String> out = new CopyOnWriteArrayList<>();
         Process p = pb.start();
         Thread reader = new Thread(() -> {
