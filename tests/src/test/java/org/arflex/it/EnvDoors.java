@@ -122,11 +122,12 @@ final class EnvDoors {
 
     /**
      * Starts bundle {@code id} and waits until the counter is ACTIVE or FAILED, or the code gate
-     * refused the bundle (its log line since now); returns null when it went ACTIVE, else the
-     * gate's refusal or the failure.
+     * refused the bundle (its log line since {@code mark}, taken before the install or update:
+     * the gate judges a revision once, at its first resolve, which another bundle's resolve may
+     * start before this start); returns null when it went ACTIVE, else the gate's refusal or the
+     * failure.
      */
-    private static String startAndJudge(Runtime rt, long id) {
-        int mark = rt.logMark();
+    private static String startAndJudge(Runtime rt, long id, int mark) {
         rt.cmd("start " + id);
         String tag = "code gate: bundle " + id + " refused";
         String[] why = new String[1];
@@ -162,8 +163,9 @@ final class EnvDoors {
             Files.setPosixFilePermissions(tools, PosixFilePermissions.fromString("rwxrwxrwx"));
             Path dropped = tools.resolve("dropped.jar");
             u.as("cp", jar.toString(), dropped.toString());
+            int mark = rt.logMark();
             long id = rt.install(dropped);
-            String problem = startAndJudge(rt, id);
+            String problem = startAndJudge(rt, id, mark);
             String ran = ranAs(marker);
             rt.cmd("uninstall " + id);
             rt.waitUntil(COMPONENT + " gone", CellIT.T, () -> rt.instance(COMPONENT) == null);
@@ -182,12 +184,14 @@ final class EnvDoors {
             Path theirs = Files.copy(Components.jar("sample-counter"), tools.resolve("theirs.jar"));
             Files.setPosixFilePermissions(theirs, PosixFilePermissions.fromString("rw-r--r--"));
             run(List.of("chown", u.uid + ":" + u.gid, theirs.toString()), false);
+            int mark = rt.logMark();
             long id = rt.install(theirs);
-            String first = startAndJudge(rt, id);
+            String first = startAndJudge(rt, id, mark);
             // the owner rewrites it in place (tools/ is 0755: no rename), then the operator updates
             u.as("cp", jar.toString(), theirs.toString());
+            int updated = rt.logMark();
             rt.cmd("update " + id);
-            String second = startAndJudge(rt, id);
+            String second = startAndJudge(rt, id, updated);
             String ran = ranAs(marker);
             rt.cmd("uninstall " + id);
             rt.waitUntil(COMPONENT + " gone", CellIT.T, () -> rt.instance(COMPONENT) == null);
@@ -235,8 +239,9 @@ final class EnvDoors {
     static CodeDoors.Attempt strayFaultInRuntimeEnvironment() throws Exception {
         Map<String, String> env = Map.of("ARFLEX_TEST_HOOKS", "1", "ARFLEX_FAULT_START_ERRNO", "125");
         try (Runtime rt = Runtime.withEnvironment("env-stray", env, "arflex.test.hooks=false")) {
+            int mark = rt.logMark();
             long id = rt.install(Components.jar("sample-counter"));
-            String problem = startAndJudge(rt, id);
+            String problem = startAndJudge(rt, id, mark);
             rt.cmd("uninstall " + id);
             rt.waitUntil(COMPONENT + " gone", CellIT.T, () -> rt.instance(COMPONENT) == null);
             return new CodeDoors.Attempt("stray ARFLEX_TEST_HOOKS + ARFLEX_FAULT_START_ERRNO in the runtime's environment",
